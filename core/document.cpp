@@ -1,0 +1,336 @@
+#include "core/document.h"
+
+#include <cmath>
+
+#include "core/atomic_file.h"
+#include "core/errors.h"
+
+namespace lobe {
+
+using nlohmann::json;
+
+namespace {
+
+// Upper bounds on what a document may hold; a file beyond them is refused.
+constexpr std::size_t kMaxStrokes = 100000;
+constexpr std::size_t kMaxPointsPerStroke = 1000000;
+
+json settings_to_json(const Settings& s)
+{
+    const InputOptions& in = s.input;
+    return json{
+        {"input",
+         {{"filter",
+           {{"min_cutoff_hz", in.filter.min_cutoff_hz},
+            {"beta", in.filter.beta},
+            {"d_cutoff_hz", in.filter.d_cutoff_hz}}},
+          {"pinch_start_m", in.pinch_start_m},
+          {"pinch_release_m", in.pinch_release_m},
+          {"pinch_min_hold_s", in.pinch_min_hold_s},
+          {"curl_grab", in.curl_grab},
+          {"curl_release", in.curl_release},
+          {"curl_point_index_max", in.curl_point_index_max},
+          {"min_point_distance_m", in.min_point_distance_m},
+          {"bridge_loss_s", in.bridge_loss_s},
+          {"min_stroke_length_m", in.min_stroke_length_m},
+          {"min_stroke_points", in.min_stroke_points},
+          {"max_hand_speed_mps", in.max_hand_speed_mps}}},
+    };
+}
+
+template <typename T>
+void read_number(const json& obj, const char* key, T& out, const std::string& where)
+{
+    auto it = obj.find(key);
+    if (it == obj.end()) return; // missing keys keep their defaults
+    if (!it->is_number())
+        throw InvalidInput(where + "." + key + ": expected a number");
+    double v = it->get<double>();
+    if (!std::isfinite(v)) throw InvalidInput(where + "." + key + ": not a finite number");
+    out = static_cast<T>(v);
+}
+
+void check_keys(const json& obj, std::initializer_list<const char*> known, const std::string& where)
+{
+    for (auto it = obj.begin(); it != obj.end(); ++it) {
+        bool ok = false;
+        for (const char* k : known) ok = ok || it.key() == k;
+        if (!ok) throw InvalidInput(where + ": unknown key '" + it.key() + "'");
+    }
+}
+
+Settings settings_from_json(const json& j)
+{
+    Settings s;
+    if (!j.is_object()) throw InvalidInput("settings: expected an object");
+    check_keys(j, {"input"}, "settings");
+    if (auto it = j.find("input"); it != j.end()) {
+        if (!it->is_object()) throw InvalidInput("settings.input: expected an object");
+        const json& in = *it;
+        const std::string w = "settings.input";
+        check_keys(in,
+                   {"filter", "pinch_start_m", "pinch_release_m", "pinch_min_hold_s", "curl_grab",
+                    "curl_release", "curl_point_index_max", "min_point_distance_m", "bridge_loss_s",
+                    "min_stroke_length_m", "min_stroke_points", "max_hand_speed_mps"},
+                   w);
+        InputOptions& o = s.input;
+        if (auto f = in.find("filter"); f != in.end()) {
+            if (!f->is_object()) throw InvalidInput(w + ".filter: expected an object");
+            check_keys(*f, {"min_cutoff_hz", "beta", "d_cutoff_hz"}, w + ".filter");
+            read_number(*f, "min_cutoff_hz", o.filter.min_cutoff_hz, w + ".filter");
+            read_number(*f, "beta", o.filter.beta, w + ".filter");
+            read_number(*f, "d_cutoff_hz", o.filter.d_cutoff_hz, w + ".filter");
+        }
+        read_number(in, "pinch_start_m", o.pinch_start_m, w);
+        read_number(in, "pinch_release_m", o.pinch_release_m, w);
+        read_number(in, "pinch_min_hold_s", o.pinch_min_hold_s, w);
+        read_number(in, "curl_grab", o.curl_grab, w);
+        read_number(in, "curl_release", o.curl_release, w);
+        read_number(in, "curl_point_index_max", o.curl_point_index_max, w);
+        read_number(in, "min_point_distance_m", o.min_point_distance_m, w);
+        read_number(in, "bridge_loss_s", o.bridge_loss_s, w);
+        read_number(in, "min_stroke_length_m", o.min_stroke_length_m, w);
+        read_number(in, "min_stroke_points", o.min_stroke_points, w);
+        read_number(in, "max_hand_speed_mps", o.max_hand_speed_mps, w);
+    }
+    validate_settings(s);
+    return s;
+}
+
+json stroke_to_json(const Stroke& s)
+{
+    json pts = json::array();
+    for (const StrokePoint& p : s.points)
+        pts.push_back(json::array({p.position.x, p.position.y, p.position.z}));
+    json times = json::array();
+    for (const StrokePoint& p : s.points) times.push_back(p.time);
+    return json{{"id", s.id},     {"kind", stroke_kind_name(s.kind)}, {"hand", hand_name(s.hand)},
+                {"closed", s.closed}, {"points", std::move(pts)},       {"times", std::move(times)}};
+}
+
+std::int64_t read_id(const json& j, const char* key, const std::string& where)
+{
+    auto it = j.find(key);
+    if (it == j.end() || !it->is_number_integer())
+        throw InvalidInput(where + "." + key + ": expected an integer");
+    return it->get<std::int64_t>();
+}
+
+Stroke stroke_from_json(const json& j, const std::string& where)
+{
+    if (!j.is_object()) throw InvalidInput(where + ": expected an object");
+    Stroke s;
+    s.id = read_id(j, "id", where);
+    auto kind = j.find("kind");
+    if (kind == j.end() || !kind->is_string()) throw InvalidInput(where + ".kind: expected a string");
+    s.kind = stroke_kind_from_name(kind->get<std::string>());
+    if (auto h = j.find("hand"); h != j.end()) {
+        if (!h->is_string() || (*h != "left" && *h != "right"))
+            throw InvalidInput(where + ".hand: expected \"left\" or \"right\"");
+        s.hand = *h == "left" ? Hand::Left : Hand::Right;
+    }
+    if (auto c = j.find("closed"); c != j.end()) {
+        if (!c->is_boolean()) throw InvalidInput(where + ".closed: expected true or false");
+        s.closed = c->get<bool>();
+    }
+    auto pts = j.find("points");
+    if (pts == j.end() || !pts->is_array()) throw InvalidInput(where + ".points: expected an array");
+    if (pts->size() > kMaxPointsPerStroke) throw InvalidInput(where + ".points: too many points");
+    const json* times = nullptr;
+    if (auto t = j.find("times"); t != j.end()) {
+        if (!t->is_array() || t->size() != pts->size())
+            throw InvalidInput(where + ".times: expected one time per point");
+        times = &*t;
+    }
+    s.points.reserve(pts->size());
+    for (std::size_t i = 0; i < pts->size(); ++i) {
+        const json& p = (*pts)[i];
+        if (!p.is_array() || p.size() != 3 || !p[0].is_number() || !p[1].is_number() || !p[2].is_number())
+            throw InvalidInput(where + ".points[" + std::to_string(i) + "]: expected [x, y, z]");
+        StrokePoint sp;
+        sp.position = {p[0].get<float>(), p[1].get<float>(), p[2].get<float>()};
+        if (!std::isfinite(sp.position.x) || !std::isfinite(sp.position.y) || !std::isfinite(sp.position.z))
+            throw InvalidInput(where + ".points[" + std::to_string(i) + "]: not finite");
+        if (times) {
+            if (!(*times)[i].is_number()) throw InvalidInput(where + ".times: expected numbers");
+            sp.time = (*times)[i].get<double>();
+        }
+        s.points.push_back(sp);
+    }
+    return s;
+}
+
+} // namespace
+
+void validate_settings(const Settings& s)
+{
+    const InputOptions& o = s.input;
+    auto require = [](bool ok, const char* what) {
+        if (!ok) throw InvalidInput(std::string("settings.input.") + what);
+    };
+    require(o.filter.min_cutoff_hz > 0 && o.filter.min_cutoff_hz <= 1000, "filter.min_cutoff_hz must be in (0, 1000]");
+    require(o.filter.beta >= 0 && o.filter.beta <= 1e4, "filter.beta must be in [0, 10000]");
+    require(o.filter.d_cutoff_hz > 0 && o.filter.d_cutoff_hz <= 1000, "filter.d_cutoff_hz must be in (0, 1000]");
+    require(o.pinch_start_m > 0 && o.pinch_start_m < 0.1, "pinch_start_m must be in (0, 0.1)");
+    require(o.pinch_release_m > o.pinch_start_m && o.pinch_release_m < 0.2,
+            "pinch_release_m must be above pinch_start_m and below 0.2");
+    require(o.pinch_min_hold_s >= 0 && o.pinch_min_hold_s <= 1, "pinch_min_hold_s must be in [0, 1]");
+    require(o.curl_grab > 0 && o.curl_grab <= 1, "curl_grab must be in (0, 1]");
+    require(o.curl_release >= 0 && o.curl_release < o.curl_grab, "curl_release must be in [0, curl_grab)");
+    require(o.curl_point_index_max > 0 && o.curl_point_index_max < 1, "curl_point_index_max must be in (0, 1)");
+    require(o.min_point_distance_m >= 0.0005 && o.min_point_distance_m <= 0.1,
+            "min_point_distance_m must be in [0.0005, 0.1]");
+    require(o.bridge_loss_s >= 0 && o.bridge_loss_s <= 5, "bridge_loss_s must be in [0, 5]");
+    require(o.min_stroke_length_m >= 0 && o.min_stroke_length_m <= 10, "min_stroke_length_m must be in [0, 10]");
+    require(o.min_stroke_points >= 2 && o.min_stroke_points <= 1000, "min_stroke_points must be in [2, 1000]");
+    require(o.max_hand_speed_mps > 0.5 && o.max_hand_speed_mps <= 100, "max_hand_speed_mps must be in (0.5, 100]");
+}
+
+nlohmann::json settings_json(const Settings& s) { return settings_to_json(s); }
+Settings settings_from_json_checked(const nlohmann::json& j) { return settings_from_json(j); }
+
+json document_to_json(const Document& doc)
+{
+    json strokes = json::array();
+    for (const Stroke& s : doc.strokes) strokes.push_back(stroke_to_json(s));
+    json lobes = json::array();
+    for (const LobeRecord& l : doc.lobes)
+        lobes.push_back({{"id", l.id}, {"strokes", l.stroke_ids}, {"mesh", l.mesh_file}});
+    json edits = json::array();
+    for (const EditOperation& e : doc.edits)
+        edits.push_back({{"id", e.id}, {"type", e.type}, {"target", e.target}, {"params", e.params}});
+    json trees = json::array();
+    for (const TreeInstance& t : doc.trees) {
+        json m = json::array();
+        for (int c = 0; c < 4; ++c)
+            for (int r = 0; r < 4; ++r) m.push_back(t.transform[c][r]);
+        trees.push_back({{"id", t.id}, {"transform", m}, {"seed", t.seed}, {"lobes", t.lobe_ids}});
+    }
+    return json{{"format", "lobesketch-session"},
+                {"version", doc.version},
+                {"source_recording", doc.source_recording},
+                {"seed", doc.seed},
+                {"settings", settings_to_json(doc.settings)},
+                {"strokes", std::move(strokes)},
+                {"lobes", std::move(lobes)},
+                {"edits", std::move(edits)},
+                {"trees", std::move(trees)}};
+}
+
+Document document_from_json(const json& j)
+{
+    if (!j.is_object()) throw InvalidInput("not a session document (expected a JSON object)");
+    auto fmt = j.find("format");
+    if (fmt == j.end() || *fmt != "lobesketch-session")
+        throw InvalidInput("not a session document (missing \"format\": \"lobesketch-session\")");
+    auto ver = j.find("version");
+    if (ver == j.end() || !ver->is_number_integer()) throw InvalidInput("version: expected an integer");
+    int version = ver->get<int>();
+    if (version < 1 || version > kDocumentVersion)
+        throw InvalidInput("unsupported session version " + std::to_string(version) + " (this build reads 1.." +
+                           std::to_string(kDocumentVersion) + ")");
+    Document doc;
+    doc.version = kDocumentVersion;
+    if (auto it = j.find("source_recording"); it != j.end() && it->is_string())
+        doc.source_recording = it->get<std::string>();
+    if (auto it = j.find("seed"); it != j.end()) {
+        if (!it->is_number_unsigned()) throw InvalidInput("seed: expected a non-negative integer");
+        doc.seed = it->get<std::uint64_t>();
+    }
+    if (auto it = j.find("settings"); it != j.end()) doc.settings = settings_from_json(*it);
+
+    auto array_of = [&](const char* key) -> const json* {
+        auto it = j.find(key);
+        if (it == j.end()) return nullptr;
+        if (!it->is_array()) throw InvalidInput(std::string(key) + ": expected an array");
+        return &*it;
+    };
+    if (const json* a = array_of("strokes")) {
+        if (a->size() > kMaxStrokes) throw InvalidInput("strokes: too many strokes");
+        for (std::size_t i = 0; i < a->size(); ++i)
+            doc.strokes.push_back(stroke_from_json((*a)[i], "strokes[" + std::to_string(i) + "]"));
+    }
+    if (const json* a = array_of("lobes")) {
+        for (std::size_t i = 0; i < a->size(); ++i) {
+            const json& l = (*a)[i];
+            const std::string w = "lobes[" + std::to_string(i) + "]";
+            if (!l.is_object()) throw InvalidInput(w + ": expected an object");
+            LobeRecord r;
+            r.id = read_id(l, "id", w);
+            if (auto s = l.find("strokes"); s != l.end()) {
+                if (!s->is_array()) throw InvalidInput(w + ".strokes: expected an array of ids");
+                for (const json& id : *s) {
+                    if (!id.is_number_integer()) throw InvalidInput(w + ".strokes: expected integer ids");
+                    r.stroke_ids.push_back(id.get<std::int64_t>());
+                }
+            }
+            if (auto m = l.find("mesh"); m != l.end() && m->is_string()) r.mesh_file = m->get<std::string>();
+            doc.lobes.push_back(std::move(r));
+        }
+    }
+    if (const json* a = array_of("edits")) {
+        for (std::size_t i = 0; i < a->size(); ++i) {
+            const json& e = (*a)[i];
+            const std::string w = "edits[" + std::to_string(i) + "]";
+            if (!e.is_object()) throw InvalidInput(w + ": expected an object");
+            EditOperation op;
+            op.id = read_id(e, "id", w);
+            auto t = e.find("type");
+            if (t == e.end() || !t->is_string()) throw InvalidInput(w + ".type: expected a string");
+            op.type = t->get<std::string>();
+            op.target = read_id(e, "target", w);
+            if (auto p = e.find("params"); p != e.end()) op.params = *p;
+            doc.edits.push_back(std::move(op));
+        }
+    }
+    if (const json* a = array_of("trees")) {
+        for (std::size_t i = 0; i < a->size(); ++i) {
+            const json& t = (*a)[i];
+            const std::string w = "trees[" + std::to_string(i) + "]";
+            if (!t.is_object()) throw InvalidInput(w + ": expected an object");
+            TreeInstance ti;
+            ti.id = read_id(t, "id", w);
+            if (auto m = t.find("transform"); m != t.end()) {
+                if (!m->is_array() || m->size() != 16) throw InvalidInput(w + ".transform: expected 16 numbers");
+                for (int k = 0; k < 16; ++k) {
+                    if (!(*m)[k].is_number()) throw InvalidInput(w + ".transform: expected 16 numbers");
+                    float v = (*m)[k].get<float>();
+                    if (!std::isfinite(v)) throw InvalidInput(w + ".transform: not finite");
+                    ti.transform[k / 4][k % 4] = v;
+                }
+            }
+            if (auto s = t.find("seed"); s != t.end()) {
+                if (!s->is_number_unsigned()) throw InvalidInput(w + ".seed: expected a non-negative integer");
+                ti.seed = s->get<std::uint64_t>();
+            }
+            if (auto l = t.find("lobes"); l != t.end()) {
+                if (!l->is_array()) throw InvalidInput(w + ".lobes: expected an array of ids");
+                for (const json& id : *l) {
+                    if (!id.is_number_integer()) throw InvalidInput(w + ".lobes: expected integer ids");
+                    ti.lobe_ids.push_back(id.get<std::int64_t>());
+                }
+            }
+            doc.trees.push_back(std::move(ti));
+        }
+    }
+    return doc;
+}
+
+void save_document(const std::string& path, const Document& doc)
+{
+    write_file_atomic(path, document_to_json(doc).dump(1) + "\n");
+}
+
+Document load_document(const std::string& path)
+{
+    std::string text = read_file_limited(path, kMaxDocumentBytes);
+    json j = json::parse(text, nullptr, /*allow_exceptions=*/false);
+    if (j.is_discarded()) throw FileError(path, "not valid JSON");
+    try {
+        return document_from_json(j);
+    } catch (const InvalidInput& e) {
+        throw FileError(path, e.what());
+    }
+}
+
+} // namespace lobe

@@ -1,0 +1,74 @@
+#pragma once
+/// \file document.h
+/// The session document: everything a person made (strokes, lobes, edits as operations,
+/// settings, seed, trees with their transforms). Versioned JSON, saved atomically.
+/// Format: docs/session-format.md.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/mat4x4.hpp>
+#include <nlohmann/json.hpp>
+
+#include "core/settings.h"
+#include "core/stroke.h"
+
+namespace lobe {
+
+inline constexpr int kDocumentVersion = 1;
+
+/// An edit stored as an operation, re-applied whenever the thing it edits is rebuilt.
+struct EditOperation {
+    std::int64_t id = 0;
+    std::string type;      ///< e.g. "pinch_deform", "bezier_stroke", "transform_lobe"
+    std::int64_t target = 0; ///< lobe or stroke id
+    nlohmann::json params = nlohmann::json::object();
+};
+
+struct LobeRecord {
+    std::int64_t id = 0;
+    std::vector<std::int64_t> stroke_ids;
+    std::string mesh_file; ///< relative to the document, empty until meshed
+};
+
+/// One tree of the scene: variants and forests are several of these.
+struct TreeInstance {
+    std::int64_t id = 0;
+    glm::mat4 transform{1.0f};
+    std::uint64_t seed = 1;
+    std::vector<std::int64_t> lobe_ids; ///< empty = all lobes
+};
+
+struct Document {
+    int version = kDocumentVersion;
+    std::string source_recording; ///< the recording this session was replayed from, if any
+    std::uint64_t seed = 1;
+    Settings settings;
+    std::vector<Stroke> strokes;
+    std::vector<LobeRecord> lobes;
+    std::vector<EditOperation> edits;
+    std::vector<TreeInstance> trees;
+};
+
+/// \throw InvalidInput naming the first setting out of its range.
+void validate_settings(const Settings& s);
+nlohmann::json settings_json(const Settings& s);
+/// Parses a settings object (unknown keys and wrong types are refused).
+/// \throw InvalidInput
+Settings settings_from_json_checked(const nlohmann::json& j);
+
+nlohmann::json document_to_json(const Document& doc);
+/// \throw InvalidInput naming the offending field when the JSON is not a valid document.
+Document document_from_json(const nlohmann::json& j);
+
+/// Saves atomically (temporary file, flush, rename): the old file survives any crash.
+/// \throw FileError
+void save_document(const std::string& path, const Document& doc);
+/// \throw FileError with a one-line reason naming the file.
+Document load_document(const std::string& path);
+
+/// Largest session file the loader accepts.
+inline constexpr std::size_t kMaxDocumentBytes = 256u << 20;
+
+} // namespace lobe

@@ -1,0 +1,49 @@
+#pragma once
+/// \file settings.h
+/// Options structs, one per pipeline stage, with the defaults documented once here.
+/// Every field is settable from the CLI/settings files and stored in the session document.
+
+#include <cstdint>
+
+namespace lobe {
+
+/// One Euro filter (Casiez et al., CHI 2012) on the joints that matter.
+struct OneEuroOptions {
+    double min_cutoff_hz = 1.0; ///< cutoff at rest: lower removes more jitter
+    double beta = 8.0;          ///< speed coefficient (per m/s): higher removes more lag when moving
+    double d_cutoff_hz = 1.0;   ///< cutoff of the speed estimate
+};
+
+/// Gesture recognition and stroke capture (hands → pen events → raw strokes).
+struct InputOptions {
+    OneEuroOptions filter;
+    /// Pinch starts when the thumb-tip/index-tip gap (centre distance minus both joint
+    /// radii) falls below this, and ends when it rises above pinch_release_m.
+    double pinch_start_m = 0.008;
+    double pinch_release_m = 0.016;
+    /// A pinch needs the gap below pinch_start_m for this long (debounces single-frame dips).
+    double pinch_min_hold_s = 0.03;
+    /// Curl (0 straight … 1 fully bent) of middle, ring and little above which they count as
+    /// curled; all three curled = grab, which is never a pinch.
+    double curl_grab = 0.45;
+    double curl_release = 0.35;
+    /// Index finger straight and middle/ring/little curled = point.
+    double curl_point_index_max = 0.25;
+    /// The paper keeps a new stroke point only when the fingertip moved at least this far.
+    double min_point_distance_m = 0.005;
+    /// Tracking loss shorter than this is bridged; longer ends the stroke.
+    double bridge_loss_s = 0.15;
+    /// Strokes shorter than this (polyline length) or with fewer points are discarded.
+    double min_stroke_length_m = 0.03;
+    int min_stroke_points = 4;
+    /// A hand position jump faster than this between two frames is a tracking glitch (snap to
+    /// the origin or the head) and the frame counts as lost.
+    double max_hand_speed_mps = 8.0;
+};
+
+/// All settings of a session.
+struct Settings {
+    InputOptions input;
+};
+
+} // namespace lobe

@@ -1,0 +1,118 @@
+#pragma once
+/// \file recording.h
+/// Recordings: the raw input of a session (hand joints, head pose, desktop mouse and
+/// keyboard), in a compact binary form for real sessions and a line-per-frame text form for
+/// hand-written fixtures. Everything derived (gestures, strokes, mode switches, edits) is
+/// recomputed on replay; derived actions may be stored as annotations that replay checks
+/// against and never applies. Format and version rules: docs/recording-format.md.
+
+#include <cstdint>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/hand_frame.h"
+
+namespace lobe {
+
+inline constexpr int kRecordingVersion = 1;
+
+/// Limits that keep a hostile or broken file from exhausting memory (documented in
+/// docs/recording-format.md). 648,000 frames is two hours at 90 Hz.
+inline constexpr std::size_t kMaxRecordingFrames = 648000;
+inline constexpr std::size_t kMaxRecordingEvents = 1000000;
+inline constexpr std::size_t kMaxRecordingAnnotations = 1000000;
+
+struct RecordingHeader {
+    int version = kRecordingVersion;
+    std::string source = "unknown";   ///< runtime or program that produced it ("openxr:Monado", "synth", "import-leap")
+    std::string device = "unknown";   ///< tracker ("Leap Motion", "Meta Quest 3", "synthetic hand")
+    std::string units = "m";          ///< always metres after import
+    std::string space = "stage";      ///< OpenXR reference space of the poses
+    double nominal_rate_hz = 90.0;
+    std::string created;              ///< ISO 8601, informational
+};
+
+/// Raw non-hand input. Desktop mouse/keyboard and controller buttons; codes are GLFW key
+/// and button codes. Unknown kinds in a file are skipped with a warning.
+enum class InputEventKind : std::uint8_t {
+    Key = 1,         ///< code = key, value = 1 press / 0 release
+    MouseButton = 2, ///< code = button, value = 1 press / 0 release
+    MouseMove = 3,   ///< x, y = cursor position in window pixels
+    MouseWheel = 4,  ///< y = wheel delta
+};
+
+struct InputEvent {
+    double time = 0.0;
+    InputEventKind kind = InputEventKind::Key;
+    std::int32_t code = 0;
+    std::int32_t value = 0;
+    float x = 0.0f;
+    float y = 0.0f;
+};
+
+/// A derived action written beside the raw input ("stroke_end id=3"): checked, never applied.
+struct Annotation {
+    double time = 0.0;
+    std::string text;
+};
+
+struct Recording {
+    RecordingHeader header;
+    std::vector<HandFrame> frames;     ///< strictly increasing time
+    std::vector<InputEvent> events;    ///< non-decreasing time
+    std::vector<Annotation> annotations;
+};
+
+/// What the reader had to drop or repair, for the one-line messages the CLI prints.
+struct ReadReport {
+    std::size_t frames_read = 0;
+    std::size_t frames_dropped = 0;
+    std::size_t events_dropped = 0;
+    std::vector<std::string> problems; ///< one line each, without the file name
+};
+
+/// Reads either form (detected by the first bytes). Recovers every complete, valid frame of
+/// a truncated or partly corrupt file; frames with NaN/Inf or absurd coordinates, or with
+/// time going backwards, are dropped and counted in the report.
+/// \throw FileError (one line, naming the file) when the file is missing, has a wrong magic
+///        or unsupported version, or no usable frame remains.
+Recording read_recording(const std::string& path, ReadReport* report = nullptr);
+
+/// Parses a recording held in memory (both forms); `name` is used in messages.
+Recording parse_recording(const std::string& bytes, const std::string& name, ReadReport* report = nullptr);
+
+/// Whole-file writers (atomic: temporary file, flush, rename).
+void write_recording_binary(const std::string& path, const Recording& rec);
+void write_recording_text(const std::string& path, const Recording& rec);
+std::string encode_recording_binary(const Recording& rec);
+std::string encode_recording_text(const Recording& rec);
+
+/// Streaming writer for live sessions: appends and flushes every `flush_every` frames (1 =
+/// every frame), so a crash loses at most the frames not yet flushed; the file is readable up
+/// to its last complete record at any moment.
+class RecordingWriter {
+public:
+    /// \throw FileError
+    RecordingWriter(const std::string& path, const RecordingHeader& header, int flush_every = 1);
+    ~RecordingWriter();
+    RecordingWriter(const RecordingWriter&) = delete;
+    RecordingWriter& operator=(const RecordingWriter&) = delete;
+
+    void append(const HandFrame& frame);
+    void append(const InputEvent& event);
+    void append(const Annotation& annotation);
+    void flush();
+    void close();
+    const std::string& path() const { return path_; }
+
+private:
+    void write_bytes(const std::string& bytes);
+    std::string path_;
+    std::FILE* file_ = nullptr;
+    int flush_every_ = 1;
+    int pending_ = 0;
+};
+
+} // namespace lobe

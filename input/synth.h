@@ -1,0 +1,72 @@
+#pragma once
+/// \file synth.h
+/// Realistic synthetic recordings from scenarios: an articulated hand whose index tip follows
+/// each stroke curve at human speed, real pinches before and after each stroke, near-pinches
+/// and grabs that must not draw, jitter, tremor and tracking drop-outs. Scenario format:
+/// docs/scenario-format.md.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+#include <nlohmann/json_fwd.hpp>
+
+#include "core/stroke.h"
+#include "input/recording.h"
+
+namespace lobe {
+
+/// One stroke to draw: the curve the index tip follows while pinching.
+struct ScenarioStroke {
+    StrokeKind kind = StrokeKind::Lobe;
+    Hand hand = Hand::Right;
+    std::vector<glm::vec3> curve; ///< control polyline in metres (densified by the synthesizer)
+    bool closed = false;          ///< the curve returns to its start
+    double speed_mps = 0.0;       ///< peak speed; 0 = chosen by the synthesizer in [0.2, 1] m/s
+};
+
+/// A scenario step: a stroke, a distractor gesture or a raw input event.
+struct ScenarioStep {
+    enum class Type { Stroke, NearPinch, Grab, Key, Pause } type = Type::Stroke;
+    ScenarioStroke stroke;       ///< Type::Stroke
+    Hand hand = Hand::Right;     ///< NearPinch, Grab
+    glm::vec3 where{0.0f};       ///< NearPinch, Grab: where the hand is
+    int key = 0;                 ///< Key: GLFW key code (see docs/scenario-format.md)
+    double duration_s = 0.5;     ///< Pause, NearPinch, Grab
+};
+
+struct Scenario {
+    std::string name;
+    std::uint64_t seed = 1;
+    double rate_hz = 90.0;
+    std::vector<ScenarioStep> steps;
+};
+
+/// \throw InvalidInput naming the field.
+Scenario scenario_from_json(const nlohmann::json& j);
+/// \throw FileError naming the file.
+Scenario load_scenario(const std::string& path);
+
+/// The curve a stroke really followed, for tests ("ground truth").
+struct GroundTruthStroke {
+    StrokeKind kind = StrokeKind::Lobe;
+    Hand hand = Hand::Right;
+    bool closed = false;
+    std::vector<glm::vec3> points; ///< dense, ≤ 2 mm apart
+    double t_begin = 0.0;          ///< recording time of the pinch start and end
+    double t_end = 0.0;
+};
+
+struct SynthResult {
+    Recording recording;
+    std::vector<GroundTruthStroke> truth;
+};
+
+SynthResult synthesize(const Scenario& scenario);
+
+nlohmann::json ground_truth_to_json(const std::vector<GroundTruthStroke>& truth);
+/// \throw FileError
+std::vector<GroundTruthStroke> load_ground_truth(const std::string& path);
+
+} // namespace lobe

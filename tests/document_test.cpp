@@ -1,0 +1,107 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "core/document.h"
+#include "core/errors.h"
+#include "tests/test_paths.h"
+
+using namespace lobe;
+
+namespace {
+Document sample_document()
+{
+    Document d;
+    d.seed = 42;
+    d.source_recording = "recordings/demo.lrec";
+    Stroke s;
+    s.id = 3;
+    s.kind = StrokeKind::Trunk;
+    s.hand = Hand::Left;
+    s.closed = true;
+    s.points = {{{0.1f, 1.2f, -0.3f}, 0.5}, {{0.11f, 1.25f, -0.31f}, 0.51}};
+    d.strokes.push_back(s);
+    d.lobes.push_back({7, {3}, "lobes/lobe_7.ply"});
+    d.edits.push_back({1, "pinch_deform", 7, {{"handle", {0.1, 0.2, 0.3}}}});
+    TreeInstance t;
+    t.id = 1;
+    t.seed = 9;
+    t.transform[3][0] = 2.0f;
+    d.trees.push_back(t);
+    d.settings.input.pinch_start_m = 0.007;
+    return d;
+}
+} // namespace
+
+TEST(Document, SaveLoadRoundTripKeepsEveryField)
+{
+    std::string dir = test::temp_dir("doc-roundtrip");
+    Document d = sample_document();
+    save_document(dir + "/s.json", d);
+    Document e = load_document(dir + "/s.json");
+    EXPECT_EQ(document_to_json(d), document_to_json(e));
+    EXPECT_EQ(e.strokes.at(0).kind, StrokeKind::Trunk);
+    EXPECT_EQ(e.strokes.at(0).hand, Hand::Left);
+    EXPECT_FLOAT_EQ(e.trees.at(0).transform[3][0], 2.0f);
+    EXPECT_DOUBLE_EQ(e.settings.input.pinch_start_m, 0.007);
+}
+
+TEST(Document, AtomicSaveLeavesNoTemporaryFilesAndReplacesOldVersion)
+{
+    std::string dir = test::temp_dir("doc-atomic");
+    Document d = sample_document();
+    save_document(dir + "/s.json", d);
+    d.seed = 43;
+    save_document(dir + "/s.json", d);
+    int files = 0;
+    for ([[maybe_unused]] auto& e : std::filesystem::directory_iterator(dir)) ++files;
+    EXPECT_EQ(files, 1);
+    EXPECT_EQ(load_document(dir + "/s.json").seed, 43u);
+}
+
+TEST(Document, FailedSaveKeepsThePreviousFile)
+{
+    std::string dir = test::temp_dir("doc-failsave");
+    save_document(dir + "/s.json", sample_document());
+    // The target folder of the second save does not exist: the save must fail cleanly.
+    EXPECT_THROW(save_document(dir + "/missing/s.json", sample_document()), FileError);
+    EXPECT_NO_THROW(load_document(dir + "/s.json"));
+}
+
+TEST(Document, BadDocumentsGiveOneLineMessagesNamingTheFile)
+{
+    std::string dir = test::temp_dir("doc-bad");
+    struct Case {
+        const char* text;
+        const char* expect;
+    };
+    const Case cases[] = {
+        {"", "not valid JSON"},
+        {"{\"format\":\"lobesketch-session\",\"version\":99}", "unsupported session version 99"},
+        {"[1,2]", "not a session document"},
+        {"{\"format\":\"lobesketch-session\",\"version\":1,\"strokes\":[{\"id\":1,\"kind\":\"leaf\",\"points\":[]}]}",
+         "unknown stroke kind"},
+        {"{\"format\":\"lobesketch-session\",\"version\":1,\"strokes\":[{\"id\":1,\"kind\":\"lobe\",\"points\":[[0,1]]}]}",
+         "expected [x, y, z]"},
+        {"{\"format\":\"lobesketch-session\",\"version\":1,\"settings\":{\"input\":{\"pinch_start_m\":\"x\"}}}",
+         "expected a number"},
+        {"{\"format\":\"lobesketch-session\",\"version\":1,\"settings\":{\"input\":{\"bogus\":1}}}", "unknown key 'bogus'"},
+        {"{\"format\":\"lobesketch-session\",\"version\":1,\"settings\":{\"input\":{\"pinch_start_m\":5}}}",
+         "pinch_start_m must be"},
+    };
+    for (const Case& c : cases) {
+        std::string path = dir + "/bad.json";
+        std::ofstream(path) << c.text;
+        try {
+            load_document(path);
+            ADD_FAILURE() << "accepted: " << c.text;
+        } catch (const FileError& e) {
+            std::string msg = e.what();
+            EXPECT_NE(msg.find(path), std::string::npos) << msg;
+            EXPECT_NE(msg.find(c.expect), std::string::npos) << msg;
+            EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+        }
+    }
+    EXPECT_THROW(load_document(dir + "/does-not-exist.json"), FileError);
+}
