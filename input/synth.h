@@ -28,8 +28,11 @@ struct ScenarioStroke {
 
 /// A scenario step: a stroke, a distractor gesture or a raw input event.
 struct ScenarioStep {
-    enum class Type { Stroke, NearPinch, Grab, Key, Pause } type = Type::Stroke;
-    ScenarioStroke stroke;       ///< Type::Stroke
+    /// Stroke: pinch, follow the curve, release (draws under the draw tools).
+    /// Drag: the same hand motion, meant for an editing tool selected by a Key step before it
+    /// (pinch-deform a lobe surface, move a stroke's control point); it is not a drawn stroke.
+    enum class Type { Stroke, Drag, NearPinch, Grab, Key, Pause } type = Type::Stroke;
+    ScenarioStroke stroke;       ///< Stroke and Drag: the path of the index tip
     Hand hand = Hand::Right;     ///< NearPinch, Grab
     glm::vec3 where{0.0f};       ///< NearPinch, Grab: where the hand is
     int key = 0;                 ///< Key: GLFW key code (see docs/scenario-format.md)
@@ -56,6 +59,7 @@ struct GroundTruthStroke {
     std::vector<glm::vec3> points; ///< dense, ≤ 2 mm apart
     double t_begin = 0.0;          ///< recording time of the pinch start and end
     double t_end = 0.0;
+    bool drag = false;             ///< from a Drag step (an edit, not a drawn stroke)
 };
 
 struct SynthResult {

@@ -1,0 +1,33 @@
+#pragma once
+/// \file tools.h
+/// Raw key codes that select the active tool. A pinch means whatever the active tool says
+/// (draw, deform, select), never guessed. Codes are GLFW key codes, so desktop keyboard
+/// input, synthesized scenarios and (later) in-VR panel presses share one mapping.
+
+#include <cstdint>
+
+namespace lobe {
+
+enum class Tool : std::uint8_t {
+    DrawLobe = 0,  ///< pinch draws a lobe stroke (the default)
+    DrawTrunk,     ///< pinch draws a trunk stroke
+    DeformLobe,    ///< pinch near a lobe surface drags a handle (Laplacian editing)
+    EditStroke,    ///< two fingertips select a stroke segment, pinch moves its control point
+    MoveLobe,      ///< grab moves/rotates/scales a lobe
+};
+
+namespace keys {
+inline constexpr int kDrawLobe = 76;   // GLFW_KEY_L
+inline constexpr int kDrawTrunk = 84;  // GLFW_KEY_T
+inline constexpr int kNewLobe = 78;    // GLFW_KEY_N: the next lobe stroke starts a new lobe
+inline constexpr int kDeformLobe = 68; // GLFW_KEY_D
+inline constexpr int kEditStroke = 69; // GLFW_KEY_E
+inline constexpr int kMoveLobe = 77;   // GLFW_KEY_M
+inline constexpr int kGrow = 71;       // GLFW_KEY_G
+inline constexpr int kUndo = 90;       // GLFW_KEY_Z
+inline constexpr int kRedo = 89;       // GLFW_KEY_Y
+} // namespace keys
+
+const char* tool_name(Tool t);
+
+} // namespace lobe
