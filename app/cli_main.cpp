@@ -1,15 +1,44 @@
 #include "app/cli.h"
 
+#include <iostream>
+
 #include <CLI/CLI.hpp>
+
+#include "app/cli_common.h"
+#include "core/errors.h"
 
 namespace lobe {
 
 int run_cli(int argc, char** argv)
 {
-    CLI::App app{"Lobesketch: sketch trees with your hands"};
+    CLI::App app{"Lobesketch: sketch trees in mid-air with your fingers.\n"
+                 "Replays hand-tracking recordings into strokes, lobes and trees."};
     app.require_subcommand(1);
-    CLI11_PARSE(app, argc, argv);
-    return kExitOk;
+    bool quiet = false;
+    app.add_flag("-q,--quiet", quiet, "Print no progress lines");
+    app.set_version_flag("--version", std::string("lobesketch ") + "0.1.0");
+    int exit_code = kExitOk;
+    cli::add_info_command(app, exit_code);
+    cli::add_replay_command(app, exit_code);
+    cli::add_import_commands(app, exit_code);
+    cli::add_synth_command(app, exit_code);
+    app.parse_complete_callback([&] { cli::set_quiet(quiet); });
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        int code = app.exit(e);
+        return code == 0 ? kExitOk : kExitUsage;
+    } catch (const Error& e) {
+        cli::error(e.what());
+        return kExitFailure;
+    } catch (const std::bad_alloc&) {
+        cli::error("out of memory");
+        return kExitFailure;
+    } catch (const std::exception& e) {
+        cli::error(std::string("unexpected failure: ") + e.what());
+        return kExitFailure;
+    }
+    return exit_code;
 }
 
 } // namespace lobe

@@ -24,6 +24,10 @@ json settings_to_json(const Settings& s)
            {{"min_cutoff_hz", in.filter.min_cutoff_hz},
             {"beta", in.filter.beta},
             {"d_cutoff_hz", in.filter.d_cutoff_hz}}},
+          {"gap_filter",
+           {{"min_cutoff_hz", in.gap_filter.min_cutoff_hz},
+            {"beta", in.gap_filter.beta},
+            {"d_cutoff_hz", in.gap_filter.d_cutoff_hz}}},
           {"pinch_start_m", in.pinch_start_m},
           {"pinch_release_m", in.pinch_release_m},
           {"pinch_min_hold_s", in.pinch_min_hold_s},
@@ -69,18 +73,23 @@ Settings settings_from_json(const json& j)
         const json& in = *it;
         const std::string w = "settings.input";
         check_keys(in,
-                   {"filter", "pinch_start_m", "pinch_release_m", "pinch_min_hold_s", "curl_grab",
+                   {"filter", "gap_filter", "pinch_start_m", "pinch_release_m", "pinch_min_hold_s", "curl_grab",
                     "curl_release", "curl_point_index_max", "min_point_distance_m", "bridge_loss_s",
                     "min_stroke_length_m", "min_stroke_points", "max_hand_speed_mps"},
                    w);
         InputOptions& o = s.input;
-        if (auto f = in.find("filter"); f != in.end()) {
-            if (!f->is_object()) throw InvalidInput(w + ".filter: expected an object");
-            check_keys(*f, {"min_cutoff_hz", "beta", "d_cutoff_hz"}, w + ".filter");
-            read_number(*f, "min_cutoff_hz", o.filter.min_cutoff_hz, w + ".filter");
-            read_number(*f, "beta", o.filter.beta, w + ".filter");
-            read_number(*f, "d_cutoff_hz", o.filter.d_cutoff_hz, w + ".filter");
-        }
+        auto read_filter = [&](const char* key, OneEuroOptions& out) {
+            auto f = in.find(key);
+            if (f == in.end()) return;
+            const std::string wf = w + "." + key;
+            if (!f->is_object()) throw InvalidInput(wf + ": expected an object");
+            check_keys(*f, {"min_cutoff_hz", "beta", "d_cutoff_hz"}, wf);
+            read_number(*f, "min_cutoff_hz", out.min_cutoff_hz, wf);
+            read_number(*f, "beta", out.beta, wf);
+            read_number(*f, "d_cutoff_hz", out.d_cutoff_hz, wf);
+        };
+        read_filter("filter", o.filter);
+        read_filter("gap_filter", o.gap_filter);
         read_number(in, "pinch_start_m", o.pinch_start_m, w);
         read_number(in, "pinch_release_m", o.pinch_release_m, w);
         read_number(in, "pinch_min_hold_s", o.pinch_min_hold_s, w);
@@ -168,9 +177,11 @@ void validate_settings(const Settings& s)
     auto require = [](bool ok, const char* what) {
         if (!ok) throw InvalidInput(std::string("settings.input.") + what);
     };
-    require(o.filter.min_cutoff_hz > 0 && o.filter.min_cutoff_hz <= 1000, "filter.min_cutoff_hz must be in (0, 1000]");
-    require(o.filter.beta >= 0 && o.filter.beta <= 1e4, "filter.beta must be in [0, 10000]");
-    require(o.filter.d_cutoff_hz > 0 && o.filter.d_cutoff_hz <= 1000, "filter.d_cutoff_hz must be in (0, 1000]");
+    for (const OneEuroOptions* f : {&o.filter, &o.gap_filter}) {
+        require(f->min_cutoff_hz > 0 && f->min_cutoff_hz <= 1000, "filter min_cutoff_hz must be in (0, 1000]");
+        require(f->beta >= 0 && f->beta <= 1e4, "filter beta must be in [0, 10000]");
+        require(f->d_cutoff_hz > 0 && f->d_cutoff_hz <= 1000, "filter d_cutoff_hz must be in (0, 1000]");
+    }
     require(o.pinch_start_m > 0 && o.pinch_start_m < 0.1, "pinch_start_m must be in (0, 0.1)");
     require(o.pinch_release_m > o.pinch_start_m && o.pinch_release_m < 0.2,
             "pinch_release_m must be above pinch_start_m and below 0.2");

@@ -16,7 +16,10 @@ struct OneEuroOptions {
 
 /// Gesture recognition and stroke capture (hands → pen events → raw strokes).
 struct InputOptions {
+    /// Filter of the drawing fingertip: strong at rest (jitter), light when moving.
     OneEuroOptions filter;
+    /// Filter of the thumb/index gap: lighter, so pinches register without delay.
+    OneEuroOptions gap_filter{5.0, 8.0, 1.0};
     /// Pinch starts when the thumb-tip/index-tip gap (centre distance minus both joint
     /// radii) falls below this, and ends when it rises above pinch_release_m.
     double pinch_start_m = 0.008;

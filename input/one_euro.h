@@ -11,7 +11,8 @@ namespace lobe {
 
 class OneEuroFilter3 {
 public:
-    explicit OneEuroFilter3(const OneEuroOptions& options = {}) : options_(options) {}
+    OneEuroFilter3() = default;
+    explicit OneEuroFilter3(const OneEuroOptions& options) : options_(options) {}
 
     /// Filters one sample at time t (seconds, strictly increasing since the last reset).
     glm::vec3 filter(const glm::vec3& x, double t);

@@ -1,0 +1,55 @@
+#include "app/cli_common.h"
+
+#include <iostream>
+
+#include <nlohmann/json.hpp>
+
+#include "core/atomic_file.h"
+#include "core/document.h"
+#include "core/errors.h"
+
+namespace lobe::cli {
+
+namespace {
+bool g_quiet = false;
+}
+
+void set_quiet(bool quiet) { g_quiet = quiet; }
+void warn(const std::string& line) { std::cerr << "lobesketch: warning: " << line << '\n'; }
+void error(const std::string& line) { std::cerr << "lobesketch: error: " << line << '\n'; }
+void progress(const std::string& line)
+{
+    if (!g_quiet) std::cerr << line << '\n';
+}
+
+void print_report(const std::string& path, const ReadReport& report)
+{
+    for (const std::string& p : report.problems) warn(path + ": " + p);
+    if (report.frames_dropped > 0)
+        warn(path + ": dropped " + std::to_string(report.frames_dropped) + " frame(s), kept " +
+             std::to_string(report.frames_read));
+}
+
+Recording load_recording_verbose(const std::string& path)
+{
+    ReadReport report;
+    Recording rec = read_recording(path, &report);
+    print_report(path, report);
+    return rec;
+}
+
+Settings load_settings_file(const std::string& path)
+{
+    const std::string text = read_file_limited(path, 16u << 20);
+    nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
+    if (j.is_discarded()) throw FileError(path, "not valid JSON");
+    try {
+        // Accept a bare settings object or a whole session document's "settings".
+        if (j.is_object() && j.contains("format") && j.contains("settings")) return settings_from_json_checked(j["settings"]);
+        return settings_from_json_checked(j);
+    } catch (const InvalidInput& e) {
+        throw FileError(path, e.what());
+    }
+}
+
+} // namespace lobe::cli

@@ -1,0 +1,37 @@
+#pragma once
+/// \file cli_common.h
+/// Shared helpers of the CLI subcommands: messages, settings files, recording input.
+
+#include <string>
+
+#include "core/settings.h"
+#include "input/recording.h"
+
+namespace CLI {
+class App;
+}
+
+namespace lobe::cli {
+
+void warn(const std::string& line);  ///< "lobesketch: warning: …" on stderr
+void error(const std::string& line); ///< "lobesketch: error: …" on stderr
+void progress(const std::string& line); ///< a progress line on stderr (suppressed by --quiet)
+void set_quiet(bool quiet);
+
+/// Prints the reader's report as warnings, one line each, naming the file.
+void print_report(const std::string& path, const ReadReport& report);
+
+/// Reads a recording and prints what had to be dropped. \throw FileError
+Recording load_recording_verbose(const std::string& path);
+
+/// Loads a settings JSON file (the "settings" object of a session document).
+/// \throw FileError naming the file and the bad key.
+Settings load_settings_file(const std::string& path);
+
+// Subcommand registration; each sets `exit_code` when it runs.
+void add_info_command(CLI::App& app, int& exit_code);
+void add_replay_command(CLI::App& app, int& exit_code);
+void add_import_commands(CLI::App& app, int& exit_code);
+void add_synth_command(CLI::App& app, int& exit_code);
+
+} // namespace lobe::cli

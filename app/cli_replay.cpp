@@ -1,0 +1,67 @@
+// `lobesketch replay REC --out DIR`: the whole pipeline from a recording.
+#include <filesystem>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "app/cli.h"
+#include "app/cli_common.h"
+#include "app/outputs.h"
+#include "core/errors.h"
+#include "input/pipeline.h"
+#include "input/session_builder.h"
+
+namespace lobe::cli {
+
+void add_replay_command(CLI::App& app, int& exit_code)
+{
+    auto* cmd = app.add_subcommand("replay", "Replay a recording through the pipeline and write its results");
+    struct Args {
+        std::string rec, out, settings;
+        std::uint64_t seed = 1;
+    };
+    auto a = std::make_shared<Args>();
+    cmd->add_option("REC", a->rec, "Recording (binary or text form)")->required();
+    cmd->add_option("-o,--out", a->out, "Output folder (created): strokes.json, session.json")->required();
+    cmd->add_option("--settings", a->settings, "Settings JSON (a settings object or a session document)");
+    cmd->add_option("--seed", a->seed, "Seed of every random choice downstream")->capture_default_str();
+    cmd->callback([a, &exit_code] {
+        Settings settings;
+        if (!a->settings.empty()) settings = load_settings_file(a->settings);
+        Recording rec = load_recording_verbose(a->rec);
+        const double duration = rec.frames.empty() ? 0.0 : rec.frames.back().time - rec.frames.front().time;
+        progress("replaying " + std::to_string(rec.frames.size()) + " frames (" + std::to_string(duration).substr(0, 6) +
+                 " s) of " + a->rec);
+        InputResult result = run_input_pipeline(rec, settings.input);
+        for (const std::string& m : result.messages) warn(a->rec + ": " + m);
+
+        Document doc;
+        doc.seed = a->seed;
+        doc.settings = settings;
+        doc.source_recording = std::filesystem::absolute(a->rec).lexically_normal().string();
+        SessionBuilder builder(std::move(doc));
+        builder.apply(result.actions);
+        const Document& out_doc = builder.document();
+
+        std::error_code ec;
+        std::filesystem::create_directories(a->out, ec);
+        if (ec) throw FileError(a->out, "cannot create output folder: " + ec.message());
+        write_strokes_json(a->out + "/strokes.json", out_doc.strokes, a->rec);
+        save_document(a->out + "/session.json", out_doc);
+        std::size_t lobe_strokes = 0, trunk_strokes = 0;
+        for (const Stroke& s : out_doc.strokes) (s.kind == StrokeKind::Lobe ? lobe_strokes : trunk_strokes)++;
+        progress("derived " + std::to_string(out_doc.strokes.size()) + " strokes (" + std::to_string(lobe_strokes) +
+                 " lobe, " + std::to_string(trunk_strokes) + " trunk) in " + std::to_string(out_doc.lobes.size()) +
+                 " lobe group(s), " + std::to_string(result.drags.size()) + " drag edit(s)");
+        progress("wrote " + a->out + "/strokes.json and " + a->out + "/session.json");
+        if (out_doc.strokes.empty() && result.drags.empty()) {
+            error(a->rec + ": no strokes in this recording");
+            exit_code = kExitFailure;
+            return;
+        }
+        exit_code = kExitOk;
+    });
+}
+
+} // namespace lobe::cli

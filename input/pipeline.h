@@ -1,0 +1,103 @@
+#pragma once
+/// \file pipeline.h
+/// Hand frames → pen events → raw strokes. Feeds frames and raw events through the gesture
+/// recogniser and turns pinches into what the active tool says: a stroke (draw tools) or a
+/// drag (editing tools). The same code runs live (VR, desktop) and on replay, so a session is
+/// a deterministic function of its recording and settings.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/settings.h"
+#include "core/stroke.h"
+#include "input/gestures.h"
+#include "input/recording.h"
+#include "input/tools.h"
+
+namespace lobe {
+
+/// A pinch-move-release made under an editing tool (deform a lobe, move a stroke's control
+/// point, move a lobe): the path of the pinch point.
+struct Drag {
+    Tool tool = Tool::DeformLobe;
+    Hand hand = Hand::Right;
+    std::vector<StrokePoint> path;
+};
+
+/// Something the person did, derived from raw input, in the order it happened.
+struct InputAction {
+    enum class Type : std::uint8_t {
+        StrokeCompleted, ///< `stroke` holds the finished stroke (already given its id)
+        StrokeDiscarded, ///< `message` says why (too short, too few points)
+        DragCompleted,   ///< `drag`
+        ToolChanged,     ///< `tool`
+        NewLobe,         ///< the next lobe stroke starts a new lobe
+        Grow, Undo, Redo,
+    } type = Type::StrokeCompleted;
+    double time = 0.0;
+    Stroke stroke;
+    Drag drag;
+    Tool tool = Tool::DrawLobe;
+    std::string message;
+};
+
+const char* action_name(InputAction::Type t);
+
+/// The incremental pipeline (one per session). Feed raw events and frames in time order.
+class InputPipeline {
+public:
+    explicit InputPipeline(const InputOptions& options = {});
+
+    void push_event(const InputEvent& event);
+    void push_frame(const HandFrame& frame);
+    /// End of input: finishes strokes still being drawn.
+    void finish();
+
+    /// Actions since the last call, in time order.
+    std::vector<InputAction> take_actions();
+    const GestureRecognizer& gestures() const { return gestures_; }
+    Tool tool() const { return tool_; }
+    /// True while `hand` is drawing; `current_stroke` then holds the points so far.
+    bool drawing(Hand hand) const { return pen_[static_cast<int>(hand)].down; }
+    const Stroke& current_stroke(Hand hand) const { return pen_[static_cast<int>(hand)].stroke; }
+
+private:
+    struct Pen {
+        bool down = false;
+        bool drag = false;   ///< an editing-tool pinch rather than a drawn stroke
+        Tool tool = Tool::DrawLobe;
+        Stroke stroke;
+        double last_good_t = 0.0;
+    };
+    void pen_down(int h, const HandGesture& g, double t);
+    void pen_move(int h, const HandGesture& g, double t);
+    void pen_up(int h, double t);
+
+    InputOptions options_;
+    GestureRecognizer gestures_;
+    Tool tool_ = Tool::DrawLobe;
+    std::array<Pen, kHandCount> pen_{};
+    std::int64_t next_stroke_id_ = 1;
+    double last_time_ = 0.0;
+    std::vector<InputAction> actions_;
+};
+
+/// Everything a recording yields.
+struct InputResult {
+    std::vector<InputAction> actions;
+    std::vector<Stroke> strokes;   ///< the completed strokes, in order
+    std::vector<Drag> drags;
+    std::vector<std::string> messages; ///< discarded strokes and annotation mismatches
+    std::size_t pinches = 0, grabs = 0, points = 0; ///< started gestures, both hands
+};
+
+/// Replays a whole recording (events merged with frames by time) through the pipeline and
+/// checks the recording's annotations against what replay derived.
+InputResult run_input_pipeline(const Recording& rec, const InputOptions& options = {});
+
+/// Annotations a live session writes beside the raw input for each derived action
+/// ("stroke id=3 kind=lobe points=120"); replay compares, never applies them.
+std::string annotation_for(const InputAction& action);
+
+} // namespace lobe
