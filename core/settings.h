@@ -26,10 +26,11 @@ struct InputOptions {
     double pinch_release_m = 0.016;
     /// A pinch needs the gap below pinch_start_m for this long (debounces single-frame dips).
     double pinch_min_hold_s = 0.03;
-    /// Curl (0 straight … 1 fully bent) of middle, ring and little above which they count as
-    /// curled; all three curled = grab, which is never a pinch.
-    double curl_grab = 0.45;
-    double curl_release = 0.35;
+    /// Curl (total bend angle over 270°, see finger_curl) of middle, ring and little above
+    /// which they count as curled; all three curled = grab, which is never a pinch. 0.48 is
+    /// 130°: a relaxed pinching hand bends them 55–80°, a fist 150–190° (shipped Leap clips).
+    double curl_grab = 0.48;
+    double curl_release = 0.41;
     /// Index finger straight and middle/ring/little curled = point.
     double curl_point_index_max = 0.25;
     /// The paper keeps a new stroke point only when the fingertip moved at least this far.

@@ -18,18 +18,24 @@ constexpr float kDefaultIndexTipRadius = 0.008f;
 constexpr float kOriginSnap = 0.02f;
 constexpr float kHeadSnap = 0.06f;
 
-constexpr Joint kFingerJoints[5][4] = {
-    {Joint::ThumbMetacarpal, Joint::ThumbProximal, Joint::ThumbDistal, Joint::ThumbTip},
-    {Joint::IndexProximal, Joint::IndexIntermediate, Joint::IndexDistal, Joint::IndexTip},
-    {Joint::MiddleProximal, Joint::MiddleIntermediate, Joint::MiddleDistal, Joint::MiddleTip},
-    {Joint::RingProximal, Joint::RingIntermediate, Joint::RingDistal, Joint::RingTip},
-    {Joint::LittleProximal, Joint::LittleIntermediate, Joint::LittleDistal, Joint::LittleTip},
+// Joint chains whose bend angles make a finger's curl: metacarpal, proximal, intermediate,
+// distal, tip (the thumb has no intermediate: its chain starts at the wrist).
+constexpr Joint kFingerJoints[5][5] = {
+    {Joint::Wrist, Joint::ThumbMetacarpal, Joint::ThumbProximal, Joint::ThumbDistal, Joint::ThumbTip},
+    {Joint::IndexMetacarpal, Joint::IndexProximal, Joint::IndexIntermediate, Joint::IndexDistal, Joint::IndexTip},
+    {Joint::MiddleMetacarpal, Joint::MiddleProximal, Joint::MiddleIntermediate, Joint::MiddleDistal, Joint::MiddleTip},
+    {Joint::RingMetacarpal, Joint::RingProximal, Joint::RingIntermediate, Joint::RingDistal, Joint::RingTip},
+    {Joint::LittleMetacarpal, Joint::LittleProximal, Joint::LittleIntermediate, Joint::LittleDistal, Joint::LittleTip},
 };
+// Total flexion of a fully folded finger (knuckle ~90°, middle joint ~110°, last joint ~70°).
+constexpr float kFullCurlRadians = 4.712389f; // 270°
 
 // The joints every decision here reads.
-constexpr Joint kNeeded[] = {Joint::Palm, Joint::ThumbTip, Joint::IndexTip, Joint::IndexProximal,
-                             Joint::MiddleProximal, Joint::MiddleTip, Joint::RingProximal,
-                             Joint::RingTip, Joint::LittleProximal, Joint::LittleTip};
+constexpr Joint kNeeded[] = {Joint::Palm, Joint::ThumbTip, Joint::IndexTip,
+                             Joint::IndexMetacarpal, Joint::IndexProximal, Joint::IndexIntermediate, Joint::IndexDistal,
+                             Joint::MiddleMetacarpal, Joint::MiddleProximal, Joint::MiddleIntermediate, Joint::MiddleDistal, Joint::MiddleTip,
+                             Joint::RingMetacarpal, Joint::RingProximal, Joint::RingIntermediate, Joint::RingDistal, Joint::RingTip,
+                             Joint::LittleMetacarpal, Joint::LittleProximal, Joint::LittleIntermediate, Joint::LittleDistal, Joint::LittleTip};
 
 float usable_radius(float r, float fallback)
 {
@@ -42,12 +48,20 @@ bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y
 
 float finger_curl(const HandState& hand, int finger)
 {
+    // Sum of the bend angles along the chain. A distance ratio (tip to knuckle over bone
+    // length) misses flexion at the knuckle: in the shipped Leap grab clip the second fist
+    // closes mostly there, with the distance ratio of middle/ring/little at only 0.27 while
+    // their bend is 150–170°; in the pinch clip those fingers bend 55–80°.
     const Joint* j = kFingerJoints[finger];
-    const glm::vec3 p0 = hand[j[0]].pose.position, p1 = hand[j[1]].pose.position,
-                    p2 = hand[j[2]].pose.position, p3 = hand[j[3]].pose.position;
-    const float chain = glm::distance(p0, p1) + glm::distance(p1, p2) + glm::distance(p2, p3);
-    if (!(chain > 1e-4f)) return 0.0f;
-    return std::clamp(1.0f - glm::distance(p0, p3) / chain, 0.0f, 1.0f);
+    float bend = 0.0f;
+    for (int k = 0; k + 2 < 5; ++k) {
+        const glm::vec3 a = hand[j[k + 1]].pose.position - hand[j[k]].pose.position;
+        const glm::vec3 b = hand[j[k + 2]].pose.position - hand[j[k + 1]].pose.position;
+        const float la = glm::length(a), lb = glm::length(b);
+        if (!(la > 1e-5f) || !(lb > 1e-5f)) continue;
+        bend += std::acos(std::clamp(glm::dot(a, b) / (la * lb), -1.0f, 1.0f));
+    }
+    return std::clamp(bend / kFullCurlRadians, 0.0f, 1.0f);
 }
 
 GestureRecognizer::GestureRecognizer(const InputOptions& options) : options_(options)

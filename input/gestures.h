@@ -17,9 +17,10 @@
 
 namespace lobe {
 
-/// Curl of one finger: 0 straight … about 1 folded flat. `1 − |tip − proximal| / chain`, where
-/// chain is the bone length from the proximal joint through the intermediate and distal
-/// joints to the tip. The thumb uses its metacarpal-proximal-distal-tip chain.
+/// Curl of one finger (0 thumb … 4 little): the sum of the bend angles at the knuckle, the
+/// middle and the last joint (metacarpal → proximal → intermediate → distal → tip) over 270°,
+/// clamped to [0, 1]: 0 straight, about 0.25 relaxed, 0.55–0.7 in a fist. The thumb's chain
+/// runs wrist → metacarpal → proximal → distal → tip.
 float finger_curl(const HandState& hand, int finger);
 
 /// Why a hand does not count as tracked this frame (for messages and tests).
