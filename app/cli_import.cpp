@@ -1,4 +1,5 @@
 // `lobesketch import-leap IN -o OUT`, `lobesketch import-webxr IN -o OUT`, and `synth`.
+#include <cstring>
 #include <filesystem>
 
 #include <CLI/CLI.hpp>
@@ -72,8 +73,10 @@ void add_synth_command(CLI::App& app, int& exit_code)
         SynthResult r = synthesize(sc);
         write_recording_any(*out, r.recording);
         std::filesystem::path truth(*out);
+        // a/b/name.lrec → a/b/name.truth.json; a/b/name.lrec.txt → a/b/name.truth.json
         std::string stem = truth.filename().string();
-        stem = stem.substr(0, stem.find('.'));
+        for (const char* ext : {".txt", ".lrec"})
+            if (stem.size() > std::strlen(ext) && stem.ends_with(ext)) stem.resize(stem.size() - std::strlen(ext));
         truth.replace_filename(stem + ".truth.json");
         write_file_atomic(truth.string(), ground_truth_to_json(r.truth).dump(1) + "\n");
         const double duration = r.recording.frames.empty() ? 0.0 : r.recording.frames.back().time;

@@ -110,6 +110,7 @@ void add_info_command(CLI::App& app, int& exit_code)
             if (events.empty()) std::printf(" none");
             for (const auto& [k, n] : events) std::printf(" %zu %s", n, k.c_str());
             std::printf("\n  annotations: %zu\n", rec.annotations.size());
+            std::fflush(stdout);
         }
         exit_code = kExitOk;
     });

@@ -44,6 +44,9 @@ struct Scenario {
     std::uint64_t seed = 1;
     double rate_hz = 90.0;
     std::vector<ScenarioStep> steps;
+    double uniform_joint_radius_m = 0.0; ///< > 0: every joint reports this radius (as some runtimes do)
+    bool noise = true;    ///< jitter, tremor and frame-time jitter (false: clean tracking, for unit tests)
+    bool dropouts = true; ///< tracking drop-outs
 };
 
 /// \throw InvalidInput naming the field.
@@ -62,11 +65,24 @@ struct GroundTruthStroke {
     bool drag = false;             ///< from a Drag step (an edit, not a drawn stroke)
 };
 
+/// When a distractor or a tracking drop-out happened, for tests.
+struct SynthSpan {
+    enum class Type { NearPinch, Grab, Dropout } type = Type::NearPinch;
+    Hand hand = Hand::Right;
+    double t_begin = 0.0;      ///< the whole gesture (thumb starts closing … is open again) or the loss
+    double t_end = 0.0;
+    double t_peak_begin = 0.0; ///< thumb at its closest / fist closed (= t_begin/t_end for drop-outs)
+    double t_peak_end = 0.0;
+};
+
 struct SynthResult {
     Recording recording;
     std::vector<GroundTruthStroke> truth;
+    std::vector<SynthSpan> spans; ///< sorted by t_begin
 };
 
+/// Deterministic: the same scenario gives bit-identical frames.
+/// \throw InvalidInput naming the field when the scenario is out of bounds.
 SynthResult synthesize(const Scenario& scenario);
 
 nlohmann::json ground_truth_to_json(const std::vector<GroundTruthStroke>& truth);

@@ -1,0 +1,130 @@
+// The lobesketch executable as a user runs it: exit codes, one-line errors, output files.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <fstream>
+
+#include <sys/wait.h>
+
+#include <nlohmann/json.hpp>
+
+#include "core/document.h"
+#include "tests/test_paths.h"
+
+using namespace lobe;
+
+namespace {
+
+struct CliRun {
+    int code = -1;
+    std::string out; ///< stdout and stderr together
+};
+
+CliRun run(const std::string& args)
+{
+    CliRun r;
+    const std::string cmd = test::cli_path() + " " + args + " 2>&1";
+    FILE* p = ::popen(cmd.c_str(), "r");
+    if (!p) return r;
+    std::array<char, 4096> buf;
+    std::size_t n;
+    while ((n = std::fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
+    int status = ::pclose(p);
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    return r;
+}
+
+std::size_t count_lines_with(const std::string& text, const std::string& needle)
+{
+    std::size_t n = 0, pos = 0;
+    while ((pos = text.find(needle, pos)) != std::string::npos) {
+        ++n;
+        pos += needle.size();
+    }
+    return n;
+}
+
+} // namespace
+
+TEST(Cli, HelpWorksForTheProgramAndEverySubcommand)
+{
+    CliRun top = run("--help");
+    EXPECT_EQ(top.code, 0) << top.out;
+    for (const char* sub : {"info", "replay", "import-leap", "import-webxr", "synth"}) {
+        EXPECT_NE(top.out.find(sub), std::string::npos) << sub;
+        CliRun r = run(std::string(sub) + " --help");
+        EXPECT_EQ(r.code, 0) << sub << ": " << r.out;
+        EXPECT_NE(r.out.find("Usage"), std::string::npos) << r.out;
+    }
+}
+
+TEST(Cli, BadCommandLineExitsWithTwo)
+{
+    EXPECT_EQ(run("no-such-command").code, 2);
+    EXPECT_EQ(run("replay").code, 2);
+}
+
+TEST(Cli, ReplayWritesStrokesAndASessionThatLoads)
+{
+    const std::string dir = test::temp_dir("cli-replay");
+    CliRun r = run("replay " + test::source_path("recordings/demo.lrec") + " --out " + dir);
+    ASSERT_EQ(r.code, 0) << r.out;
+    std::ifstream in(dir + "/strokes.json");
+    nlohmann::json j = nlohmann::json::parse(in);
+    ASSERT_TRUE(j["strokes"].is_array());
+    ASSERT_GE(j["strokes"].size(), 5u);
+    for (const auto& s : j["strokes"]) {
+        EXPECT_TRUE(s["id"].is_number_integer());
+        EXPECT_TRUE(s["kind"] == "lobe" || s["kind"] == "trunk");
+        EXPECT_TRUE(s["closed"].is_boolean());
+        EXPECT_GE(s["points"].size(), 4u);
+        EXPECT_EQ(s["points"][0].size(), 3u);
+    }
+    Document doc = load_document(dir + "/session.json");
+    EXPECT_EQ(doc.strokes.size(), j["strokes"].size());
+    EXPECT_FALSE(doc.lobes.empty());
+}
+
+TEST(Cli, InfoSummarisesARecording)
+{
+    CliRun r = run("info --json " + test::source_path("recordings/demo.lrec"));
+    ASSERT_EQ(r.code, 0) << r.out;
+    nlohmann::json j = nlohmann::json::parse(r.out);
+    EXPECT_GT(j["frames"].get<int>(), 1000);
+    EXPECT_GT(j["duration_s"].get<double>(), 10.0);
+    EXPECT_GT(j["hands"]["right"]["frames"].get<int>(), 1000);
+    EXPECT_GE(j["hands"]["right"]["dropouts"].get<int>(), 1);
+    EXPECT_GE(j["events"]["key"].get<int>(), 2);
+}
+
+TEST(Cli, UnusableInputsFailWithOneLineNamingTheFile)
+{
+    const std::string dir = test::temp_dir("cli-bad");
+    std::ofstream(dir + "/garbage.lrec") << "this is not a recording at all";
+    std::ofstream(dir + "/empty.json") << "";
+    const std::string cases[] = {
+        "info " + dir + "/garbage.lrec",
+        "replay " + dir + "/garbage.lrec --out " + dir + "/o",
+        "replay " + dir + "/missing.lrec --out " + dir + "/o",
+        "import-leap " + dir + "/empty.json -o " + dir + "/x.lrec",
+        "import-webxr " + dir + "/empty.json -o " + dir + "/x.lrec",
+        "synth " + dir + "/empty.json -o " + dir + "/x.lrec",
+    };
+    for (const std::string& c : cases) {
+        CliRun r = run(c);
+        EXPECT_EQ(r.code, 1) << c << "\n" << r.out;
+        EXPECT_EQ(count_lines_with(r.out, "error:"), 1u) << c << "\n" << r.out;
+        EXPECT_NE(r.out.find(dir), std::string::npos) << c << "\n" << r.out;
+    }
+}
+
+TEST(Cli, ImportedLeapCaptureReplaysWithoutStrokesFromAGrab)
+{
+    const std::string dir = test::temp_dir("cli-leap");
+    CliRun imp = run("import-leap " + test::shared_path("data/real/leap-grab.json") + " -o " + dir + "/grab.lrec");
+    ASSERT_EQ(imp.code, 0) << imp.out;
+    CliRun rep = run("replay " + dir + "/grab.lrec --out " + dir + "/out");
+    EXPECT_EQ(rep.code, 1) << rep.out; // nothing drawn: "no strokes"
+    EXPECT_NE(rep.out.find("no strokes"), std::string::npos) << rep.out;
+}
