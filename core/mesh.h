@@ -14,7 +14,7 @@ namespace lobe {
 struct TriangleMesh {
     std::vector<glm::vec3> positions;              ///< #V vertex positions, metres
     std::vector<std::array<int, 3>> triangles;     ///< #F triangles, counter-clockwise seen from outside
-    std::vector<bool> feature_edge_vertices;       ///< optional, #V: vertex lies on a stroke (constraint)
+    std::vector<std::array<int, 2>> feature_edges; ///< optional: edges that lie on a stroke (remeshing constraints)
 
     std::size_t vertex_count() const { return positions.size(); }
     std::size_t triangle_count() const { return triangles.size(); }
