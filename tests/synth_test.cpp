@@ -316,7 +316,8 @@ TEST(SynthFrames, JointsFollowTheOpenXrConventionForBothHands)
 {
     Scenario s = idle_scenario(1.0);
     s.noise = false;
-    const HandFrame& f = synthesize(s).recording.frames[45];
+    const SynthResult result = synthesize(s);
+    const HandFrame& f = result.recording.frames[45];
     for (Hand hand : {Hand::Left, Hand::Right}) {
         SCOPED_TRACE(hand_name(hand));
         const HandState& h = f.hand(hand);
