@@ -1,5 +1,6 @@
 #include "app/cli_common.h"
 
+#include <fstream>
 #include <iostream>
 
 #include <nlohmann/json.hpp>
@@ -33,7 +34,24 @@ void print_report(const std::string& path, const ReadReport& report)
 Recording load_recording_verbose(const std::string& path)
 {
     ReadReport report;
-    Recording rec = read_recording(path, &report);
+    Recording rec;
+    try {
+        rec = read_recording(path, &report);
+    } catch (const FileError& e) {
+        // Captures of other programs are a common mix-up: say which command converts them.
+        std::string head;
+        if (std::ifstream in{path, std::ios::binary}) {
+            head.resize(16);
+            in.read(head.data(), 16);
+            head.resize(static_cast<std::size_t>(in.gcount()));
+        }
+        const std::string what = e.what();
+        if (head.rfind("{", 0) == 0 && what.find("magic") != std::string::npos)
+            throw Error(what + " (a Leap Motion JSON capture? convert it with 'lobesketch import-leap')");
+        if (head.rfind("var ", 0) == 0 && what.find("magic") != std::string::npos)
+            throw Error(what + " (a WebXR capture? convert it with 'lobesketch import-webxr')");
+        throw;
+    }
     print_report(path, report);
     return rec;
 }
