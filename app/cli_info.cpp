@@ -48,16 +48,6 @@ HandStats hand_stats(const Recording& rec, int h)
     return s;
 }
 
-const char* event_kind_name(InputEventKind k)
-{
-    switch (k) {
-    case InputEventKind::Key: return "key";
-    case InputEventKind::MouseButton: return "mouse_button";
-    case InputEventKind::MouseMove: return "mouse_move";
-    case InputEventKind::MouseWheel: return "wheel";
-    }
-    return "unknown";
-}
 
 } // namespace
 
@@ -72,7 +62,10 @@ void add_info_command(CLI::App& app, int& exit_code)
         Recording rec = load_recording_verbose(*path);
         const double duration = rec.frames.size() > 1 ? rec.frames.back().time - rec.frames.front().time : 0.0;
         std::map<std::string, std::size_t> events;
-        for (const InputEvent& e : rec.events) ++events[event_kind_name(e.kind)];
+        for (const InputEvent& e : rec.events) {
+            const char* kind = event_kind_name(e.kind);
+            ++events[kind ? kind : "unknown"];
+        }
         nlohmann::json j = {
             {"file", *path},
             {"version", rec.header.version},

@@ -1,5 +1,7 @@
 #include "input/hand_derive.h"
 
+#include "core/errors.h"
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -548,6 +550,28 @@ double median_rate_hz(const std::vector<HandFrame>& frames, double fallback)
     const auto mid = dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2);
     std::nth_element(dt.begin(), mid, dt.end());
     return *mid > 0.0 ? 1.0 / *mid : fallback;
+}
+
+void finish_import(Recording& rec, const std::string& name, const std::string& stop, std::size_t with_hand,
+                   std::size_t dropped, ProblemLog& problems, const std::vector<const ProblemLog*>& logs,
+                   ReadReport* report)
+{
+    if (!stop.empty())
+        problems.add("frames end early (" + stop + "); the " + std::to_string(rec.frames.size()) +
+                     " frames before are kept");
+    if (rec.frames.empty()) {
+        const std::string why = !stop.empty() ? stop : problems.count() ? problems.first() : "the frames array is empty";
+        throw FileError(name, "no usable frame (" + why + ")");
+    }
+    if (with_hand == 0)
+        throw FileError(name, "no frame with a usable hand" +
+                                  (problems.count() ? " (" + problems.first() + ")" : std::string()));
+    rec.header.nominal_rate_hz = median_rate_hz(rec.frames, rec.header.nominal_rate_hz);
+    if (report != nullptr) {
+        report->frames_read += rec.frames.size();
+        report->frames_dropped += dropped;
+        for (const ProblemLog* log : logs) log->write_to(report);
+    }
 }
 
 } // namespace lobe

@@ -172,4 +172,12 @@ std::string frame_time_problem(double t, double last);
 /// fewer than two frames.
 double median_rate_hz(const std::vector<HandFrame>& frames, double fallback);
 
+/// The common end of both importers: refuses a capture with no usable frame or no frame with a
+/// usable hand (FileError naming `name`), notes an early stop, sets the nominal rate and fills
+/// the report from `logs` (in order).
+/// \param stop why reading stopped early, or "" when the frames array was read to its end
+void finish_import(Recording& rec, const std::string& name, const std::string& stop, std::size_t with_hand,
+                   std::size_t dropped, ProblemLog& problems, const std::vector<const ProblemLog*>& logs,
+                   ReadReport* report);
+
 } // namespace lobe

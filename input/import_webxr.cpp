@@ -350,25 +350,7 @@ Recording import_webxr_capture_text(const std::string& text, const std::string& 
     } catch (const LiteralError&) {
         throw FileError(name, "frames is not an array");
     }
-    if (!stop.empty())
-        problems.add("frames end early (" + stop + "); the " + std::to_string(rec.frames.size()) +
-                     " frames before are kept");
-
-    if (rec.frames.empty()) {
-        const std::string why = !stop.empty() ? stop : problems.count() ? problems.first() : "the frames array is empty";
-        throw FileError(name, "no usable frame (" + why + ")");
-    }
-    if (with_hand == 0)
-        throw FileError(name, "no frame with a usable hand" +
-                                  (problems.count() ? " (" + problems.first() + ")" : std::string()));
-
-    rec.header.nominal_rate_hz = median_rate_hz(rec.frames, rec.header.nominal_rate_hz);
-    if (report != nullptr) {
-        report->frames_read += rec.frames.size();
-        report->frames_dropped += dropped;
-        schema_problems.write_to(report);
-        problems.write_to(report);
-    }
+    finish_import(rec, name, stop, with_hand, dropped, problems, {&schema_problems, &problems}, report);
     return rec;
 }
 

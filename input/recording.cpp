@@ -377,16 +377,6 @@ std::size_t json_nesting(std::string_view s)
     return deepest;
 }
 
-const char* event_kind_name(InputEventKind k)
-{
-    switch (k) {
-    case InputEventKind::Key: return "key";
-    case InputEventKind::MouseButton: return "mouse_button";
-    case InputEventKind::MouseMove: return "mouse_move";
-    case InputEventKind::MouseWheel: return "wheel";
-    }
-    return nullptr;
-}
 
 bool known_event_kind(std::uint8_t k) { return k >= 1 && k <= 4; }
 
@@ -1477,6 +1467,17 @@ void RecordingWriter::close()
         err = errno;
     }
     if (!ok) throw FileError(path_, std::string("close failed: ") + std::strerror(err));
+}
+
+const char* event_kind_name(InputEventKind k)
+{
+    switch (k) {
+    case InputEventKind::Key: return "key";
+    case InputEventKind::MouseButton: return "mouse_button";
+    case InputEventKind::MouseMove: return "mouse_move";
+    case InputEventKind::MouseWheel: return "wheel";
+    }
+    return nullptr;
 }
 
 } // namespace lobe

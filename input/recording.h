@@ -43,6 +43,9 @@ enum class InputEventKind : std::uint8_t {
     MouseWheel = 4,  ///< y = wheel delta
 };
 
+/// "key", "mouse_button", "mouse_move", "wheel"; nullptr for a kind this build does not know.
+const char* event_kind_name(InputEventKind kind);
+
 struct InputEvent {
     double time = 0.0;
     InputEventKind kind = InputEventKind::Key;
