@@ -10,6 +10,7 @@ PACKAGES=(
   build-essential cmake ninja-build ccache pkg-config git
   nlohmann-json3-dev libcli11-dev libglm-dev libeigen3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  libcgal-dev libopenmesh-dev libgmp-dev libmpfr-dev
 )
 
 missing=()

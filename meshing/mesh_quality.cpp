@@ -1,0 +1,271 @@
+#include "meshing/mesh_quality.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numeric>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include <glm/geometric.hpp>
+
+#include "core/errors.h"
+
+namespace lobe {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+glm::dvec3 pos(const TriangleMesh& m, int v) { return glm::dvec3(m.positions[static_cast<std::size_t>(v)]); }
+
+void check_mesh(const TriangleMesh& mesh, const char* who)
+{
+    if (mesh.triangles.empty()) throw InvalidInput(std::string(who) + ": mesh has no triangle");
+    const auto n = static_cast<long long>(mesh.positions.size());
+    for (const auto& t : mesh.triangles)
+        for (int v : t)
+            if (v < 0 || v >= n) throw InvalidInput(std::string(who) + ": triangle index out of range");
+}
+
+/// Interior angle at `a` of triangle (a, b, c), degrees; 0 for a degenerate corner.
+double corner_angle(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c)
+{
+    const glm::dvec3 u = b - a, v = c - a;
+    const double s = glm::length(glm::cross(u, v)), d = glm::dot(u, v);
+    return std::atan2(s, d) * 180.0 / kPi;
+}
+
+std::uint64_t edge_key(int a, int b)
+{
+    const auto lo = static_cast<std::uint32_t>(std::min(a, b)), hi = static_cast<std::uint32_t>(std::max(a, b));
+    return (static_cast<std::uint64_t>(lo) << 32) | hi;
+}
+
+int find_root(std::vector<int>& parent, int x)
+{
+    while (parent[static_cast<std::size_t>(x)] != x) {
+        parent[static_cast<std::size_t>(x)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
+        x = parent[static_cast<std::size_t>(x)];
+    }
+    return x;
+}
+
+/// Closest distance from p to triangle (a, b, c) (Voronoi-region walk over the triangle's
+/// vertices, edges and face).
+double point_triangle_distance(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c)
+{
+    const glm::dvec3 ab = b - a, ac = c - a, ap = p - a;
+    const double d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
+    if (d1 <= 0 && d2 <= 0) return glm::length(p - a);
+    const glm::dvec3 bp = p - b;
+    const double d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
+    if (d3 >= 0 && d4 <= d3) return glm::length(p - b);
+    const double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0 && d1 >= 0 && d3 <= 0) return glm::length(p - (a + ab * (d1 / (d1 - d3))));
+    const glm::dvec3 cp = p - c;
+    const double d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
+    if (d6 >= 0 && d5 <= d6) return glm::length(p - c);
+    const double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0 && d2 >= 0 && d6 <= 0) return glm::length(p - (a + ac * (d2 / (d2 - d6))));
+    const double va = d3 * d6 - d5 * d4;
+    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+        return glm::length(p - (b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)))));
+    const double denom = va + vb + vc;
+    if (std::abs(denom) < 1e-300) // degenerate triangle: its edges hold the closest point
+        return std::min({glm::length(p - a), glm::length(p - b), glm::length(p - c)});
+    const double v = vb / denom, w = vc / denom;
+    return glm::length(p - (a + ab * v + ac * w));
+}
+
+} // namespace
+
+void bounding_box(const TriangleMesh& mesh, glm::dvec3& lo, glm::dvec3& hi)
+{
+    if (mesh.positions.empty()) throw InvalidInput("bounding_box: mesh has no vertex");
+    lo = hi = glm::dvec3(mesh.positions.front());
+    for (const glm::vec3& p : mesh.positions) {
+        lo = glm::min(lo, glm::dvec3(p));
+        hi = glm::max(hi, glm::dvec3(p));
+    }
+}
+
+MeshQuality measure_quality(const TriangleMesh& mesh)
+{
+    check_mesh(mesh, "measure_quality");
+    MeshQuality q;
+    q.vertices = mesh.positions.size();
+    q.triangles = mesh.triangles.size();
+
+    // Angles and volume.
+    q.min_angle_deg = 180.0;
+    std::size_t good = 0;
+    double volume6 = 0;
+    for (const auto& t : mesh.triangles) {
+        const glm::dvec3 a = pos(mesh, t[0]), b = pos(mesh, t[1]), c = pos(mesh, t[2]);
+        const double A = corner_angle(a, b, c), B = corner_angle(b, c, a), C = corner_angle(c, a, b);
+        const double lo = std::min({A, B, C}), hi = std::max({A, B, C});
+        q.min_angle_deg = std::min(q.min_angle_deg, lo);
+        q.max_angle_deg = std::max(q.max_angle_deg, hi);
+        if (lo >= 30.0) ++good;
+        if (lo < 15.0) ++q.count_angle_lt_15;
+        volume6 += glm::dot(a, glm::cross(b, c));
+    }
+    q.share_all_angles_ge_30 = static_cast<double>(good) / static_cast<double>(q.triangles);
+    q.signed_volume_m3 = volume6 / 6.0;
+
+    // Edges: incidence counts and directions.
+    struct EdgeUse {
+        int count = 0;
+        int forward = 0; ///< uses running from the smaller to the larger index
+        int a = 0, b = 0;
+    };
+    std::unordered_map<std::uint64_t, EdgeUse> edges;
+    edges.reserve(mesh.triangles.size() * 2);
+    for (const auto& t : mesh.triangles)
+        for (int k = 0; k < 3; ++k) {
+            const int a = t[static_cast<std::size_t>(k)], b = t[static_cast<std::size_t>((k + 1) % 3)];
+            EdgeUse& e = edges[edge_key(a, b)];
+            e.a = std::min(a, b);
+            e.b = std::max(a, b);
+            ++e.count;
+            if (a < b) ++e.forward;
+        }
+    double sum = 0, sum2 = 0;
+    q.edge_min_m = std::numeric_limits<double>::max();
+    for (const auto& [key, e] : edges) {
+        const double len = glm::length(pos(mesh, e.a) - pos(mesh, e.b));
+        q.edge_min_m = std::min(q.edge_min_m, len);
+        q.edge_max_m = std::max(q.edge_max_m, len);
+        sum += len;
+        sum2 += len * len;
+        if (e.count == 1) ++q.boundary_edges;
+        if (e.count > 2) ++q.non_manifold_edges;
+        if (e.count == 2 && e.forward != 1) ++q.inconsistent_edges;
+    }
+    const double n = static_cast<double>(edges.size());
+    q.edge_mean_m = sum / n;
+    q.edge_stddev_m = std::sqrt(std::max(0.0, sum2 / n - q.edge_mean_m * q.edge_mean_m));
+
+    // Vertex fans: the triangles around a vertex, joined through shared edges, must form one
+    // fan. Count per vertex the incident triangles and the fan pieces (union-find over the
+    // triangle corners that share an edge at that vertex).
+    const std::size_t nv = mesh.positions.size();
+    std::vector<int> corner_start(nv + 1, 0);
+    for (const auto& t : mesh.triangles)
+        for (int v : t) ++corner_start[static_cast<std::size_t>(v) + 1];
+    std::partial_sum(corner_start.begin(), corner_start.end(), corner_start.begin());
+    std::vector<int> corner_tri(corner_start.back());
+    {
+        std::vector<int> fill(corner_start.begin(), corner_start.end() - 1);
+        for (std::size_t f = 0; f < mesh.triangles.size(); ++f)
+            for (int v : mesh.triangles[f]) corner_tri[static_cast<std::size_t>(fill[static_cast<std::size_t>(v)]++)] = static_cast<int>(f);
+    }
+    std::vector<int> parent;
+    std::unordered_map<int, int> local;
+    for (std::size_t v = 0; v < nv; ++v) {
+        const int b = corner_start[v], e = corner_start[v + 1];
+        if (e - b == 0) continue;
+        // Other vertex -> first local fan piece that holds it.
+        local.clear();
+        parent.resize(static_cast<std::size_t>(e - b));
+        std::iota(parent.begin(), parent.end(), 0);
+        for (int i = b; i < e; ++i) {
+            const auto& t = mesh.triangles[static_cast<std::size_t>(corner_tri[static_cast<std::size_t>(i)])];
+            for (int w : t) {
+                if (w == static_cast<int>(v)) continue;
+                auto [it, inserted] = local.emplace(w, i - b);
+                if (!inserted) {
+                    const int ra = find_root(parent, it->second), rb = find_root(parent, i - b);
+                    if (ra != rb) parent[static_cast<std::size_t>(ra)] = rb;
+                }
+            }
+        }
+        int pieces = 0;
+        for (int i = 0; i < e - b; ++i)
+            if (find_root(parent, i) == i) ++pieces;
+        if (pieces > 1) ++q.non_manifold_vertices;
+    }
+
+    // Components over shared vertices.
+    parent.resize(nv);
+    std::iota(parent.begin(), parent.end(), 0);
+    for (const auto& t : mesh.triangles)
+        for (int k = 1; k < 3; ++k) {
+            const int ra = find_root(parent, t[0]), rb = find_root(parent, t[static_cast<std::size_t>(k)]);
+            if (ra != rb) parent[static_cast<std::size_t>(ra)] = rb;
+        }
+    std::vector<char> used(nv, 0);
+    for (const auto& t : mesh.triangles)
+        for (int v : t) used[static_cast<std::size_t>(v)] = 1;
+    for (std::size_t v = 0; v < nv; ++v)
+        if (used[v] && find_root(parent, static_cast<int>(v)) == static_cast<int>(v)) ++q.components;
+
+    q.closed = q.boundary_edges == 0;
+    q.manifold = q.non_manifold_edges == 0 && q.non_manifold_vertices == 0 && q.inconsistent_edges == 0;
+    q.outward = q.closed && q.signed_volume_m3 > 0;
+    return q;
+}
+
+double max_vertex_distance(const TriangleMesh& from, const TriangleMesh& to)
+{
+    check_mesh(to, "max_vertex_distance");
+    glm::dvec3 lo, hi;
+    bounding_box(to, lo, hi);
+    // Cell size: about twice the mean edge, and at most 64 cells per axis so that memory
+    // stays small.
+    double mean_edge = 0;
+    for (const auto& t : to.triangles) mean_edge += glm::length(pos(to, t[0]) - pos(to, t[1]));
+    mean_edge /= static_cast<double>(to.triangles.size());
+    const glm::dvec3 ext = hi - lo;
+    double cell = std::max({mean_edge * 2.0, std::max({ext.x, ext.y, ext.z}) / 64.0, 1e-9});
+    const glm::ivec3 dims = glm::ivec3(glm::max(glm::dvec3(1.0), glm::ceil(ext / cell + 1e-9)));
+    auto cell_of = [&](const glm::dvec3& p) {
+        return glm::clamp(glm::ivec3(glm::floor((p - lo) / cell)), glm::ivec3(0), dims - 1);
+    };
+    auto cell_index = [&](const glm::ivec3& c) {
+        return (static_cast<std::size_t>(c.z) * static_cast<std::size_t>(dims.y) + static_cast<std::size_t>(c.y)) *
+                   static_cast<std::size_t>(dims.x) + static_cast<std::size_t>(c.x);
+    };
+    const std::size_t ncells = static_cast<std::size_t>(dims.x) * static_cast<std::size_t>(dims.y) * static_cast<std::size_t>(dims.z);
+    std::vector<std::vector<int>> cells(ncells);
+    for (std::size_t f = 0; f < to.triangles.size(); ++f) {
+        const auto& t = to.triangles[f];
+        const glm::dvec3 a = pos(to, t[0]), b = pos(to, t[1]), c = pos(to, t[2]);
+        const glm::ivec3 c0 = cell_of(glm::min(a, glm::min(b, c))), c1 = cell_of(glm::max(a, glm::max(b, c)));
+        for (int z = c0.z; z <= c1.z; ++z)
+            for (int y = c0.y; y <= c1.y; ++y)
+                for (int x = c0.x; x <= c1.x; ++x) cells[cell_index({x, y, z})].push_back(static_cast<int>(f));
+    }
+
+    // For each query point, search the cells within a cube of half-side r around it; a
+    // triangle nearer than r has its bounding box overlap that cube, so once the best found
+    // is ≤ r it is exact. Otherwise double r.
+    std::vector<int> stamp(to.triangles.size(), -1);
+    double worst = 0;
+    for (std::size_t qi = 0; qi < from.positions.size(); ++qi) {
+        const glm::dvec3 p(from.positions[qi]);
+        double best = std::numeric_limits<double>::max();
+        for (double r = cell;; r *= 2.0) {
+            const glm::ivec3 c0 = cell_of(p - r), c1 = cell_of(p + r);
+            for (int z = c0.z; z <= c1.z; ++z)
+                for (int y = c0.y; y <= c1.y; ++y)
+                    for (int x = c0.x; x <= c1.x; ++x)
+                        for (int f : cells[cell_index({x, y, z})]) {
+                            if (stamp[static_cast<std::size_t>(f)] == static_cast<int>(qi)) continue;
+                            stamp[static_cast<std::size_t>(f)] = static_cast<int>(qi);
+                            const auto& t = to.triangles[static_cast<std::size_t>(f)];
+                            best = std::min(best, point_triangle_distance(p, pos(to, t[0]), pos(to, t[1]), pos(to, t[2])));
+                        }
+            const bool covers_all = c0 == glm::ivec3(0) && c1 == dims - 1;
+            if (best <= r || covers_all) break;
+        }
+        worst = std::max(worst, best);
+    }
+    return worst;
+}
+
+} // namespace lobe

@@ -1,0 +1,38 @@
+#pragma once
+/// \file remesh.h
+/// Isotropic remeshing of lobe surfaces to the attractor spacing, with the stroke edges as
+/// constraints (the attractors of growth are the lobe's vertices). CGAL works behind
+/// this plain interface (remesh_cgal.cpp). See docs/lobes-from-models.md.
+
+#include <vector>
+
+#include "core/mesh.h"
+
+namespace lobe {
+
+/// Remeshing options.
+struct RemeshOptions {
+    /// Target edge length: the attractor spacing, one absolute length for every lobe
+    /// (DESIGN.md: 3 cm).
+    double target_edge_length_m = 0.03;
+    /// Rounds of split / collapse / flip / tangential relaxation / projection.
+    unsigned iterations = 3;
+    /// Keep TriangleMesh::feature_edges: they are first split to at most the target length
+    /// (so CGAL's protect_constraints precondition, < 4/3 target, holds), then neither split,
+    /// collapsed, flipped nor moved. Otherwise they are ignored (and dropped in the output).
+    bool protect_feature_edges = true;
+    /// Triangle indices to remesh (incremental remeshing of a changed region); empty: all.
+    /// The region's border edges are constrained too (split first when longer than the
+    /// target), so every vertex outside the region keeps its position.
+    std::vector<int> faces;
+};
+
+/// Remeshes `mesh` towards edges of options.target_edge_length_m with
+/// CGAL::Polygon_mesh_processing::isotropic_remeshing on an OpenMesh TriMesh, projecting
+/// onto the input surface. The output's feature_edges are the constrained edges after
+/// splitting. Vertex indices change; positions of vertices outside options.faces do not.
+/// \pre mesh is 2-manifold (closed or with boundary), indices in range; target > 0.
+/// \throw InvalidInput when the precondition does not hold (one-line message).
+TriangleMesh remesh_isotropic(const TriangleMesh& mesh, const RemeshOptions& options = {});
+
+} // namespace lobe

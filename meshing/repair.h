@@ -1,0 +1,66 @@
+#pragma once
+/// \file repair.h
+/// Turning an external mesh (a scan, a model from the web) into a valid lobe surface:
+/// closed, 2-manifold, one component, oriented outward. CGAL works behind this plain
+/// interface (repair_cgal.cpp). See docs/lobes-from-models.md.
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "core/mesh.h"
+
+namespace lobe {
+
+/// What repair_mesh() did, for the import report.
+struct RepairReport {
+    std::size_t input_vertices = 0;
+    std::size_t input_triangles = 0;
+    std::size_t merged_vertices = 0;         ///< duplicate points merged or unused points dropped
+    std::size_t removed_triangles = 0;       ///< degenerate (repeated vertex) or duplicate triangles
+    std::size_t split_non_manifold_vertices = 0; ///< vertex copies made to split non-manifold vertices
+    std::size_t holes_filled = 0;
+    std::size_t holes_faired = 0;            ///< of those, filled with a smooth (faired) patch
+    std::size_t components = 0;              ///< connected components before keeping the largest
+    std::size_t removed_component_triangles = 0; ///< triangles of the smaller components, dropped
+    bool self_intersections_left = false;    ///< the input self-intersected and not all could be removed
+    bool reoriented = false;                 ///< all faces were flipped to point outward
+    std::size_t output_vertices = 0;
+    std::size_t output_triangles = 0;
+    std::vector<std::string> notes;          ///< one line per notable step, in order
+};
+
+/// Repairs a triangle soup into one closed, 2-manifold, outward-oriented surface:
+/// 1. drops triangles with repeated vertices and duplicate triangles, merges vertices at the
+///    same position, drops unused vertices (CGAL repair_polygon_soup);
+/// 2. orients the soup consistently, splitting vertices and edges where it is not manifold
+///    (orient_polygon_soup), builds a halfedge mesh and splits any remaining non-manifold
+///    vertex (duplicate_non_manifold_vertices); the copies of a split vertex are moved a
+///    hair apart (1% towards their own fan) so the surface does not touch itself there;
+/// 3. keeps the largest connected component (by triangle count), noting the others;
+/// 4. fills every hole (triangulate_refine_and_fair_hole; plain triangulate_hole when
+///    that gives nothing);
+/// 5. removes self-intersections where it can (CGAL's experimental
+///    remove_self_intersections, preserve_genus(false)); what is left is reported in
+///    RepairReport::self_intersections_left, not thrown;
+/// 6. orients the faces outward (is_outward_oriented, reverse_face_orientations).
+/// Feature edges of the input are dropped. `report` (optional) receives what was done.
+/// \throw InvalidInput when an index is out of range, a coordinate is not finite, nothing
+/// is left after step 1, or the result is still not closed and 2-manifold (a hole that
+/// cannot be triangulated), with a one-line message.
+TriangleMesh repair_mesh(const TriangleMesh& mesh, RepairReport* report = nullptr);
+
+/// Removes self-intersections where it can: CGAL's experimental remove_self_intersections
+/// (preserve_genus(false)) takes out the faces involved and fills the gaps by smoothing or
+/// re-triangulating; the result may have holes or several components (repair_mesh deals
+/// with them). Feature edges are dropped. Returns true when none is left.
+/// \pre mesh is 2-manifold. \throw InvalidInput when it is not.
+bool remove_self_intersections(TriangleMesh& mesh);
+
+/// True when two non-adjacent triangles of `mesh` intersect
+/// (CGAL::Polygon_mesh_processing::does_self_intersect).
+/// \pre mesh is 2-manifold (it is converted to a halfedge mesh).
+/// \throw InvalidInput when it is not.
+bool self_intersects(const TriangleMesh& mesh);
+
+} // namespace lobe

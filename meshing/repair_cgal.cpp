@@ -1,0 +1,241 @@
+// Mesh repair with CGAL's Polygon Mesh Processing (self-intersections are in
+// self_intersections_cgal.cpp, a translation unit of their own: they double the compile time). Works on CGAL::Surface_mesh rather than
+// OpenMesh: the soup-to-mesh functions, hole filling and component removal need no
+// per-element status bookkeeping there, and nothing outside this file sees the type.
+#include "meshing/repair.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <iterator>
+#include <map>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wconversion"
+#pragma GCC diagnostic ignored "-Wshadow"
+#pragma GCC diagnostic ignored "-Wsign-conversion"
+#pragma GCC diagnostic ignored "-Wunused-parameter"
+#pragma GCC diagnostic ignored "-Wpedantic"
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_mesh_processing/border.h>
+#include <CGAL/Polygon_mesh_processing/connected_components.h>
+#include <CGAL/Polygon_mesh_processing/manifoldness.h>
+#include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
+#include <CGAL/Polygon_mesh_processing/orientation.h>
+#include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
+#include <CGAL/Polygon_mesh_processing/repair_polygon_soup.h>
+#include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
+#include <CGAL/Surface_mesh.h>
+#pragma GCC diagnostic pop
+
+#include "core/errors.h"
+#include "meshing/mesh_quality.h"
+
+namespace lobe {
+
+namespace {
+
+namespace PMP = CGAL::Polygon_mesh_processing;
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Point = Kernel::Point_3;
+using Mesh = CGAL::Surface_mesh<Point>;
+using VertexIndex = Mesh::Vertex_index;
+using Polygon = std::vector<std::size_t>;
+
+/// The input as a polygon soup, with its preconditions checked.
+void to_soup(const TriangleMesh& in, const char* who, std::vector<Point>& points, std::vector<Polygon>& polygons)
+{
+    points.reserve(in.positions.size());
+    for (const glm::vec3& p : in.positions) {
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+            throw InvalidInput(std::string(who) + ": vertex with a non-finite coordinate");
+        points.emplace_back(p.x, p.y, p.z);
+    }
+    const auto n = static_cast<long long>(in.positions.size());
+    polygons.reserve(in.triangles.size());
+    for (const auto& t : in.triangles) {
+        for (int v : t)
+            if (v < 0 || v >= n) throw InvalidInput(std::string(who) + ": triangle index out of range");
+        polygons.push_back({static_cast<std::size_t>(t[0]), static_cast<std::size_t>(t[1]), static_cast<std::size_t>(t[2])});
+    }
+}
+
+/// A compact (garbage-free) Surface_mesh as a TriangleMesh.
+TriangleMesh to_triangle_mesh(Mesh& mesh)
+{
+    mesh.collect_garbage();
+    TriangleMesh out;
+    out.positions.reserve(mesh.number_of_vertices());
+    for (VertexIndex v : mesh.vertices()) {
+        const Point& p = mesh.point(v);
+        out.positions.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
+    }
+    out.triangles.reserve(mesh.number_of_faces());
+    for (auto f : mesh.faces()) {
+        std::array<int, 3> t{};
+        int k = 0;
+        for (VertexIndex v : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) {
+            if (k < 3) t[static_cast<std::size_t>(k)] = static_cast<int>(v.idx());
+            ++k;
+        }
+        if (k != 3) throw InvalidInput("repair_mesh: internal error: a face is not a triangle");
+        out.triangles.push_back(t);
+    }
+    return out;
+}
+
+/// Vertices at exactly the same position (the copies of a split non-manifold vertex) are
+/// moved 1% of the way towards the centroid of their own neighbours, so the surface no
+/// longer touches itself there. Returns how many vertices moved.
+std::size_t separate_coincident_vertices(Mesh& mesh)
+{
+    std::map<std::array<double, 3>, std::vector<VertexIndex>> at;
+    for (VertexIndex v : mesh.vertices()) {
+        const Point& p = mesh.point(v);
+        at[{p.x(), p.y(), p.z()}].push_back(v);
+    }
+    std::size_t moved = 0;
+    for (const auto& [key, group] : at) {
+        if (group.size() < 2) continue;
+        for (VertexIndex v : group) {
+            double c[3] = {0, 0, 0};
+            int n = 0;
+            for (VertexIndex w : CGAL::vertices_around_target(mesh.halfedge(v), mesh)) {
+                const Point& q = mesh.point(w);
+                c[0] += q.x();
+                c[1] += q.y();
+                c[2] += q.z();
+                ++n;
+            }
+            if (n == 0) continue;
+            const double s = 0.01 / n;
+            mesh.point(v) = Point(key[0] + (c[0] - n * key[0]) * s, key[1] + (c[1] - n * key[1]) * s,
+                                  key[2] + (c[2] - n * key[2]) * s);
+            ++moved;
+        }
+    }
+    return moved;
+}
+
+/// Keeps the component with the most triangles.
+void keep_largest_component(Mesh& mesh, RepairReport& r)
+{
+    auto fcc = mesh.add_property_map<Mesh::Face_index, std::size_t>("f:lobe_cc").first;
+    const std::size_t n = PMP::connected_components(mesh, fcc);
+    mesh.remove_property_map(fcc);
+    r.components = std::max(r.components, n);
+    if (n <= 1) return;
+    const std::size_t faces_before = mesh.number_of_faces();
+    PMP::keep_largest_connected_components(mesh, 1);
+    mesh.collect_garbage();
+    r.removed_component_triangles += faces_before - mesh.number_of_faces();
+    r.notes.push_back("kept the largest of " + std::to_string(n) + " connected components (dropped " +
+                      std::to_string(faces_before - mesh.number_of_faces()) + " triangles)");
+}
+
+/// Fills every hole with a refined, faired patch (a plain minimal-area one when that fails).
+/// \throw InvalidInput when a hole stays open.
+void fill_holes(Mesh& mesh, RepairReport& r)
+{
+    std::vector<Mesh::Halfedge_index> borders;
+    PMP::extract_boundary_cycles(mesh, std::back_inserter(borders));
+    if (borders.empty()) return;
+    std::size_t filled = 0, faired = 0;
+    for (Mesh::Halfedge_index h : borders) {
+        std::vector<Mesh::Face_index> new_faces;
+        std::vector<VertexIndex> new_vertices;
+        const auto result =
+            PMP::triangulate_refine_and_fair_hole(mesh, h, std::back_inserter(new_faces), std::back_inserter(new_vertices));
+        if (new_faces.empty()) PMP::triangulate_hole(mesh, h, std::back_inserter(new_faces));
+        else if (std::get<0>(result)) ++faired;
+        if (!new_faces.empty()) ++filled;
+    }
+    r.holes_filled += filled;
+    r.holes_faired += faired;
+    r.notes.push_back("filled " + std::to_string(filled) + " of " + std::to_string(borders.size()) + " holes (" +
+                      std::to_string(faired) + " faired)");
+    if (!CGAL::is_closed(mesh))
+        throw InvalidInput("repair_mesh: a hole could not be filled (" + std::to_string(borders.size() - filled) +
+                           " of " + std::to_string(borders.size()) + " left open)");
+}
+
+} // namespace
+
+TriangleMesh repair_mesh(const TriangleMesh& in, RepairReport* report)
+{
+    RepairReport r;
+    r.input_vertices = in.positions.size();
+    r.input_triangles = in.triangles.size();
+    std::vector<Point> points;
+    std::vector<Polygon> polygons;
+    to_soup(in, "repair_mesh", points, polygons);
+
+    // 1. Soup clean-up: repeated vertices in a triangle, duplicate triangles, duplicate and
+    //    unused points.
+    PMP::repair_polygon_soup(points, polygons);
+    r.merged_vertices = in.positions.size() - points.size();
+    r.removed_triangles = in.triangles.size() - polygons.size();
+    if (polygons.empty()) throw InvalidInput("repair_mesh: no valid triangle left after removing degenerate ones");
+    if (r.merged_vertices) r.notes.push_back("merged or dropped " + std::to_string(r.merged_vertices) + " duplicate or unused vertices");
+    if (r.removed_triangles) r.notes.push_back("removed " + std::to_string(r.removed_triangles) + " degenerate or duplicate triangles");
+
+    // 2. Consistent orientation; non-manifold vertices and edges are split here.
+    const std::size_t before_orient = points.size();
+    PMP::orient_polygon_soup(points, polygons);
+    r.split_non_manifold_vertices = points.size() - before_orient;
+    Mesh mesh;
+    PMP::polygon_soup_to_polygon_mesh(points, polygons, mesh);
+    r.split_non_manifold_vertices += PMP::duplicate_non_manifold_vertices(mesh);
+    if (r.split_non_manifold_vertices)
+        r.notes.push_back("split non-manifold vertices (" + std::to_string(r.split_non_manifold_vertices) + " copies made)");
+
+    // 3. One component, 4. no holes.
+    keep_largest_component(mesh, r);
+    fill_holes(mesh, r);
+
+    // Copies of split vertices would make the surface touch itself at a point.
+    separate_coincident_vertices(mesh);
+
+    // 5. Self-intersections (the cow's tail runs into its body): CGAL's experimental local
+    //    repair removes the faces involved and fills the gap, smoothing or re-triangulating;
+    //    with preserve_genus(false) it may also cut through a handle, which a lobe (an
+    //    envelope of foliage) does not mind.
+    {
+        TriangleMesh tm = to_triangle_mesh(mesh);
+        if (self_intersects(tm)) {
+            r.self_intersections_left = !remove_self_intersections(tm);
+            r.notes.push_back(r.self_intersections_left ? "some self-intersections could not be removed"
+                                                        : "removed self-intersections");
+            mesh.clear();
+            std::vector<Point> pts;
+            std::vector<Polygon> polys;
+            to_soup(tm, "repair_mesh", pts, polys);
+            PMP::polygon_soup_to_polygon_mesh(pts, polys, mesh);
+            keep_largest_component(mesh, r);
+            fill_holes(mesh, r);
+        }
+    }
+
+    // 6. Outward orientation.
+    if (!PMP::is_outward_oriented(mesh)) {
+        PMP::reverse_face_orientations(mesh);
+        r.reoriented = true;
+        r.notes.push_back("flipped all faces to point outward");
+    }
+
+    TriangleMesh out = to_triangle_mesh(mesh);
+    const MeshQuality q = measure_quality(out);
+    if (!q.closed || !q.manifold || !q.outward)
+        throw InvalidInput("repair_mesh: the result is still not a closed, 2-manifold, outward-oriented surface");
+    r.output_vertices = out.positions.size();
+    r.output_triangles = out.triangles.size();
+    if (report) *report = std::move(r);
+    return out;
+}
+
+} // namespace lobe
