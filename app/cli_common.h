@@ -33,5 +33,6 @@ void add_info_command(CLI::App& app, int& exit_code);
 void add_replay_command(CLI::App& app, int& exit_code);
 void add_import_commands(CLI::App& app, int& exit_code);
 void add_synth_command(CLI::App& app, int& exit_code);
+void add_lobes_command(CLI::App& app, int& exit_code);
 
 } // namespace lobe::cli

@@ -1,8 +1,13 @@
 #include "app/outputs.h"
 
+#include <filesystem>
+
 #include <nlohmann/json.hpp>
 
 #include "core/atomic_file.h"
+#include "core/errors.h"
+#include "meshing/lobe_document.h"
+#include "meshing/mesh_io.h"
 
 namespace lobe {
 
@@ -25,6 +30,31 @@ void write_strokes_json(const std::string& path, const std::vector<Stroke>& stro
     }
     nlohmann::json j = {{"format", "lobesketch-strokes"}, {"version", 1}, {"source", source}, {"strokes", std::move(arr)}};
     write_file_atomic(path, j.dump(1) + "\n");
+}
+
+} // namespace lobe
+
+namespace lobe {
+
+std::size_t write_document_lobes(Document& doc, const std::string& out_dir, std::vector<std::string>& warnings)
+{
+    const std::vector<BuiltLobe> lobes = build_document_lobes(doc, &warnings);
+    const std::string dir = out_dir + "/lobes";
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (ec) throw FileError(dir, "cannot create folder: " + ec.message());
+    std::size_t written = 0;
+    for (LobeRecord& rec : doc.lobes) {
+        rec.mesh_file.clear();
+        for (const BuiltLobe& b : lobes) {
+            if (b.lobe_id != rec.id) continue;
+            const std::string name = "lobes/lobe_" + std::to_string(rec.id) + ".ply";
+            write_ply(out_dir + "/" + name, b.mesh);
+            rec.mesh_file = name;
+            ++written;
+        }
+    }
+    return written;
 }
 
 } // namespace lobe

@@ -23,7 +23,8 @@ void add_replay_command(CLI::App& app, int& exit_code)
     };
     auto a = std::make_shared<Args>();
     cmd->add_option("REC", a->rec, "Recording (binary or text form)")->required();
-    cmd->add_option("-o,--out", a->out, "Output folder (created): strokes.json, session.json")->required();
+    cmd->add_option("-o,--out", a->out, "Output folder (created): strokes.json, session.json, lobes/lobe_N.ply")
+        ->required();
     cmd->add_option("--settings", a->settings, "Settings JSON (a settings object or a session document)");
     cmd->add_option("--seed", a->seed, "Seed of every random choice downstream")->capture_default_str();
     cmd->callback([a, &exit_code] {
@@ -42,19 +43,26 @@ void add_replay_command(CLI::App& app, int& exit_code)
         doc.source_recording = std::filesystem::absolute(a->rec).lexically_normal().string();
         SessionBuilder builder(std::move(doc));
         builder.apply(result.actions);
-        const Document& out_doc = builder.document();
+        Document out_doc = builder.take_document();
 
         std::error_code ec;
         std::filesystem::create_directories(a->out, ec);
         if (ec) throw FileError(a->out, "cannot create output folder: " + ec.message());
         write_strokes_json(a->out + "/strokes.json", out_doc.strokes, a->rec);
+        // The session first (every stroke is safe even if meshing fails), then the lobes, then
+        // the session again with their files.
+        save_document(a->out + "/session.json", out_doc);
+        std::vector<std::string> warnings;
+        const std::size_t lobe_files = write_document_lobes(out_doc, a->out, warnings);
+        for (const std::string& w : warnings) warn(a->rec + ": " + w);
         save_document(a->out + "/session.json", out_doc);
         std::size_t lobe_strokes = 0, trunk_strokes = 0;
         for (const Stroke& s : out_doc.strokes) (s.kind == StrokeKind::Lobe ? lobe_strokes : trunk_strokes)++;
         progress("derived " + std::to_string(out_doc.strokes.size()) + " strokes (" + std::to_string(lobe_strokes) +
                  " lobe, " + std::to_string(trunk_strokes) + " trunk) in " + std::to_string(out_doc.lobes.size()) +
                  " lobe group(s), " + std::to_string(result.drags.size()) + " drag edit(s)");
-        progress("wrote " + a->out + "/strokes.json and " + a->out + "/session.json");
+        progress("wrote " + a->out + "/strokes.json, " + a->out + "/session.json and " + std::to_string(lobe_files) +
+                 " lobe mesh(es) in " + a->out + "/lobes");
         if (out_doc.strokes.empty() && result.drags.empty()) {
             error(a->rec + ": no strokes in this recording");
             exit_code = kExitFailure;

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "core/document.h"
 #include "core/stroke.h"
 
 namespace lobe {
@@ -12,5 +13,11 @@ namespace lobe {
 /// `{"format":"lobesketch-strokes","version":1,"source":…,"strokes":[{id, kind, closed, hand,
 /// points:[[x,y,z] metres…], times:[s…]}]}`, written atomically.
 void write_strokes_json(const std::string& path, const std::vector<Stroke>& strokes, const std::string& source);
+
+/// Rebuilds every lobe of `doc` (meshing/lobe_document.h) and writes each as
+/// `out_dir/lobes/lobe_<id>.ply`, recording the relative path in the lobe's mesh_file.
+/// Lobes that cannot be built get an empty mesh_file. Warnings are appended, one line each.
+/// Returns the number of lobe files written. 	hrow FileError
+std::size_t write_document_lobes(Document& doc, const std::string& out_dir, std::vector<std::string>& warnings);
 
 } // namespace lobe

@@ -39,6 +39,13 @@ json settings_to_json(const Settings& s)
           {"min_stroke_length_m", in.min_stroke_length_m},
           {"min_stroke_points", in.min_stroke_points},
           {"max_hand_speed_mps", in.max_hand_speed_mps}}},
+        {"lobes",
+         {{"edge_length_m", s.lobes.edge_length_m},
+          {"remesh_iterations", s.lobes.remesh_iterations},
+          {"closed_gap_fraction", s.lobes.closed_gap_fraction},
+          {"closed_gap_max_m", s.lobes.closed_gap_max_m},
+          {"pinch_roi_radius_m", s.lobes.pinch_roi_radius_m},
+          {"pinch_pick_distance_m", s.lobes.pinch_pick_distance_m}}},
     };
 }
 
@@ -67,7 +74,22 @@ Settings settings_from_json(const json& j)
 {
     Settings s;
     if (!j.is_object()) throw InvalidInput("settings: expected an object");
-    check_keys(j, {"input"}, "settings");
+    check_keys(j, {"input", "lobes"}, "settings");
+    if (auto it = j.find("lobes"); it != j.end()) {
+        if (!it->is_object()) throw InvalidInput("settings.lobes: expected an object");
+        const std::string w = "settings.lobes";
+        check_keys(*it,
+                   {"edge_length_m", "remesh_iterations", "closed_gap_fraction", "closed_gap_max_m",
+                    "pinch_roi_radius_m", "pinch_pick_distance_m"},
+                   w);
+        LobeSettings& l = s.lobes;
+        read_number(*it, "edge_length_m", l.edge_length_m, w);
+        read_number(*it, "remesh_iterations", l.remesh_iterations, w);
+        read_number(*it, "closed_gap_fraction", l.closed_gap_fraction, w);
+        read_number(*it, "closed_gap_max_m", l.closed_gap_max_m, w);
+        read_number(*it, "pinch_roi_radius_m", l.pinch_roi_radius_m, w);
+        read_number(*it, "pinch_pick_distance_m", l.pinch_pick_distance_m, w);
+    }
     if (auto it = j.find("input"); it != j.end()) {
         if (!it->is_object()) throw InvalidInput("settings.input: expected an object");
         const json& in = *it;
@@ -195,6 +217,17 @@ void validate_settings(const Settings& s)
     require(o.min_stroke_length_m >= 0 && o.min_stroke_length_m <= 10, "min_stroke_length_m must be in [0, 10]");
     require(o.min_stroke_points >= 2 && o.min_stroke_points <= 1000, "min_stroke_points must be in [2, 1000]");
     require(o.max_hand_speed_mps > 0.5 && o.max_hand_speed_mps <= 100, "max_hand_speed_mps must be in (0.5, 100]");
+    const LobeSettings& l = s.lobes;
+    auto require_lobes = [](bool ok, const char* what) {
+        if (!ok) throw InvalidInput(std::string("settings.lobes.") + what);
+    };
+    require_lobes(l.edge_length_m >= 0.005 && l.edge_length_m <= 0.5, "edge_length_m must be in [0.005, 0.5]");
+    require_lobes(l.remesh_iterations >= 0 && l.remesh_iterations <= 20, "remesh_iterations must be in [0, 20]");
+    require_lobes(l.closed_gap_fraction > 0 && l.closed_gap_fraction <= 0.5, "closed_gap_fraction must be in (0, 0.5]");
+    require_lobes(l.closed_gap_max_m > 0 && l.closed_gap_max_m <= 1, "closed_gap_max_m must be in (0, 1]");
+    require_lobes(l.pinch_roi_radius_m >= 0.01 && l.pinch_roi_radius_m <= 2, "pinch_roi_radius_m must be in [0.01, 2]");
+    require_lobes(l.pinch_pick_distance_m > 0 && l.pinch_pick_distance_m <= 0.5,
+                  "pinch_pick_distance_m must be in (0, 0.5]");
 }
 
 nlohmann::json settings_json(const Settings& s) { return settings_to_json(s); }

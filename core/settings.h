@@ -45,9 +45,27 @@ struct InputOptions {
     double max_hand_speed_mps = 8.0;
 };
 
+/// Lobes (§4): closing, remeshing, pinch editing. The paper gives no numbers; these are ours.
+struct LobeSettings {
+    /// Attractor spacing: one absolute target edge length for every lobe, so small and
+    /// large lobes carry the same attractor density.
+    double edge_length_m = 0.03;
+    /// Rounds of isotropic remeshing.
+    int remesh_iterations = 3;
+    /// A stroke is closed when the gap between its ends is below this fraction of its length
+    /// (and below closed_gap_max_m).
+    double closed_gap_fraction = 0.15;
+    double closed_gap_max_m = 0.08;
+    /// Region of interest of a pinch edit: vertices within this distance of the handle.
+    double pinch_roi_radius_m = 0.08;
+    /// A pinch edit picks the lobe vertex nearest the pinch within this distance.
+    double pinch_pick_distance_m = 0.05;
+};
+
 /// All settings of a session.
 struct Settings {
     InputOptions input;
+    LobeSettings lobes;
 };
 
 } // namespace lobe

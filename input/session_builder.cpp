@@ -1,6 +1,10 @@
 #include "input/session_builder.h"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <glm/geometric.hpp>
 
 namespace lobe {
 
@@ -15,15 +19,65 @@ SessionBuilder::SessionBuilder(Document doc) : doc_(std::move(doc))
     for (const EditOperation& e : doc_.edits) next_edit_id_ = std::max(next_edit_id_, e.id + 1);
 }
 
+namespace {
+
+/// Smallest distance between (up to 256 evenly spread) points of `stroke` and (up to 4,096)
+/// points of the lobe's strokes; also the lobe's radius around the centroid of its points.
+void lobe_distance(const Document& doc, const LobeRecord& lobe, const Stroke& stroke, double& distance, double& radius)
+{
+    std::vector<glm::vec3> pts;
+    for (std::int64_t id : lobe.stroke_ids)
+        for (const Stroke& s : doc.strokes)
+            if (s.id == id)
+                for (const StrokePoint& p : s.points) pts.push_back(p.position);
+    distance = 0; // without geometry to compare, the stroke stays with the lobe
+    radius = 0;
+    if (pts.empty() || stroke.points.empty()) return;
+    distance = std::numeric_limits<double>::infinity();
+    glm::dvec3 centroid(0.0);
+    for (const glm::vec3& p : pts) centroid += glm::dvec3(p);
+    centroid /= static_cast<double>(pts.size());
+    for (const glm::vec3& p : pts) radius = std::max(radius, glm::distance(glm::dvec3(p), centroid));
+    const std::size_t step_a = std::max<std::size_t>(1, stroke.points.size() / 256);
+    const std::size_t step_b = std::max<std::size_t>(1, pts.size() / 4096);
+    for (std::size_t i = 0; i < stroke.points.size(); i += step_a)
+        for (std::size_t j = 0; j < pts.size(); j += step_b)
+            distance = std::min(distance, static_cast<double>(glm::distance(stroke.points[i].position, pts[j])));
+}
+
+} // namespace
+
 void SessionBuilder::add_stroke(const Stroke& stroke)
 {
     doc_.strokes.push_back(stroke);
     if (stroke.kind != StrokeKind::Lobe) return;
-    if (doc_.lobes.empty() || new_lobe_pending_) {
-        doc_.lobes.push_back(LobeRecord{next_lobe_id_++, {}, {}});
-        new_lobe_pending_ = false;
+    // A stroke joins the lobe it is drawn into: the current lobe when it comes near it, else
+    // the nearest lobe it comes near; far from every lobe (or after "new lobe") it starts one.
+    LobeRecord* target = nullptr;
+    if (!new_lobe_pending_ && !doc_.lobes.empty()) {
+        auto near = [&](const LobeRecord& l, double& d) {
+            double radius = 0;
+            lobe_distance(doc_, l, stroke, d, radius);
+            return d <= std::max(kJoinDistanceM, 0.5 * radius);
+        };
+        double d = 0;
+        if (near(doc_.lobes.back(), d)) {
+            target = &doc_.lobes.back();
+        } else {
+            double best = std::numeric_limits<double>::infinity();
+            for (LobeRecord& l : doc_.lobes)
+                if (near(l, d) && d < best) {
+                    best = d;
+                    target = &l;
+                }
+        }
     }
-    doc_.lobes.back().stroke_ids.push_back(stroke.id);
+    if (!target) {
+        doc_.lobes.push_back(LobeRecord{next_lobe_id_++, {}, {}});
+        target = &doc_.lobes.back();
+    }
+    new_lobe_pending_ = false;
+    target->stroke_ids.push_back(stroke.id);
 }
 
 bool SessionBuilder::apply(const InputAction& a)

@@ -13,6 +13,10 @@ namespace lobe {
 
 class SessionBuilder {
 public:
+    /// A lobe stroke whose points all stay farther than this (or half the lobe's radius,
+    /// when larger) from every lobe's strokes starts a new lobe.
+    static constexpr double kJoinDistanceM = 0.10;
+
     explicit SessionBuilder(Document doc = {});
 
     /// Applies one action; returns true when the document changed.

@@ -21,6 +21,11 @@ struct RemeshOptions {
     /// (so CGAL's protect_constraints precondition, < 4/3 target, holds), then neither split,
     /// collapsed, flipped nor moved. Otherwise they are ignored (and dropped in the output).
     bool protect_feature_edges = true;
+    /// With protect_feature_edges: let remeshing also split and collapse feature edges along
+    /// their polyline (CGAL's protect_constraints(false)): they are never flipped, their
+    /// vertices never leave the polyline, and short pieces merge into target-length edges, so
+    /// densely sampled strokes do not force slivers. Whole-mesh remeshing only (`faces` empty).
+    bool relax_feature_edges = false;
     /// Triangle indices to remesh (incremental remeshing of a changed region); empty: all.
     /// The region's border edges are constrained too (split first when longer than the
     /// target), so every vertex outside the region keeps its position.

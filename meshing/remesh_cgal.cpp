@@ -178,7 +178,7 @@ TriangleMesh remesh_isotropic(const TriangleMesh& mesh, const RemeshOptions& opt
     PMP::isotropic_remeshing(region, target, om,
                              CGAL::parameters::number_of_iterations(options.iterations)
                                  .edge_is_constrained_map(ecm)
-                                 .protect_constraints(true));
+                                 .protect_constraints(!(options.relax_feature_edges && whole)));
     om.garbage_collection();
 
     TriangleMesh out;

@@ -1,0 +1,71 @@
+#pragma once
+/// \file lobe.h
+/// Progressive lobes (§4.2, Fig. 5): strokes join a lobe one at a time and the lobe's
+/// closed surface follows at once. See docs/lobes.md.
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "meshing/lobe_surface.h"
+#include "meshing/sampling.h"
+
+namespace lobe {
+
+/// Options of progressive lobes.
+struct LobeOptions {
+    SamplingOptions sampling;
+    ClosureOptions closure;
+    LobeSurfaceOptions surface;
+    /// A stroke whose samples all lie within this distance of one stroke of the lobe
+    /// duplicates it and is refused.
+    double duplicate_distance_m = 0.004;
+    /// The lobe's centre stays where it is while the centroid of its strokes is within
+    /// this fraction of the lobe's mean radius of it, so adding a stroke changes only the
+    /// region around that stroke; beyond it the centre moves and the lobe is re-laid.
+    double recentre_fraction = 0.2;
+};
+
+/// Sampling (Eq. 1) and closing (§4.1) of one raw lobe stroke.
+/// \throw InvalidInput for degenerate strokes (fewer than 4 points, zero length, all on one
+/// line, not finite, beyond 1 km).
+LobeStrokeSamples prepare_lobe_stroke(std::int64_t id, const std::vector<glm::vec3>& raw,
+                                      const LobeOptions& options = {});
+
+/// One lobe built progressively. Every change either succeeds or leaves the lobe exactly as
+/// it was (strong guarantee) and throws InvalidInput with a one-line reason.
+class Lobe {
+public:
+    explicit Lobe(LobeOptions options = {});
+
+    /// Adds a raw stroke: sampled, closed when its ends meet, then joined to the surface.
+    void add_stroke(std::int64_t id, const std::vector<glm::vec3>& raw);
+    /// Adds an already prepared stroke.
+    void add_prepared(LobeStrokeSamples stroke);
+    /// Removes a stroke (by id); false when the lobe has no such stroke. Throws when the
+    /// remaining strokes cannot make a lobe (the lobe is left unchanged then).
+    bool remove_stroke(std::int64_t id);
+
+    bool empty() const { return strokes_.empty(); }
+    const std::vector<LobeStrokeSamples>& strokes() const { return strokes_; }
+    /// The closed surface through every stroke, before remeshing.
+    /// \pre !empty()
+    const LobeSurface& surface() const { return *surface_; }
+    const glm::dvec3& centre() const { return centre_; }
+    /// Mean distance of the stroke samples from the centre.
+    double mean_radius() const;
+    /// Smallest distance from any of `points` to any stroke sample of the lobe (metres);
+    /// infinity for an empty lobe.
+    double distance_to(const std::vector<glm::vec3>& points) const;
+
+private:
+    void rebuild(std::vector<LobeStrokeSamples> strokes);
+    LobeOptions options_;
+    std::vector<LobeStrokeSamples> strokes_;
+    std::optional<LobeSurface> surface_;
+    glm::dvec3 centre_{0.0};
+};
+
+} // namespace lobe

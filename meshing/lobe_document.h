@@ -1,0 +1,42 @@
+#pragma once
+/// \file lobe_document.h
+/// Every lobe of a session document, rebuilt from what the person did: the lobe's strokes
+/// joined in drawing order (lobe.h), remeshed to the attractor spacing (remesh.h), then
+/// the document's edit operations re-applied in order (pinch edits, Laplacian editing). A
+/// stroke that cannot join its lobe is left out of the mesh with a warning; it stays in
+/// the document. See docs/lobes.md.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/document.h"
+#include "core/mesh.h"
+#include "meshing/lobe.h"
+
+namespace lobe {
+
+/// One lobe of a document, ready for growth.
+struct BuiltLobe {
+    std::int64_t lobe_id = 0;
+    std::vector<std::int64_t> stroke_ids; ///< the strokes that joined, in order
+    LobeSurface surface;                  ///< the surface through the strokes, before remeshing
+    TriangleMesh mesh;                    ///< remeshed, edits applied: closed, outward
+    std::size_t edits_applied = 0;
+};
+
+/// The options the document's settings give.
+LobeOptions lobe_options_from(const Settings& settings);
+
+/// Rebuilds every lobe of `doc` that has at least one stroke that can join. Warnings (a
+/// stroke left out, an edit that picked nothing) are appended to `warnings` when given,
+/// one line each.
+std::vector<BuiltLobe> build_document_lobes(const Document& doc, std::vector<std::string>* warnings = nullptr);
+
+/// Re-applies the pinch edits (edit operations of type "drag:deform-lobe") that target
+/// `lobe_id` (or, with target 0, start within the pick distance of `mesh`) to `mesh`, in
+/// document order. Returns how many were applied.
+std::size_t apply_pinch_edits(const Document& doc, std::int64_t lobe_id, TriangleMesh& mesh,
+                              std::vector<std::string>* warnings = nullptr);
+
+} // namespace lobe

@@ -1,0 +1,174 @@
+// Lives in lobe_meshing_cgal (hence the name): it builds lobe surfaces and remeshes them.
+#include "meshing/lobe_document.h"
+
+#include <cmath>
+#include <limits>
+#include <map>
+
+#include <glm/geometric.hpp>
+
+#include "core/errors.h"
+#include "meshing/laplacian_edit.h"
+#include "meshing/remesh.h"
+
+namespace lobe {
+
+namespace {
+
+constexpr const char* kPinchEditType = "drag:deform-lobe";
+
+const Stroke* find_stroke(const Document& doc, std::int64_t id)
+{
+    for (const Stroke& s : doc.strokes)
+        if (s.id == id) return &s;
+    return nullptr;
+}
+
+/// The start and end of an edit's fingertip path; false when it has none.
+bool drag_ends(const EditOperation& op, glm::vec3& from, glm::vec3& to)
+{
+    const auto it = op.params.find("path");
+    if (it == op.params.end() || !it->is_array() || it->empty()) return false;
+    auto point = [](const nlohmann::json& p, glm::vec3& out) {
+        if (!p.is_array() || p.size() < 3) return false;
+        for (int k = 0; k < 3; ++k) {
+            if (!p[static_cast<std::size_t>(k)].is_number()) return false;
+            out[k] = p[static_cast<std::size_t>(k)].get<float>();
+            if (!std::isfinite(out[k])) return false;
+        }
+        return true;
+    };
+    return point(it->front(), from) && point(it->back(), to);
+}
+
+double nearest_vertex_distance(const TriangleMesh& mesh, const glm::vec3& p)
+{
+    double best = std::numeric_limits<double>::infinity();
+    for (const glm::vec3& v : mesh.positions) best = std::min(best, static_cast<double>(glm::distance(v, p)));
+    return best;
+}
+
+/// Applies one pinch edit to `mesh`; false (and a warning) when it cannot be applied.
+bool apply_pinch(const Document& doc, const EditOperation& op, TriangleMesh& mesh, std::vector<std::string>* warnings)
+{
+    glm::vec3 from, to;
+    const std::string who = "edit " + std::to_string(op.id);
+    if (!drag_ends(op, from, to)) {
+        if (warnings) warnings->push_back(who + ": no fingertip path, skipped");
+        return false;
+    }
+    PinchEditOptions options;
+    options.roi_radius_m = doc.settings.lobes.pinch_roi_radius_m;
+    try {
+        const int handle = pick_handle(mesh, from, doc.settings.lobes.pinch_pick_distance_m);
+        const glm::vec3 target = mesh.positions[static_cast<std::size_t>(handle)] + (to - from);
+        laplacian_deform(mesh, handle, target, options);
+    } catch (const InvalidInput& e) {
+        if (warnings) warnings->push_back(who + ": " + e.what());
+        return false;
+    } catch (const SolverError& e) {
+        if (warnings) warnings->push_back(who + ": " + e.what());
+        return false;
+    }
+    return true;
+}
+
+} // namespace
+
+LobeOptions lobe_options_from(const Settings& settings)
+{
+    LobeOptions o;
+    o.closure.max_gap_fraction = settings.lobes.closed_gap_fraction;
+    o.closure.max_gap_m = settings.lobes.closed_gap_max_m;
+    o.surface.fill_edge_m = settings.lobes.edge_length_m;
+    o.sampling.seed = 0;
+    return o;
+}
+
+std::vector<BuiltLobe> build_document_lobes(const Document& doc, std::vector<std::string>* warnings)
+{
+    const LobeOptions options = lobe_options_from(doc.settings);
+    RemeshOptions remesh;
+    remesh.target_edge_length_m = doc.settings.lobes.edge_length_m;
+    remesh.iterations = static_cast<unsigned>(doc.settings.lobes.remesh_iterations);
+    remesh.relax_feature_edges = true;
+    std::vector<BuiltLobe> out;
+    for (const LobeRecord& rec : doc.lobes) {
+        Lobe lobe(options);
+        BuiltLobe built;
+        built.lobe_id = rec.id;
+        for (std::int64_t id : rec.stroke_ids) {
+            const Stroke* s = find_stroke(doc, id);
+            if (!s) {
+                if (warnings) warnings->push_back("lobe " + std::to_string(rec.id) + ": stroke " + std::to_string(id) + " is missing");
+                continue;
+            }
+            std::vector<glm::vec3> raw;
+            raw.reserve(s->points.size());
+            for (const StrokePoint& p : s->points) raw.push_back(p.position);
+            try {
+                lobe.add_stroke(id, raw);
+                built.stroke_ids.push_back(id);
+            } catch (const InvalidInput& e) {
+                if (warnings)
+                    warnings->push_back("lobe " + std::to_string(rec.id) + ": " + e.what() + "; the stroke is left out of the lobe");
+            }
+        }
+        if (lobe.empty()) continue;
+        built.surface = lobe.surface();
+        if (remesh.iterations > 0) {
+            built.mesh = remesh_isotropic(built.surface.mesh, remesh);
+        } else {
+            built.mesh = built.surface.mesh;
+        }
+        out.push_back(std::move(built));
+    }
+    // Edits in document order. A pinch edit goes to its target lobe, or (no target) to the
+    // lobe with a vertex nearest the pinch.
+    for (const EditOperation& op : doc.edits) {
+        if (op.type != kPinchEditType) continue;
+        BuiltLobe* target = nullptr;
+        if (op.target > 0) {
+            for (BuiltLobe& b : out)
+                if (b.lobe_id == op.target) target = &b;
+        } else {
+            glm::vec3 from, to;
+            if (drag_ends(op, from, to)) {
+                double best = std::numeric_limits<double>::infinity();
+                for (BuiltLobe& b : out) {
+                    const double d = nearest_vertex_distance(b.mesh, from);
+                    if (d < best) {
+                        best = d;
+                        target = &b;
+                    }
+                }
+            }
+        }
+        if (!target) {
+            if (warnings) warnings->push_back("edit " + std::to_string(op.id) + ": no lobe to edit, skipped");
+            continue;
+        }
+        if (apply_pinch(doc, op, target->mesh, warnings)) ++target->edits_applied;
+    }
+    return out;
+}
+
+std::size_t apply_pinch_edits(const Document& doc, std::int64_t lobe_id, TriangleMesh& mesh,
+                              std::vector<std::string>* warnings)
+{
+    std::size_t applied = 0;
+    for (const EditOperation& op : doc.edits) {
+        if (op.type != kPinchEditType) continue;
+        if (op.target > 0 && op.target != lobe_id) continue;
+        if (op.target == 0) {
+            glm::vec3 from, to;
+            if (!drag_ends(op, from, to) ||
+                nearest_vertex_distance(mesh, from) > doc.settings.lobes.pinch_pick_distance_m)
+                continue;
+        }
+        if (apply_pinch(doc, op, mesh, warnings)) ++applied;
+    }
+    return applied;
+}
+
+} // namespace lobe

@@ -1,0 +1,1086 @@
+// The lobe surface: a constrained Delaunay triangulation of the strokes on the sphere of
+// directions around the lobe's centre (CGAL's Constrained_Delaunay_triangulation_2 in a
+// stereographic projection), lifted back to the strokes' distances. See lobe_surface.h.
+#include "meshing/lobe_surface.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <unordered_map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <glm/geometric.hpp>
+
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wconversion"
+#pragma GCC diagnostic ignored "-Wshadow"
+#pragma GCC diagnostic ignored "-Wsign-conversion"
+#pragma GCC diagnostic ignored "-Wunused-parameter"
+#pragma GCC diagnostic ignored "-Wpedantic"
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#pragma GCC diagnostic ignored "-Wdeprecated-copy"
+#include <CGAL/Constrained_Delaunay_triangulation_2.h>
+#include <CGAL/Constrained_triangulation_face_base_2.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Triangulation_face_base_with_info_2.h>
+#include <CGAL/Triangulation_vertex_base_with_info_2.h>
+#include <Eigen/Dense>
+#include <Eigen/Sparse>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseLU>
+#pragma GCC diagnostic pop
+
+#include "core/errors.h"
+#include "meshing/polyline.h"
+#include "meshing/stitch.h"
+
+namespace lobe {
+
+namespace {
+
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+struct VertexInfo {
+    int id = -1; ///< index into the node table; -1: created by CGAL at a residual crossing
+};
+using Vb = CGAL::Triangulation_vertex_base_with_info_2<VertexInfo, K>;
+using Fb0 = CGAL::Constrained_triangulation_face_base_2<K>;
+using Fb = CGAL::Triangulation_face_base_with_info_2<int, K, Fb0>; // region id
+using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
+using CDT = CGAL::Constrained_Delaunay_triangulation_2<K, Tds, CGAL::Exact_predicates_tag>;
+using VH = CDT::Vertex_handle;
+using FH = CDT::Face_handle;
+using Index = std::size_t;
+
+/// Stereographic projection from `pole` onto the plane through the centre normal to it:
+/// circles map to circles, so the planar constrained Delaunay triangulation is the
+/// spherical one.
+struct Stereo {
+    glm::dvec3 pole, e1, e2;
+
+    explicit Stereo(const glm::dvec3& n) : pole(n)
+    {
+        const glm::dvec3 a = std::abs(n.x) < 0.6 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
+        e1 = glm::normalize(glm::cross(n, a));
+        e2 = glm::cross(n, e1);
+    }
+    glm::dvec2 to_plane(const glm::dvec3& d) const
+    {
+        const double w = 1.0 - glm::dot(d, pole);
+        return {glm::dot(d, e1) / w, glm::dot(d, e2) / w};
+    }
+    glm::dvec3 to_sphere(const glm::dvec2& x) const
+    {
+        const double s = glm::dot(x, x);
+        return (2.0 * x.x * e1 + 2.0 * x.y * e2 + (s - 1.0) * pole) / (s + 1.0);
+    }
+};
+
+/// A vertex of the surface before lifting.
+struct Node {
+    glm::dvec3 dir{0.0};  ///< unit direction from the centre
+    double radius = 0.0;  ///< distance from the centre (interpolated for Fill)
+    LobeVertexOrigin origin;
+};
+
+/// A crossing of segment `seg` of stroke `a` (at parameter `s`) with segment `other_seg`
+/// of stroke `b` (at `t`).
+struct Crossing {
+    int a, seg, b, other_seg;
+    double s, t;
+    int node = -1;
+};
+
+double cross2(const glm::dvec2& u, const glm::dvec2& v) { return u.x * v.y - u.y * v.x; }
+
+/// Proper intersection of segments p0p1 and q0q1 (end points shared or touching count as
+/// none: adjacent segments meet there by construction).
+bool segment_crossing(const glm::dvec2& p0, const glm::dvec2& p1, const glm::dvec2& q0, const glm::dvec2& q1,
+                      double& s, double& t)
+{
+    const glm::dvec2 r = p1 - p0, q = q1 - q0;
+    const double den = cross2(r, q);
+    if (std::abs(den) < 1e-300) return false;
+    const glm::dvec2 w = q0 - p0;
+    s = cross2(w, q) / den;
+    t = cross2(w, r) / den;
+    const double eps = 1e-12;
+    return s > eps && s < 1.0 - eps && t > eps && t < 1.0 - eps;
+}
+
+/// Angular radius of the circle through three unit directions.
+double circumradius_angle(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c)
+{
+    glm::dvec3 n = glm::cross(b - a, c - a);
+    const double len = glm::length(n);
+    if (!(len > 1e-300)) return M_PI;
+    n /= len;
+    return std::acos(std::clamp(std::abs(glm::dot(n, a)), -1.0, 1.0));
+}
+
+double angle_between(const glm::dvec3& a, const glm::dvec3& b)
+{
+    return 2.0 * std::asin(std::min(1.0, 0.5 * glm::length(a - b)));
+}
+
+bool solver_ok(const Eigen::VectorXd& x)
+{
+    return x.allFinite();
+}
+
+double orient3(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c)
+{
+    return glm::dot(a, glm::cross(b, c));
+}
+
+/// Segments of all strokes binned in a uniform grid over the plane, so crossings are
+/// found in time about linear in the number of segments.
+class SegmentGrid {
+public:
+    struct Seg {
+        int stroke, index;
+        glm::dvec2 p0, p1;
+    };
+
+    SegmentGrid(std::vector<Seg> segs) : segs_(std::move(segs))
+    {
+        lo_ = glm::dvec2(std::numeric_limits<double>::max());
+        glm::dvec2 hi(-std::numeric_limits<double>::max());
+        std::vector<double> lengths;
+        lengths.reserve(segs_.size());
+        for (const Seg& s : segs_) {
+            lo_ = glm::min(lo_, glm::min(s.p0, s.p1));
+            hi = glm::max(hi, glm::max(s.p0, s.p1));
+            lengths.push_back(glm::distance(s.p0, s.p1));
+        }
+        std::nth_element(lengths.begin(), lengths.begin() + static_cast<long>(lengths.size() / 2), lengths.end());
+        const glm::dvec2 extent = hi - lo_;
+        const double cap = std::max(extent.x, extent.y) / 512.0;
+        cell_ = std::max({lengths[lengths.size() / 2] * 2.0, cap, 1e-12});
+        nx_ = static_cast<int>(extent.x / cell_) + 1;
+        ny_ = static_cast<int>(extent.y / cell_) + 1;
+        cells_.assign(static_cast<Index>(nx_) * static_cast<Index>(ny_), {});
+        for (int i = 0; i < static_cast<int>(segs_.size()); ++i) {
+            const Seg& s = segs_[static_cast<Index>(i)];
+            const auto [x0, y0] = cell_of(glm::min(s.p0, s.p1));
+            const auto [x1, y1] = cell_of(glm::max(s.p0, s.p1));
+            for (int y = y0; y <= y1; ++y)
+                for (int x = x0; x <= x1; ++x) cells_[static_cast<Index>(y * nx_ + x)].push_back(i);
+        }
+    }
+
+    /// Calls f(seg_i, seg_j) once for each pair of segments whose boxes share a cell.
+    template <typename F>
+    void for_each_candidate(F&& f) const
+    {
+        std::vector<std::pair<int, int>> pairs;
+        for (const auto& cell : cells_)
+            for (Index i = 0; i < cell.size(); ++i)
+                for (Index j = i + 1; j < cell.size(); ++j)
+                    pairs.emplace_back(std::min(cell[i], cell[j]), std::max(cell[i], cell[j]));
+        std::sort(pairs.begin(), pairs.end());
+        pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+        for (const auto& [i, j] : pairs) f(segs_[static_cast<Index>(i)], segs_[static_cast<Index>(j)]);
+    }
+
+private:
+    std::pair<int, int> cell_of(const glm::dvec2& p) const
+    {
+        const int x = std::clamp(static_cast<int>((p.x - lo_.x) / cell_), 0, nx_ - 1);
+        const int y = std::clamp(static_cast<int>((p.y - lo_.y) / cell_), 0, ny_ - 1);
+        return {x, y};
+    }
+    std::vector<Seg> segs_;
+    glm::dvec2 lo_;
+    double cell_ = 1;
+    int nx_ = 1, ny_ = 1;
+    std::vector<std::vector<int>> cells_;
+};
+
+/// Everything one build needs.
+class Builder {
+public:
+    Builder(const std::vector<LobeStrokeSamples>& strokes, const glm::dvec3& centre, const LobeSurfaceOptions& options)
+        : strokes_(strokes), centre_(centre), options_(options)
+    {
+    }
+
+    LobeSurface run();
+
+private:
+    std::string stroke_name(int s) const
+    {
+        return "lobe stroke " + std::to_string(strokes_[static_cast<Index>(s)].id);
+    }
+    void make_directions();
+    void choose_pole();
+    void find_crossings();
+    void build_chains();
+    void triangulate();
+    void mark_regions();
+    void find_paper_regions();
+    void refine();
+    void seed_fill(double max_edge, int& added);
+    void emit(LobeSurface& out);
+    void solve_fill_radii(const std::vector<std::array<int, 3>>& triangles);
+    bool fit_radius_model(const std::vector<std::vector<int>>& adj, std::vector<double>& model) const;
+
+    int add_node(const Node& n)
+    {
+        nodes_.push_back(n);
+        return static_cast<int>(nodes_.size()) - 1;
+    }
+    VH insert_node(int id, VH hint);
+
+    const std::vector<LobeStrokeSamples>& strokes_;
+    glm::dvec3 centre_;
+    LobeSurfaceOptions options_;
+
+    std::vector<std::vector<glm::dvec3>> dirs_;    ///< per stroke, per sample
+    std::vector<std::vector<double>> radii_;       ///< per stroke, per sample
+    std::vector<std::vector<glm::dvec2>> plane_;   ///< per stroke, per sample
+    std::vector<double> spacing_;                  ///< per stroke: median 3D spacing
+    double mean_radius_ = 0;
+    double empty_angle_ = 0;                       ///< angular radius of the empty cap at the pole
+    Stereo stereo_{glm::dvec3(0, 0, 1)};
+
+    std::vector<Crossing> crossings_;
+    std::vector<int> crossing_count_;              ///< per stroke
+    std::vector<Node> nodes_;
+    std::vector<std::vector<int>> chains_;         ///< per stroke: node ids in order
+    std::vector<int> sample_node_;                 ///< flattened (stroke, sample) → node, or -1
+    std::vector<Index> sample_offset_;
+
+    CDT cdt_;
+    std::vector<VH> node_vertex_;                  ///< node → CDT vertex (several nodes may share one)
+    std::vector<char> paper_region_;               ///< per region: stitched with stitch_closed_closed
+    std::vector<std::pair<int, int>> region_strokes_;
+    int region_count_ = 0;
+    int pole_node_ = -1;
+    double max_piece_angle_ = 3.0 * M_PI / 180.0;
+    double ring_angle_ = 0;
+};
+
+void Builder::make_directions()
+{
+    const Index n = strokes_.size();
+    dirs_.resize(n);
+    radii_.resize(n);
+    spacing_.resize(n);
+    double sum_r = 0;
+    std::size_t count = 0;
+    double largest = 0;
+    for (Index s = 0; s < n; ++s) {
+        const auto pts = to_double(strokes_[s].points);
+        spacing_[s] = median_spacing(pts, strokes_[s].closed);
+        for (const glm::dvec3& p : pts) largest = std::max(largest, glm::length(p - centre_));
+    }
+    const double too_close = std::max(1e-4, 1e-3 * largest);
+    for (Index s = 0; s < n; ++s) {
+        for (const glm::vec3& pf : strokes_[s].points) {
+            const glm::dvec3 v = glm::dvec3(pf) - centre_;
+            const double r = glm::length(v);
+            if (!(r > too_close))
+                throw InvalidInput(stroke_name(static_cast<int>(s)) + " passes through the lobe's centre");
+            dirs_[s].push_back(v / r);
+            radii_[s].push_back(r);
+            sum_r += r;
+            ++count;
+        }
+    }
+    mean_radius_ = sum_r / static_cast<double>(count);
+    // Seen from the centre, consecutive samples of a stroke drawn around the lobe are close;
+    // a segment spanning more than 90° cuts through the lobe's inside.
+    for (Index s = 0; s < n; ++s) {
+        const auto& d = dirs_[s];
+        const Index m = d.size();
+        for (Index i = 0; i + (strokes_[s].closed ? 0 : 1) < m; ++i)
+            if (angle_between(d[i], d[(i + 1) % m]) > M_PI / 2.0)
+                throw InvalidInput(stroke_name(static_cast<int>(s)) + " cuts through the lobe's inside, near its centre");
+    }
+}
+
+void Builder::choose_pole()
+{
+    // The direction farthest from every sample: a Fibonacci lattice of candidates, then a
+    // few rounds of pushing the best one away from its nearest sample.
+    constexpr int kCandidates = 512;
+    const double golden = M_PI * (3.0 - std::sqrt(5.0));
+    double best_dot = 2.0;
+    glm::dvec3 best(0, 0, 1);
+    auto max_dot = [&](const glm::dvec3& d, glm::dvec3* nearest) {
+        double m = -2.0;
+        for (const auto& stroke : dirs_)
+            for (const glm::dvec3& u : stroke) {
+                const double c = glm::dot(u, d);
+                if (c > m) {
+                    m = c;
+                    if (nearest) *nearest = u;
+                }
+            }
+        return m;
+    };
+    for (int i = 0; i < kCandidates; ++i) {
+        const double z = 1.0 - (2.0 * i + 1.0) / kCandidates;
+        const double rr = std::sqrt(std::max(0.0, 1.0 - z * z));
+        const glm::dvec3 d(rr * std::cos(golden * i), rr * std::sin(golden * i), z);
+        const double m = max_dot(d, nullptr);
+        if (m < best_dot) {
+            best_dot = m;
+            best = d;
+        }
+    }
+    double step = 0.1;
+    for (int it = 0; it < 40; ++it) {
+        glm::dvec3 nearest(0.0);
+        max_dot(best, &nearest);
+        const glm::dvec3 trial = glm::normalize(best - step * (nearest - glm::dot(nearest, best) * best));
+        const double m = max_dot(trial, nullptr);
+        if (m < best_dot) {
+            best_dot = m;
+            best = trial;
+        } else {
+            step *= 0.5;
+        }
+    }
+    empty_angle_ = std::acos(std::clamp(best_dot, -1.0, 1.0));
+    if (empty_angle_ < 3.0 * M_PI / 180.0)
+        throw InvalidInput("the lobe's strokes leave no open direction around its centre (they cover it densely)");
+    stereo_ = Stereo(best);
+    plane_.resize(strokes_.size());
+    for (Index s = 0; s < strokes_.size(); ++s)
+        for (const glm::dvec3& d : dirs_[s]) plane_[s].push_back(stereo_.to_plane(d));
+}
+
+void Builder::find_crossings()
+{
+    std::vector<SegmentGrid::Seg> segs;
+    for (Index s = 0; s < strokes_.size(); ++s) {
+        const Index n = plane_[s].size();
+        const Index count = strokes_[s].closed ? n : n - 1;
+        for (Index i = 0; i < count; ++i)
+            segs.push_back({static_cast<int>(s), static_cast<int>(i), plane_[s][i], plane_[s][(i + 1) % n]});
+    }
+    SegmentGrid grid(std::move(segs));
+    crossing_count_.assign(strokes_.size(), 0);
+    std::vector<std::vector<int>> pair_count(strokes_.size(), std::vector<int>(strokes_.size(), 0));
+    grid.for_each_candidate([&](const SegmentGrid::Seg& a, const SegmentGrid::Seg& b) {
+        double s = 0, t = 0;
+        if (!segment_crossing(a.p0, a.p1, b.p0, b.p1, s, t)) return;
+        if (a.stroke == b.stroke)
+            throw InvalidInput(stroke_name(a.stroke) + " folds back over itself as seen from the lobe's centre");
+        crossings_.push_back({a.stroke, a.index, b.stroke, b.index, s, t});
+        ++crossing_count_[static_cast<Index>(a.stroke)];
+        ++crossing_count_[static_cast<Index>(b.stroke)];
+        ++pair_count[static_cast<Index>(a.stroke)][static_cast<Index>(b.stroke)];
+    });
+    // Two strokes that retrace each other cross again and again.
+    for (Index a = 0; a < strokes_.size(); ++a)
+        for (Index b = 0; b < strokes_.size(); ++b) {
+            const std::size_t c = static_cast<std::size_t>(pair_count[a][b] + (a < b ? pair_count[b][a] : 0));
+            if (a < b && c > std::max<std::size_t>(16, std::min(plane_[a].size(), plane_[b].size()) / 2))
+                throw InvalidInput(stroke_name(static_cast<int>(b)) + " runs along " + stroke_name(static_cast<int>(a)) +
+                                   " as seen from the lobe's centre (they cross " + std::to_string(c) +
+                                   " times; is one inside the lobe?)");
+        }
+    if (crossings_.size() > 100000) throw InvalidInput("the lobe's strokes cross each other too often to mesh");
+    std::sort(crossings_.begin(), crossings_.end(), [](const Crossing& x, const Crossing& y) {
+        return std::tie(x.a, x.seg, x.s, x.b, x.other_seg) < std::tie(y.a, y.seg, y.s, y.b, y.other_seg);
+    });
+}
+
+void Builder::build_chains()
+{
+    // Nodes: every sample, then every crossing.
+    sample_offset_.assign(strokes_.size() + 1, 0);
+    for (Index s = 0; s < strokes_.size(); ++s) sample_offset_[s + 1] = sample_offset_[s] + strokes_[s].points.size();
+    sample_node_.assign(sample_offset_.back(), -1);
+    for (Index s = 0; s < strokes_.size(); ++s)
+        for (Index i = 0; i < dirs_[s].size(); ++i) {
+            Node n;
+            n.dir = dirs_[s][i];
+            n.radius = radii_[s][i];
+            n.origin = {LobeVertexKind::Sample, static_cast<int>(s), static_cast<int>(i), -1};
+            sample_node_[sample_offset_[s] + i] = add_node(n);
+        }
+    // Per stroke: (segment, parameter, node) of every crossing on it.
+    struct OnStroke {
+        int seg;
+        double t;
+        int node;
+    };
+    std::vector<std::vector<OnStroke>> on(strokes_.size());
+    for (Crossing& c : crossings_) {
+        const Index a = static_cast<Index>(c.a), b = static_cast<Index>(c.b);
+        auto lerp3 = [&](Index s, int seg, double t) {
+            const auto& pts = strokes_[s].points;
+            const glm::dvec3 p0(pts[static_cast<Index>(seg)]);
+            const glm::dvec3 p1(pts[(static_cast<Index>(seg) + 1) % pts.size()]);
+            return p0 + t * (p1 - p0);
+        };
+        const glm::dvec2 x = plane_[a][static_cast<Index>(c.seg)] +
+                             c.s * (plane_[a][(static_cast<Index>(c.seg) + 1) % plane_[a].size()] -
+                                    plane_[a][static_cast<Index>(c.seg)]);
+        Node n;
+        n.dir = glm::normalize(stereo_.to_sphere(x));
+        const glm::dvec3 mid = 0.5 * (lerp3(a, c.seg, c.s) + lerp3(b, c.other_seg, c.t));
+        n.radius = glm::length(mid - centre_);
+        n.origin = {LobeVertexKind::Crossing, c.a, -1, c.b};
+        c.node = add_node(n);
+        on[a].push_back({c.seg, c.s, c.node});
+        on[b].push_back({c.other_seg, c.t, c.node});
+    }
+    chains_.assign(strokes_.size(), {});
+    for (Index s = 0; s < strokes_.size(); ++s) {
+        auto& list = on[s];
+        std::sort(list.begin(), list.end(), [](const OnStroke& x, const OnStroke& y) {
+            return std::tie(x.seg, x.t) < std::tie(y.seg, y.t);
+        });
+        const auto& pts = strokes_[s].points;
+        const Index n = pts.size();
+        const bool closed = strokes_[s].closed;
+        // Drop samples too close to a crossing on the same stroke (never an open stroke's ends).
+        const double merge = options_.crossing_merge_fraction * spacing_[s];
+        std::vector<char> keep(n, 1);
+        for (const OnStroke& c : list) {
+            const glm::dvec3 x = glm::dvec3(nodes_[static_cast<Index>(c.node)].dir) *
+                                     nodes_[static_cast<Index>(c.node)].radius + centre_;
+            for (Index k : {static_cast<Index>(c.seg), (static_cast<Index>(c.seg) + 1) % n}) {
+                if (!closed && (k == 0 || k + 1 == n)) continue;
+                if (glm::distance(glm::dvec3(pts[k]), x) < merge) keep[k] = 0;
+            }
+        }
+        std::vector<int> chain;
+        Index next = 0;
+        for (Index i = 0; i < n; ++i) {
+            if (keep[i]) chain.push_back(sample_node_[sample_offset_[s] + i]);
+            while (next < list.size() && static_cast<Index>(list[next].seg) == i) chain.push_back(list[next++].node);
+        }
+        if (chain.size() < (closed ? 3u : 2u))
+            throw InvalidInput(stroke_name(static_cast<int>(s)) + " is crossed too densely by other strokes to mesh");
+        // Long segments are subdivided along the straight 3D segment, so that seen from the
+        // centre every piece is short and the planar constraint follows the great arc.
+        std::vector<int> fine;
+        const Index m = chain.size();
+        for (Index i = 0; i < m; ++i) {
+            fine.push_back(chain[i]);
+            if (!closed && i + 1 == m) break;
+            const Node a = nodes_[static_cast<Index>(chain[i])];
+            const Node b = nodes_[static_cast<Index>(chain[(i + 1) % m])];
+            const int pieces = static_cast<int>(std::ceil(angle_between(a.dir, b.dir) / max_piece_angle_));
+            const glm::dvec3 pa = centre_ + a.radius * a.dir, pb = centre_ + b.radius * b.dir;
+            for (int k = 1; k < pieces; ++k) {
+                const glm::dvec3 p = pa + (pb - pa) * (static_cast<double>(k) / pieces);
+                Node piece;
+                piece.radius = glm::length(p - centre_);
+                piece.dir = (p - centre_) / piece.radius;
+                piece.origin = {LobeVertexKind::Segment, static_cast<int>(s), a.origin.sample, -1};
+                fine.push_back(add_node(piece));
+            }
+        }
+        chains_[s] = std::move(fine);
+    }
+}
+
+VH Builder::insert_node(int id, VH hint)
+{
+    const glm::dvec2 x = stereo_.to_plane(nodes_[static_cast<Index>(id)].dir);
+    const K::Point_2 p(x.x, x.y);
+    VH v = hint == VH() ? cdt_.insert(p) : cdt_.insert(p, hint->face());
+    if (v->info().id < 0) v->info().id = id;
+    return v;
+}
+
+void Builder::triangulate()
+{
+    node_vertex_.assign(nodes_.size(), VH());
+    VH hint;
+    for (Index s = 0; s < chains_.size(); ++s)
+        for (int id : chains_[s]) hint = node_vertex_[static_cast<Index>(id)] = insert_node(id, hint);
+    // A small ring around the pole closes the planar triangulation's outside: the ring
+    // encloses every stroke point, and the pole vertex fans the ring.
+    const double ring_angle = ring_angle_ = std::min(empty_angle_ * 0.5, 2.0 * M_PI / 180.0);
+    for (int k = 0; k < 6; ++k) {
+        const double a = k * M_PI / 3.0;
+        const glm::dvec3 d = std::cos(ring_angle) * stereo_.pole +
+                             std::sin(ring_angle) * (std::cos(a) * stereo_.e1 + std::sin(a) * stereo_.e2);
+        Node n;
+        n.dir = d;
+        const int id = add_node(n);
+        node_vertex_.push_back(VH());
+        node_vertex_[static_cast<Index>(id)] = insert_node(id, hint);
+    }
+    for (Index s = 0; s < chains_.size(); ++s) {
+        const auto& chain = chains_[s];
+        const Index n = chain.size();
+        const Index count = strokes_[s].closed ? n : n - 1;
+        for (Index i = 0; i < count; ++i) {
+            const VH a = node_vertex_[static_cast<Index>(chain[i])];
+            const VH b = node_vertex_[static_cast<Index>(chain[(i + 1) % n])];
+            if (a != b) cdt_.insert_constraint(a, b);
+        }
+    }
+    Node pole;
+    pole.dir = stereo_.pole;
+    pole_node_ = add_node(pole);
+    node_vertex_.push_back(VH());
+}
+
+void Builder::mark_regions()
+{
+    for (FH f : cdt_.all_face_handles()) f->info() = -1;
+    region_count_ = 0;
+    std::vector<FH> stack;
+    for (FH f : cdt_.finite_face_handles()) {
+        if (f->info() >= 0) continue;
+        f->info() = region_count_;
+        stack.push_back(f);
+        while (!stack.empty()) {
+            FH g = stack.back();
+            stack.pop_back();
+            for (int i = 0; i < 3; ++i) {
+                FH h = g->neighbor(i);
+                if (cdt_.is_infinite(h) || h->info() >= 0 || cdt_.is_constrained(CDT::Edge(g, i))) continue;
+                h->info() = region_count_;
+                stack.push_back(h);
+            }
+        }
+        ++region_count_;
+    }
+}
+
+void Builder::find_paper_regions()
+{
+    paper_region_.assign(static_cast<Index>(region_count_), 0);
+    region_strokes_.assign(static_cast<Index>(region_count_), {-1, -1});
+    if (!options_.paper_strips) return;
+    std::vector<char> bad(static_cast<Index>(region_count_), 0);
+    auto stroke_of = [&](VH v) -> int {
+        const int id = v->info().id;
+        if (id < 0) return -1;
+        const auto& o = nodes_[static_cast<Index>(id)].origin;
+        return o.kind == LobeVertexKind::Sample || o.kind == LobeVertexKind::Segment ? o.stroke : -1;
+    };
+    std::vector<std::array<int, 2>> edge_counts(static_cast<Index>(region_count_), {0, 0});
+    for (FH f : cdt_.finite_face_handles()) {
+        const Index r = static_cast<Index>(f->info());
+        auto& rs = region_strokes_[r];
+        for (int i = 0; i < 3; ++i) {
+            const int s = stroke_of(f->vertex(i));
+            if (s < 0 || crossing_count_[static_cast<Index>(s)] > 0 || !strokes_[static_cast<Index>(s)].closed) {
+                bad[r] = 1;
+                continue;
+            }
+            if (rs.first < 0 || rs.first == s) rs.first = s;
+            else if (rs.second < 0 || rs.second == s) rs.second = s;
+            else bad[r] = 1;
+            if (cdt_.is_infinite(f->neighbor(i))) bad[r] = 1;
+        }
+        for (int i = 0; i < 3; ++i) {
+            if (!cdt_.is_constrained(CDT::Edge(f, i))) continue;
+            const int s = stroke_of(f->vertex((i + 1) % 3));
+            if (s == rs.first) ++edge_counts[r][0];
+            else if (s == rs.second) ++edge_counts[r][1];
+        }
+    }
+    for (Index r = 0; r < static_cast<Index>(region_count_); ++r) {
+        const auto [a, b] = region_strokes_[r];
+        if (bad[r] || a < 0 || b < 0) continue;
+        // The region is the whole annulus between the two loops: all their edges bound it.
+        if (edge_counts[r][0] != static_cast<int>(chains_[static_cast<Index>(a)].size()) ||
+            edge_counts[r][1] != static_cast<int>(chains_[static_cast<Index>(b)].size()))
+            continue;
+        paper_region_[r] = 1;
+    }
+}
+
+void Builder::seed_fill(double max_edge, int& added)
+{
+    // Fill vertices on a Fibonacci lattice of directions about as dense as the largest
+    // allowed triangle, except near strokes and near the pole: uniform, deterministic, and
+    // a new stroke only removes the lattice points near it.
+    const double spacing = 0.85 * max_edge;
+    const double clearance = 0.5 * spacing;
+    const double cell = clearance;
+    std::unordered_map<std::int64_t, std::vector<glm::dvec3>> grid;
+    auto key = [&](const glm::dvec3& d, int dx, int dy, int dz) {
+        const std::int64_t x = static_cast<std::int64_t>(std::floor(d.x / cell)) + dx + (1 << 20);
+        const std::int64_t y = static_cast<std::int64_t>(std::floor(d.y / cell)) + dy + (1 << 20);
+        const std::int64_t z = static_cast<std::int64_t>(std::floor(d.z / cell)) + dz + (1 << 20);
+        return (x << 42) | (y << 21) | z;
+    };
+    auto add = [&](const glm::dvec3& d) { grid[key(d, 0, 0, 0)].push_back(d); };
+    for (Index s = 0; s < chains_.size(); ++s) {
+        const auto& chain = chains_[s];
+        const Index n = chain.size();
+        const Index count = strokes_[s].closed ? n : n - 1;
+        add(nodes_[static_cast<Index>(chain[0])].dir);
+        for (Index i = 0; i < count; ++i) {
+            const glm::dvec3 a = nodes_[static_cast<Index>(chain[i])].dir;
+            const glm::dvec3 b = nodes_[static_cast<Index>(chain[(i + 1) % n])].dir;
+            const int steps = std::max(1, static_cast<int>(std::ceil(angle_between(a, b) / (0.25 * clearance))));
+            for (int k = 1; k <= steps; ++k) add(glm::normalize(a + (b - a) * (static_cast<double>(k) / steps)));
+        }
+    }
+    const double cos_clear = std::cos(clearance);
+    const double ring_keep = std::cos(ring_angle_ + clearance);
+    const int count = static_cast<int>(std::ceil(4.0 * M_PI / (spacing * spacing * 0.866)));
+    const double golden = M_PI * (3.0 - std::sqrt(5.0));
+    std::vector<glm::dvec3> candidates;
+    FH hint_face;
+    for (int i = 0; i < count; ++i) {
+        const double z = 1.0 - (2.0 * i + 1.0) / count;
+        const double rr = std::sqrt(std::max(0.0, 1.0 - z * z));
+        const glm::dvec3 d(rr * std::cos(golden * i), rr * std::sin(golden * i), z);
+        if (glm::dot(d, stereo_.pole) > ring_keep) continue;
+        bool near = false;
+        for (int dx = -1; dx <= 1 && !near; ++dx)
+            for (int dy = -1; dy <= 1 && !near; ++dy)
+                for (int dz = -1; dz <= 1 && !near; ++dz) {
+                    auto it = grid.find(key(d, dx, dy, dz));
+                    if (it == grid.end()) continue;
+                    for (const glm::dvec3& u : it->second)
+                        if (glm::dot(u, d) > cos_clear) {
+                            near = true;
+                            break;
+                        }
+                }
+        if (near) continue;
+        // Located before any fill vertex goes in (faces made by insertion carry no region).
+        const glm::dvec2 x = stereo_.to_plane(d);
+        const K::Point_2 p(x.x, x.y);
+        hint_face = cdt_.locate(p, hint_face);
+        if (hint_face != FH() && !cdt_.is_infinite(hint_face) && hint_face->info() >= 0 &&
+            static_cast<Index>(hint_face->info()) < paper_region_.size() && paper_region_[static_cast<Index>(hint_face->info())])
+            continue;
+        candidates.push_back(d);
+    }
+    VH hint;
+    for (const glm::dvec3& d : candidates) {
+        if (added >= options_.max_fill_vertices) break;
+        Node n;
+        n.dir = d;
+        const int id = add_node(n);
+        node_vertex_.push_back(VH());
+        const glm::dvec2 x = stereo_.to_plane(d);
+        VH v = cdt_.insert(K::Point_2(x.x, x.y), hint == VH() ? FH() : hint->face());
+        if (v->info().id < 0) v->info().id = id;
+        node_vertex_[static_cast<Index>(id)] = v;
+        hint = v;
+        ++added;
+    }
+}
+
+void Builder::refine()
+{
+    const double r = std::max(options_.reference_radius_m > 0 ? options_.reference_radius_m : mean_radius_, 1e-6);
+    const double by_sagitta = std::acos(std::clamp(1.0 - options_.fill_sagitta_m / r, -1.0, 1.0));
+    const double by_edge = options_.fill_edge_m / r;
+    const double max_angle = std::max(1e-3, std::min(by_sagitta, by_edge));
+    const double max_edge = std::sqrt(3.0) * max_angle;
+    int added = 0;
+    auto dir_of = [&](VH v) {
+        const int id = v->info().id;
+        if (id >= 0) return nodes_[static_cast<Index>(id)].dir;
+        return glm::normalize(stereo_.to_sphere({v->point().x(), v->point().y()}));
+    };
+    mark_regions();
+    find_paper_regions();
+    seed_fill(max_edge, added);
+    for (int pass = 0; pass < 8; ++pass) {
+        mark_regions();
+        find_paper_regions();
+        std::vector<glm::dvec2> points;
+        for (FH f : cdt_.finite_face_handles()) {
+            const int region = f->info();
+            if (paper_region_[static_cast<Index>(region)]) continue;
+            const glm::dvec3 a = dir_of(f->vertex(0)), b = dir_of(f->vertex(1)), c = dir_of(f->vertex(2));
+            // Too large: a free side longer than that of an equilateral triangle with the
+            // largest circumradius allowed.
+            // Stroke segments are never split here (remeshing splits them), so only free sides count.
+            const std::array<glm::dvec3, 3> d{a, b, c};
+            double longest = 0;
+            for (int i = 0; i < 3; ++i)
+                if (!cdt_.is_constrained(CDT::Edge(f, i)))
+                    longest = std::max(longest, angle_between(d[static_cast<Index>((i + 1) % 3)], d[static_cast<Index>((i + 2) % 3)]));
+            if (longest <= max_edge) continue;
+            // The circumcentre (Delaunay refinement) when the triangle is not a sliver and its
+            // circumcentre lies in the same region, else the centroid, which is inside the
+            // triangle: no stroke is crossed either way.
+            const double radius = circumradius_angle(a, b, c);
+            bool use_cc = radius < longest;
+            K::Point_2 cc;
+            if (use_cc) {
+                cc = CGAL::circumcenter(f->vertex(0)->point(), f->vertex(1)->point(), f->vertex(2)->point());
+                CDT::Locate_type lt;
+                int li = 0;
+                FH located = cdt_.locate(cc, lt, li, f);
+                use_cc = lt == CDT::FACE && !cdt_.is_infinite(located) && located->info() == region;
+            }
+            if (use_cc) {
+                points.emplace_back(cc.x(), cc.y());
+            } else {
+                glm::dvec2 x(0.0);
+                for (int i = 0; i < 3; ++i) x += glm::dvec2(f->vertex(i)->point().x(), f->vertex(i)->point().y());
+                points.push_back(x / 3.0);
+            }
+        }
+        if (points.empty()) break;
+        VH hint;
+        for (const glm::dvec2& x : points) {
+            if (added >= options_.max_fill_vertices) break;
+            Node n;
+            n.dir = glm::normalize(stereo_.to_sphere(x));
+            const int id = add_node(n);
+            node_vertex_.push_back(VH());
+            const K::Point_2 p(x.x, x.y);
+            VH v = hint == VH() ? cdt_.insert(p) : cdt_.insert(p, hint->face());
+            if (v->info().id < 0) v->info().id = id;
+            node_vertex_[static_cast<Index>(id)] = v;
+            hint = v;
+            ++added;
+        }
+        if (added >= options_.max_fill_vertices) break;
+    }
+    // Paper regions may have been renumbered: find them again on the final triangulation.
+    mark_regions();
+    find_paper_regions();
+}
+
+void Builder::solve_fill_radii(const std::vector<std::array<int, 3>>& triangles)
+{
+    // Fill vertices (and vertices CGAL made at residual crossings) get the radius of a smooth
+    // model of the whole lobe plus the harmonic interpolation of the strokes' residuals:
+    // - the model is a least-squares fit of the radius over the sphere of directions by
+    //   polynomials of degree ≤ 3 in the direction (the span of spherical harmonics up to
+    //   degree 3), penalised by degree so it stays smooth where no stroke is: an ellipsoid
+    //   or an off-centre sphere is nearly exact, so an automatic cap rounds off as the
+    //   strokes around it suggest;
+    // - the residuals (stroke radius − model) are interpolated harmonically (uniform
+    //   weights), so the surface passes through every stroke and stays within their range.
+    // When the model is implausible (it leaves 0.5–1.5 times the strokes' radii), the
+    // radius itself is interpolated harmonically.
+    const Index n = nodes_.size();
+    std::vector<int> unknown(n, -1);
+    int count = 0;
+    for (Index i = 0; i < n; ++i)
+        if (nodes_[i].origin.kind == LobeVertexKind::Fill) unknown[i] = count++;
+    if (count == 0) return;
+    std::vector<std::vector<int>> adj(n);
+    for (const auto& t : triangles)
+        for (int k = 0; k < 3; ++k) {
+            adj[static_cast<Index>(t[static_cast<Index>(k)])].push_back(t[static_cast<Index>((k + 1) % 3)]);
+            adj[static_cast<Index>(t[static_cast<Index>((k + 1) % 3)])].push_back(t[static_cast<Index>(k)]);
+        }
+    // Rows of L over the free columns (b: the fixed columns' part of each row), weighted by
+    // inverse angular edge length so long strip edges and short cap edges measure slope alike.
+    auto solve = [&](bool biharmonic, Eigen::VectorXd& x) {
+        std::vector<Eigen::Triplet<double>> entries;
+        std::vector<double> fixed_part;
+        int rows = 0;
+        for (Index i = 0; i < n; ++i) {
+            const auto& nb = adj[i];
+            if (nb.empty()) continue;
+            if (!biharmonic && unknown[i] < 0) continue;
+            bool touches_free = unknown[i] >= 0;
+            for (int j : nb) touches_free = touches_free || unknown[static_cast<Index>(j)] >= 0;
+            if (!touches_free) continue;
+            std::vector<double> w(nb.size());
+            double sum = 0;
+            for (Index k = 0; k < nb.size(); ++k) {
+                w[k] = 1.0 / std::max(1e-6, angle_between(nodes_[i].dir, nodes_[static_cast<Index>(nb[k])].dir));
+                sum += w[k];
+            }
+            double b = 0;
+            if (unknown[i] >= 0) entries.emplace_back(rows, unknown[i], 1.0);
+            else b += nodes_[i].radius;
+            for (Index k = 0; k < nb.size(); ++k) {
+                const int j = nb[k];
+                if (unknown[static_cast<Index>(j)] >= 0) entries.emplace_back(rows, unknown[static_cast<Index>(j)], -w[k] / sum);
+                else b -= w[k] / sum * nodes_[static_cast<Index>(j)].radius;
+            }
+            fixed_part.push_back(b);
+            ++rows;
+        }
+        Eigen::SparseMatrix<double> l(rows, count);
+        l.setFromTriplets(entries.begin(), entries.end());
+        const Eigen::Map<const Eigen::VectorXd> b(fixed_part.data(), rows);
+        if (biharmonic) {
+            const Eigen::SparseMatrix<double> m = l.transpose() * l;
+            Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(m);
+            if (solver.info() != Eigen::Success) return false;
+            x = solver.solve(-(l.transpose() * b));
+        } else {
+            Eigen::SparseLU<Eigen::SparseMatrix<double>> solver(l);
+            if (solver.info() != Eigen::Success) return false;
+            x = solver.solve(-b);
+        }
+        return solver_ok(x);
+    };
+    for (Index i = 0; i < n; ++i) {
+        auto& nb = adj[i];
+        std::sort(nb.begin(), nb.end());
+        nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
+    }
+    double lo = std::numeric_limits<double>::infinity(), hi = 0;
+    for (Index i = 0; i < n; ++i)
+        if (unknown[i] < 0 && !adj[i].empty()) {
+            lo = std::min(lo, nodes_[i].radius);
+            hi = std::max(hi, nodes_[i].radius);
+        }
+    std::vector<double> model(n, 0.0);
+    bool use_model = fit_radius_model(adj, model) ;
+    if (use_model)
+        for (Index i = 0; i < n; ++i)
+            if (unknown[i] >= 0 && !(model[i] >= 0.5 * lo && model[i] <= 1.5 * hi)) use_model = false;
+    if (!use_model) std::fill(model.begin(), model.end(), 0.0);
+    // Harmonic interpolation of the residuals (of the radii without a model).
+    std::vector<double> saved(n);
+    for (Index i = 0; i < n; ++i) {
+        saved[i] = nodes_[i].radius;
+        if (unknown[i] < 0) nodes_[i].radius -= model[i];
+    }
+    Eigen::VectorXd x;
+    const bool ok = solve(false, x);
+    for (Index i = 0; i < n; ++i) nodes_[i].radius = saved[i];
+    if (!ok) throw InvalidInput("the lobe's strokes leave a gap that cannot be closed around its centre");
+    for (Index i = 0; i < n; ++i)
+        if (unknown[i] >= 0) {
+            const double r = x[unknown[i]] + model[i];
+            if (!(r > 0.25 * lo)) throw InvalidInput("the lobe's strokes leave a gap too wide to close around its centre");
+            nodes_[i].radius = r;
+        }
+}
+
+bool Builder::fit_radius_model(const std::vector<std::vector<int>>& adj, std::vector<double>& model) const
+{
+    // Monomials x^a y^b z^c of the direction, a + b + c ≤ 3: 20 functions spanning the
+    // spherical harmonics up to degree 3 on the sphere.
+    struct Mono {
+        int a, b, c;
+    };
+    static const std::vector<Mono> monos = [] {
+        std::vector<Mono> m;
+        for (int d = 0; d <= 3; ++d)
+            for (int a = d; a >= 0; --a)
+                for (int b = d - a; b >= 0; --b) m.push_back({a, b, d - a - b});
+        return m;
+    }();
+    const Index k = monos.size();
+    auto basis = [&](const glm::dvec3& u, Eigen::VectorXd& out) {
+        const double px[4] = {1, u.x, u.x * u.x, u.x * u.x * u.x};
+        const double py[4] = {1, u.y, u.y * u.y, u.y * u.y * u.y};
+        const double pz[4] = {1, u.z, u.z * u.z, u.z * u.z * u.z};
+        for (Index j = 0; j < k; ++j) out[static_cast<Eigen::Index>(j)] = px[monos[j].a] * py[monos[j].b] * pz[monos[j].c];
+    };
+    Eigen::MatrixXd ata = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k));
+    Eigen::VectorXd atb = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(k));
+    Eigen::VectorXd phi(static_cast<Eigen::Index>(k));
+    double samples = 0;
+    for (Index i = 0; i < nodes_.size(); ++i) {
+        if (nodes_[i].origin.kind == LobeVertexKind::Fill || adj[i].empty()) continue;
+        basis(nodes_[i].dir, phi);
+        ata.noalias() += phi * phi.transpose();
+        atb.noalias() += phi * nodes_[i].radius;
+        samples += 1;
+    }
+    if (samples < static_cast<double>(k)) return false;
+    // Penalty growing with degree (d(d+1))², scaled to the number of samples.
+    for (Index j = 0; j < k; ++j) {
+        const int d = monos[j].a + monos[j].b + monos[j].c;
+        const double w = d == 0 ? 1e-6 : 1e-3 * static_cast<double>(d * (d + 1)) * static_cast<double>(d * (d + 1));
+        ata(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(j)) += w * samples;
+    }
+    const Eigen::VectorXd coef = ata.ldlt().solve(atb);
+    if (!coef.allFinite()) return false;
+    for (Index i = 0; i < nodes_.size(); ++i) {
+        if (adj[i].empty()) continue;
+        basis(nodes_[i].dir, phi);
+        model[i] = phi.dot(coef);
+    }
+    return true;
+}
+
+void Builder::emit(LobeSurface& out)
+{
+    // CGAL vertices without a node (residual crossings it split itself) become fill nodes.
+    for (auto v = cdt_.finite_vertices_begin(); v != cdt_.finite_vertices_end(); ++v) {
+        if (v->info().id >= 0) continue;
+        Node n;
+        n.dir = glm::normalize(stereo_.to_sphere({v->point().x(), v->point().y()}));
+        v->info().id = add_node(n);
+        node_vertex_.push_back(v);
+    }
+    auto node_of = [&](VH v) { return v->info().id; };
+    auto position = [&](int id) {
+        const Node& n = nodes_[static_cast<Index>(id)];
+        return centre_ + n.radius * n.dir;
+    };
+    auto valid = [&](const std::array<int, 3>& t) {
+        const glm::dvec3 p0 = position(t[0]), p1 = position(t[1]), p2 = position(t[2]);
+        return orient3(nodes_[static_cast<Index>(t[0])].dir, nodes_[static_cast<Index>(t[1])].dir,
+                       nodes_[static_cast<Index>(t[2])].dir) > 0.0 &&
+               glm::dot(glm::cross(p1 - p0, p2 - p0), (p0 + p1 + p2) / 3.0 - centre_) > 0.0;
+    };
+    // The paper's strips for the regions between two uncrossed loops; a strip that would
+    // fold seen from the centre leaves its region to the Delaunay triangles.
+    std::vector<std::array<int, 3>> tris; // node ids, outward
+    for (Index r = 0; r < paper_region_.size(); ++r) {
+        if (!paper_region_[r]) continue;
+        const auto [a, b] = region_strokes_[r];
+        std::vector<std::array<int, 3>> region;
+        try {
+            auto chain_points = [&](int stroke) {
+                std::vector<glm::vec3> pts;
+                for (int id : chains_[static_cast<Index>(stroke)]) pts.emplace_back(position(id));
+                return pts;
+            };
+            const StrokeStrip strip = stitch_closed_closed(chain_points(a), chain_points(b));
+            for (const auto& t : strip.triangles) {
+                std::array<int, 3> ids{};
+                for (int k = 0; k < 3; ++k) {
+                    const StripVertexSource src = strip.sources[static_cast<Index>(t[static_cast<Index>(k)])];
+                    const int s = src.stroke == 0 ? a : b;
+                    ids[static_cast<Index>(k)] = chains_[static_cast<Index>(s)][static_cast<Index>(src.sample)];
+                }
+                region.push_back(ids);
+            }
+        } catch (const InvalidInput&) {
+            region.clear();
+        }
+        if (!region.empty() && !valid(region.front()))
+            for (auto& u : region) std::swap(u[1], u[2]);
+        const bool ok = !region.empty() && std::all_of(region.begin(), region.end(), valid);
+        if (!ok) {
+            paper_region_[r] = 0;
+            continue;
+        }
+        out.paper_strip_triangles += region.size();
+        tris.insert(tris.end(), region.begin(), region.end());
+    }
+    for (FH f : cdt_.finite_face_handles()) {
+        if (paper_region_[static_cast<Index>(f->info())]) continue;
+        // Planar counter-clockwise is clockwise seen from outside the sphere.
+        tris.push_back({node_of(f->vertex(0)), node_of(f->vertex(2)), node_of(f->vertex(1))});
+    }
+    // The pole fans the ring (the triangulation's outer boundary).
+    for (FH f : cdt_.all_face_handles()) {
+        if (!cdt_.is_infinite(f)) continue;
+        const int i = f->index(cdt_.infinite_vertex());
+        std::array<int, 3> t{pole_node_, node_of(f->vertex((i + 1) % 3)), node_of(f->vertex((i + 2) % 3))};
+        if (orient3(nodes_[static_cast<Index>(t[0])].dir, nodes_[static_cast<Index>(t[1])].dir,
+                    nodes_[static_cast<Index>(t[2])].dir) < 0)
+            std::swap(t[1], t[2]);
+        tris.push_back(t);
+    }
+    solve_fill_radii(tris);
+
+    // Output: only nodes used by triangles, in node order (samples first, by stroke).
+    std::vector<int> out_index(nodes_.size(), -1);
+    for (const auto& t : tris)
+        for (int id : t) out_index[static_cast<Index>(id)] = 0;
+    for (Index i = 0; i < nodes_.size(); ++i) {
+        if (out_index[i] < 0) continue;
+        out_index[i] = static_cast<int>(out.mesh.positions.size());
+        const Node& n = nodes_[i];
+        const glm::dvec3 p = n.origin.kind == LobeVertexKind::Sample
+                                 ? glm::dvec3(strokes_[static_cast<Index>(n.origin.stroke)]
+                                                  .points[static_cast<Index>(n.origin.sample)])
+                                 : centre_ + n.radius * n.dir;
+        out.mesh.positions.emplace_back(p);
+        out.origins.push_back(n.origin);
+    }
+    for (const auto& t : tris) {
+        const glm::dvec3 d0 = nodes_[static_cast<Index>(t[0])].dir, d1 = nodes_[static_cast<Index>(t[1])].dir,
+                         d2 = nodes_[static_cast<Index>(t[2])].dir;
+        const std::array<int, 3> o{out_index[static_cast<Index>(t[0])], out_index[static_cast<Index>(t[1])],
+                                   out_index[static_cast<Index>(t[2])]};
+        const glm::dvec3 p0(out.mesh.positions[static_cast<Index>(o[0])]);
+        const glm::dvec3 p1(out.mesh.positions[static_cast<Index>(o[1])]);
+        const glm::dvec3 p2(out.mesh.positions[static_cast<Index>(o[2])]);
+        const glm::dvec3 normal = glm::cross(p1 - p0, p2 - p0);
+        const glm::dvec3 mid = (p0 + p1 + p2) / 3.0 - centre_;
+        if (!(orient3(d0, d1, d2) > 0.0) || !(glm::dot(normal, mid) > 0.0))
+            throw InvalidInput("the lobe's strokes fold over each other as seen from its centre (draw around the lobe)");
+        out.mesh.triangles.push_back(o);
+    }
+    // Stroke segments (split at crossings) are the constraints of remeshing.
+    for (const auto& e : cdt_.constrained_edges()) {
+        const int a = out_index[static_cast<Index>(node_of(e.first->vertex(CDT::ccw(e.second))))];
+        const int b = out_index[static_cast<Index>(node_of(e.first->vertex(CDT::cw(e.second))))];
+        if (a >= 0 && b >= 0 && a != b) out.mesh.feature_edges.push_back({std::min(a, b), std::max(a, b)});
+    }
+    std::sort(out.mesh.feature_edges.begin(), out.mesh.feature_edges.end());
+    out.crossings = crossings_.size();
+}
+
+LobeSurface Builder::run()
+{
+    if (strokes_.empty()) throw InvalidInput("a lobe needs at least one stroke");
+    std::size_t total = 0;
+    for (Index s = 0; s < strokes_.size(); ++s) {
+        if (strokes_[s].points.size() < 4)
+            throw InvalidInput(stroke_name(static_cast<int>(s)) + " has fewer than 4 samples");
+        total += strokes_[s].points.size();
+        for (const glm::vec3& p : strokes_[s].points)
+            if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) ||
+                std::abs(p.x) > StrokeLimits::max_coordinate_m || std::abs(p.y) > StrokeLimits::max_coordinate_m ||
+                std::abs(p.z) > StrokeLimits::max_coordinate_m)
+                throw InvalidInput(stroke_name(static_cast<int>(s)) + " has a coordinate that is not finite or beyond 1 km");
+    }
+    if (total > 200000) throw InvalidInput("a lobe's strokes have more than 200,000 samples");
+    if (!std::isfinite(centre_.x) || !std::isfinite(centre_.y) || !std::isfinite(centre_.z))
+        throw InvalidInput("the lobe's centre is not finite");
+    make_directions();
+    choose_pole();
+    find_crossings();
+    build_chains();
+    LobeSurface out;
+    out.centre = centre_;
+    out.reference_radius = options_.reference_radius_m > 0 ? options_.reference_radius_m : mean_radius_;
+    try {
+        triangulate();
+        refine();
+        emit(out);
+    } catch (const CGAL::Failure_exception& e) {
+        throw InvalidInput(std::string("the lobe's strokes could not be triangulated: ") + e.message());
+    }
+    return out;
+}
+
+} // namespace
+
+glm::dvec3 lobe_stroke_centroid(const std::vector<LobeStrokeSamples>& strokes)
+{
+    bool any_closed = false;
+    for (const auto& s : strokes) any_closed = any_closed || s.closed;
+    glm::dvec3 sum(0.0);
+    double weight = 0;
+    for (const auto& s : strokes) {
+        if (any_closed && !s.closed) continue;
+        const auto pts = to_double(s.points);
+        const double len = polyline_length(pts, s.closed);
+        sum += len * polyline_barycentre(pts, s.closed);
+        weight += len;
+    }
+    if (weight > 0) return sum / weight;
+    glm::dvec3 mean(0.0);
+    std::size_t n = 0;
+    for (const auto& s : strokes)
+        for (const glm::vec3& p : s.points) {
+            mean += glm::dvec3(p);
+            ++n;
+        }
+    return n ? mean / static_cast<double>(n) : mean;
+}
+
+LobeSurface build_lobe_surface(const std::vector<LobeStrokeSamples>& strokes, const glm::dvec3& centre,
+                               const LobeSurfaceOptions& options)
+{
+    Builder b(strokes, centre, options);
+    return b.run();
+}
+
+} // namespace lobe
