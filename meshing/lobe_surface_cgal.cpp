@@ -6,7 +6,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
+#include <map>
 #include <unordered_map>
 #include <string>
 #include <utility>
@@ -30,7 +34,6 @@
 #include <Eigen/Dense>
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
-#include <Eigen/SparseLU>
 #pragma GCC diagnostic pop
 
 #include "core/errors.h"
@@ -259,7 +262,7 @@ private:
     std::vector<std::pair<int, int>> region_strokes_;
     int region_count_ = 0;
     int pole_node_ = -1;
-    double max_piece_angle_ = 3.0 * M_PI / 180.0;
+    double max_piece_angle_ = 6.0 * M_PI / 180.0;
     double ring_angle_ = 0;
 };
 
@@ -429,8 +432,43 @@ void Builder::build_chains()
         n.radius = glm::length(mid - centre_);
         n.origin = {LobeVertexKind::Crossing, c.a, -1, c.b};
         c.node = add_node(n);
-        on[a].push_back({c.seg, c.s, c.node});
-        on[b].push_back({c.other_seg, c.t, c.node});
+    }
+    // Crossings closer together than the merge distance (several strokes through about one
+    // point, or two strokes crossing twice in quick succession) become one vertex, so no
+    // sliver is left between them.
+    if (crossings_.size() <= 4000) {
+        std::vector<int> parent(nodes_.size());
+        for (Index i = 0; i < parent.size(); ++i) parent[i] = static_cast<int>(i);
+        auto find = [&](int x) {
+            while (parent[static_cast<Index>(x)] != x) x = parent[static_cast<Index>(x)] = parent[static_cast<Index>(parent[static_cast<Index>(x)])];
+            return x;
+        };
+        auto pos = [&](int id) { return centre_ + nodes_[static_cast<Index>(id)].radius * nodes_[static_cast<Index>(id)].dir; };
+        for (Index i = 0; i < crossings_.size(); ++i)
+            for (Index j = i + 1; j < crossings_.size(); ++j) {
+                const Crossing& x = crossings_[i];
+                const Crossing& y = crossings_[j];
+                const double merge = options_.crossing_merge_fraction *
+                                     std::min({spacing_[static_cast<Index>(x.a)], spacing_[static_cast<Index>(x.b)],
+                                               spacing_[static_cast<Index>(y.a)], spacing_[static_cast<Index>(y.b)]});
+                if (glm::distance(pos(x.node), pos(y.node)) < merge) parent[static_cast<Index>(find(x.node))] = find(y.node);
+            }
+        std::map<int, std::pair<glm::dvec3, int>> sums; // root → (sum of positions, count)
+        for (const Crossing& c : crossings_) {
+            auto& e = sums[find(c.node)];
+            e.first += pos(c.node);
+            e.second += 1;
+        }
+        for (auto& [root, e] : sums) {
+            const glm::dvec3 p = e.first / static_cast<double>(e.second) - centre_;
+            nodes_[static_cast<Index>(root)].radius = glm::length(p);
+            nodes_[static_cast<Index>(root)].dir = p / glm::length(p);
+        }
+        for (Crossing& c : crossings_) c.node = find(c.node);
+    }
+    for (const Crossing& c : crossings_) {
+        on[static_cast<Index>(c.a)].push_back({c.seg, c.s, c.node});
+        on[static_cast<Index>(c.b)].push_back({c.other_seg, c.t, c.node});
     }
     chains_.assign(strokes_.size(), {});
     for (Index s = 0; s < strokes_.size(); ++s) {
@@ -454,10 +492,14 @@ void Builder::build_chains()
         }
         std::vector<int> chain;
         Index next = 0;
+        auto push = [&](int id) {
+            if (chain.empty() || chain.back() != id) chain.push_back(id);
+        };
         for (Index i = 0; i < n; ++i) {
-            if (keep[i]) chain.push_back(sample_node_[sample_offset_[s] + i]);
-            while (next < list.size() && static_cast<Index>(list[next].seg) == i) chain.push_back(list[next++].node);
+            if (keep[i]) push(sample_node_[sample_offset_[s] + i]);
+            while (next < list.size() && static_cast<Index>(list[next].seg) == i) push(list[next++].node);
         }
+        if (closed && chain.size() > 1 && chain.front() == chain.back()) chain.pop_back();
         if (chain.size() < (closed ? 3u : 2u))
             throw InvalidInput(stroke_name(static_cast<int>(s)) + " is crossed too densely by other strokes to mesh");
         // Long segments are subdivided along the straight 3D segment, so that seen from the
@@ -689,7 +731,7 @@ void Builder::refine()
     mark_regions();
     find_paper_regions();
     seed_fill(max_edge, added);
-    for (int pass = 0; pass < 8; ++pass) {
+    for (int pass = 0; pass < 4; ++pass) {
         mark_regions();
         find_paper_regions();
         std::vector<glm::dvec2> points;
@@ -778,7 +820,7 @@ void Builder::solve_fill_radii(const std::vector<std::array<int, 3>>& triangles)
     // inverse angular edge length so long strip edges and short cap edges measure slope alike.
     auto solve = [&](bool biharmonic, Eigen::VectorXd& x) {
         std::vector<Eigen::Triplet<double>> entries;
-        std::vector<double> fixed_part;
+        std::vector<double> fixed_part, sums;
         int rows = 0;
         for (Index i = 0; i < n; ++i) {
             const auto& nb = adj[i];
@@ -802,8 +844,10 @@ void Builder::solve_fill_radii(const std::vector<std::array<int, 3>>& triangles)
                 else b -= w[k] / sum * nodes_[static_cast<Index>(j)].radius;
             }
             fixed_part.push_back(b);
+            sums.push_back(sum);
             ++rows;
         }
+        const Eigen::VectorXd row_scale = Eigen::Map<const Eigen::VectorXd>(sums.data(), rows);
         Eigen::SparseMatrix<double> l(rows, count);
         l.setFromTriplets(entries.begin(), entries.end());
         const Eigen::Map<const Eigen::VectorXd> b(fixed_part.data(), rows);
@@ -813,9 +857,11 @@ void Builder::solve_fill_radii(const std::vector<std::array<int, 3>>& triangles)
             if (solver.info() != Eigen::Success) return false;
             x = solver.solve(-(l.transpose() * b));
         } else {
-            Eigen::SparseLU<Eigen::SparseMatrix<double>> solver(l);
+            // Rows scaled back by their weight sums: symmetric positive definite.
+            Eigen::SparseMatrix<double> sym = row_scale.asDiagonal() * l;
+            Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(sym);
             if (solver.info() != Eigen::Success) return false;
-            x = solver.solve(-b);
+            x = solver.solve(-(row_scale.asDiagonal() * b));
         }
         return solver_ok(x);
     };
@@ -1013,7 +1059,10 @@ void Builder::emit(LobeSurface& out)
         if (a >= 0 && b >= 0 && a != b) out.mesh.feature_edges.push_back({std::min(a, b), std::max(a, b)});
     }
     std::sort(out.mesh.feature_edges.begin(), out.mesh.feature_edges.end());
-    out.crossings = crossings_.size();
+    std::vector<int> crossing_nodes;
+    for (const Crossing& c : crossings_) crossing_nodes.push_back(c.node);
+    std::sort(crossing_nodes.begin(), crossing_nodes.end());
+    out.crossings = static_cast<std::size_t>(std::unique(crossing_nodes.begin(), crossing_nodes.end()) - crossing_nodes.begin());
 }
 
 LobeSurface Builder::run()

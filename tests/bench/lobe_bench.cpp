@@ -1,0 +1,105 @@
+// Progressive lobes at the default 3 cm spacing (issue: adding a stroke to a 10-stroke lobe
+// and updating its surface ≤ 1 ms; remeshing a lobe ≤ 20 ms). The lobe is a 20 cm sphere
+// drawn as six loops through its centre at 30° steps plus four stacked rings, the kind of
+// lobe a person sketches with about ten strokes.
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <vector>
+
+#include <glm/geometric.hpp>
+
+#include "meshing/lobe.h"
+#include "meshing/lobe_document.h"
+#include "meshing/mesh_quality.h"
+#include "meshing/remesh.h"
+
+using namespace lobe;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+const glm::dvec3 kCentre(0.0, 1.4, -0.45);
+constexpr double kRadius = 0.2;
+
+/// Raw stroke points 5 mm apart (the pipeline's minimum point spacing) with 1 mm of wobble.
+std::vector<glm::vec3> raw_loop(const glm::dvec3& centre, const glm::dvec3& u, const glm::dvec3& v, double r, int seed)
+{
+    const int n = static_cast<int>(2 * kPi * r / 0.005);
+    std::vector<glm::vec3> out;
+    for (int i = 0; i < n; ++i) {
+        const double t = 2 * kPi * i / n;
+        const double w = 0.001 * std::sin(7 * t + seed);
+        out.emplace_back(centre + (r + w) * (std::cos(t) * u + std::sin(t) * v));
+    }
+    return out;
+}
+
+std::vector<std::vector<glm::vec3>> ten_strokes()
+{
+    std::vector<std::vector<glm::vec3>> s;
+    for (int k = 0; k < 6; ++k) {
+        const double a = k * kPi / 6;
+        s.push_back(raw_loop(kCentre, {0, 1, 0}, {std::cos(a), 0, std::sin(a)}, kRadius, k));
+    }
+    for (double h : {-0.15, -0.08, 0.08, 0.15}) {
+        const double r = std::sqrt(kRadius * kRadius - h * h);
+        s.push_back(raw_loop(kCentre + glm::dvec3(0, h, 0), {1, 0, 0}, {0, 0, 1}, r, static_cast<int>(h * 100)));
+    }
+    return s;
+}
+
+/// Adds the 11th stroke (a loop tilted by 45°) to a lobe of ten; the lobe is copied back
+/// outside the timed region each round.
+void BM_AddStrokeToTenStrokeLobe(benchmark::State& state)
+{
+    Lobe base;
+    const auto strokes = ten_strokes();
+    for (std::size_t i = 0; i < strokes.size(); ++i) base.add_stroke(static_cast<std::int64_t>(i + 1), strokes[i]);
+    const auto extra = raw_loop(kCentre, glm::normalize(glm::dvec3(1, 1, 0)), {0, 0, 1}, kRadius, 11);
+    const LobeStrokeSamples prepared = prepare_lobe_stroke(11, extra);
+    for (auto _ : state) {
+        state.PauseTiming();
+        Lobe lobe = base;
+        state.ResumeTiming();
+        lobe.add_prepared(prepared);
+        benchmark::DoNotOptimize(lobe.surface().mesh.positions.data());
+    }
+    const LobeSurface& s = base.surface();
+    state.counters["vertices"] = static_cast<double>(s.mesh.positions.size());
+    state.counters["crossings"] = static_cast<double>(s.crossings);
+}
+BENCHMARK(BM_AddStrokeToTenStrokeLobe)->Unit(benchmark::kMillisecond);
+
+/// Sampling and closing one raw stroke (part of adding a stroke from the pipeline).
+void BM_PrepareStroke(benchmark::State& state)
+{
+    const auto raw = raw_loop(kCentre, glm::normalize(glm::dvec3(1, 1, 0)), {0, 0, 1}, kRadius, 11);
+    for (auto _ : state) benchmark::DoNotOptimize(prepare_lobe_stroke(11, raw).points.data());
+    state.counters["raw_points"] = static_cast<double>(raw.size());
+}
+BENCHMARK(BM_PrepareStroke)->Unit(benchmark::kMillisecond);
+
+/// Remeshing the ten-stroke lobe to 3 cm with the strokes as constraints, as lobes are
+/// remeshed (3 iterations, feature edges split and collapsed along their stroke).
+void BM_RemeshTenStrokeLobe(benchmark::State& state)
+{
+    Lobe lobe;
+    const auto strokes = ten_strokes();
+    for (std::size_t i = 0; i < strokes.size(); ++i) lobe.add_stroke(static_cast<std::int64_t>(i + 1), strokes[i]);
+    RemeshOptions options;
+    options.relax_feature_edges = true;
+    TriangleMesh out;
+    for (auto _ : state) {
+        out = remesh_isotropic(lobe.surface().mesh, options);
+        benchmark::DoNotOptimize(out.positions.data());
+    }
+    const MeshQuality q = measure_quality(out);
+    state.counters["in_vertices"] = static_cast<double>(lobe.surface().mesh.positions.size());
+    state.counters["out_vertices"] = static_cast<double>(q.vertices);
+    state.counters["share_angles_ge_30"] = q.share_all_angles_ge_30;
+    state.counters["min_angle_deg"] = q.min_angle_deg;
+}
+BENCHMARK(BM_RemeshTenStrokeLobe)->Unit(benchmark::kMillisecond);
+
+} // namespace
