@@ -46,7 +46,7 @@ struct LobeSurfaceOptions {
     /// A stroke sample closer than this fraction of its stroke's median spacing to a
     /// crossing with another stroke is dropped in favour of the crossing vertex (no
     /// sliver triangles at crossings). Stroke end points are never dropped.
-    double crossing_merge_fraction = 0.4;
+    double crossing_merge_fraction = 0.25;
     /// Stitch regions bounded by exactly two uncrossed closed strokes with the paper's
     /// strip (stitch_closed_closed) instead of the Delaunay triangulation.
     bool paper_strips = true;

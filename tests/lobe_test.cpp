@@ -165,17 +165,38 @@ TEST(Lobes, SurfaceBeforeRemeshingIsMadeOfStrokePointsStripsAndCaps)
     }
     EXPECT_EQ(crossings, s.crossings);
     EXPECT_GT(s.crossings, 0u); // the loops are drawn at different angles and cross
-    // Every sample of every stroke is a vertex, except the few that gave way to a crossing.
-    std::size_t all_samples = 0;
-    Lobe lobe;
+    // Every sample of every stroke is a vertex, except those that gave way to a crossing
+    // vertex within the merge distance (a quarter of the stroke's median spacing).
+    std::set<std::tuple<float, float, float>> vertices;
+    std::vector<glm::vec3> crossing_vertices;
+    for (std::size_t i = 0; i < s.mesh.positions.size(); ++i) {
+        const glm::vec3& p = s.mesh.positions[i];
+        vertices.insert({p.x, p.y, p.z});
+        if (s.origins[i].kind == LobeVertexKind::Crossing) crossing_vertices.push_back(p);
+    }
+    std::size_t checked = 0, gave_way = 0;
     for (std::int64_t id : lobes[0].stroke_ids)
         for (const Stroke& st : doc.strokes)
             if (st.id == id) {
                 std::vector<glm::vec3> raw;
                 for (const auto& p : st.points) raw.push_back(p.position);
-                all_samples += prepare_lobe_stroke(id, raw).points.size();
+                const LobeStrokeSamples prepared = prepare_lobe_stroke(id, raw);
+                std::vector<double> gaps;
+                for (std::size_t i = 0; i + 1 < prepared.points.size(); ++i)
+                    gaps.push_back(glm::distance(prepared.points[i], prepared.points[i + 1]));
+                std::nth_element(gaps.begin(), gaps.begin() + static_cast<long>(gaps.size() / 2), gaps.end());
+                const double merge = 0.25 * gaps[gaps.size() / 2];
+                for (const glm::vec3& p : prepared.points) {
+                    ++checked;
+                    if (vertices.count({p.x, p.y, p.z})) continue;
+                    ++gave_way;
+                    double nearest = 1e9;
+                    for (const glm::vec3& q : crossing_vertices) nearest = std::min(nearest, static_cast<double>(glm::distance(p, q)));
+                    EXPECT_LT(nearest, merge * 1.5) << "stroke " << id << ": a sample is neither a vertex nor next to a crossing";
+                }
             }
-    EXPECT_GE(samples + 2 * s.crossings, all_samples);
+    EXPECT_GT(checked, 40u);
+    EXPECT_LT(gave_way, checked / 5);
     // Stroke segments are the remeshing constraints: every feature edge is a mesh edge.
     std::set<std::pair<int, int>> edges;
     for (const auto& t : s.mesh.triangles)
