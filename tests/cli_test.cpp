@@ -1,6 +1,10 @@
 // The lobesketch executable as a user runs it: exit codes, one-line errors, output files.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
+#include <filesystem>
+
 #include <array>
 #include <cstdio>
 #include <fstream>
@@ -10,6 +14,8 @@
 #include <nlohmann/json.hpp>
 
 #include "core/document.h"
+#include "meshing/mesh_io.h"
+#include "meshing/mesh_quality.h"
 #include "tests/test_paths.h"
 
 using namespace lobe;
@@ -84,6 +90,50 @@ TEST(Cli, ReplayWritesStrokesAndASessionThatLoads)
     Document doc = load_document(dir + "/session.json");
     EXPECT_EQ(doc.strokes.size(), j["strokes"].size());
     EXPECT_FALSE(doc.lobes.empty());
+    // Every lobe's mesh is written beside the session and recorded in it.
+    for (const LobeRecord& l : doc.lobes) {
+        EXPECT_EQ(l.mesh_file, "lobes/lobe_" + std::to_string(l.id) + ".ply");
+        const TriangleMesh m = read_mesh(dir + "/" + l.mesh_file);
+        const MeshQuality q = measure_quality(m);
+        EXPECT_TRUE(q.closed && q.manifold && q.outward) << l.mesh_file;
+        EXPECT_GT(q.vertices, 100u);
+    }
+}
+
+TEST(Cli, LobesCommandBuildsLobesFromARecordingASessionAndAMesh)
+{
+    const std::string dir = test::temp_dir("cli-lobes");
+    CliRun r = run("lobes " + test::source_path("recordings/table1-1lobe-5strokes.lrec") + " --out " + dir + "/rec");
+    ASSERT_EQ(r.code, 0) << r.out;
+    const Document from_rec = load_document(dir + "/rec/session.json");
+    ASSERT_EQ(from_rec.lobes.size(), 1u);
+    const TriangleMesh rec_mesh = read_mesh(dir + "/rec/" + from_rec.lobes[0].mesh_file);
+    // The session it wrote rebuilds the same lobe.
+    r = run("lobes " + dir + "/rec/session.json --out " + dir + "/session");
+    ASSERT_EQ(r.code, 0) << r.out;
+    const Document from_session = load_document(dir + "/session/session.json");
+    const TriangleMesh session_mesh = read_mesh(dir + "/session/" + from_session.lobes[0].mesh_file);
+    EXPECT_EQ(session_mesh.positions, rec_mesh.positions);
+    EXPECT_EQ(session_mesh.triangles, rec_mesh.triangles);
+    // A mesh becomes one lobe scaled to --size.
+    r = run("lobes " + test::shared_path("data/models/spot.obj") + " --size 0.8 --out " + dir + "/mesh");
+    ASSERT_EQ(r.code, 0) << r.out;
+    const TriangleMesh spot = read_mesh(dir + "/mesh/lobes/lobe_1.ply");
+    glm::dvec3 lo, hi;
+    bounding_box(spot, lo, hi);
+    EXPECT_NEAR(std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z}), 0.8, 0.02);
+    EXPECT_TRUE(measure_quality(spot).closed);
+    // A malformed mesh: one line naming the file, exit 1, nothing written.
+    const std::string bad = dir + "/bad.obj";
+    {
+        std::ofstream f(bad);
+        f << "v 0 0 0\nv 1 0 0\nf 1 2 7\n";
+    }
+    r = run("lobes " + bad + " --out " + dir + "/bad");
+    EXPECT_EQ(r.code, 1) << r.out;
+    EXPECT_EQ(count_lines_with(r.out, "error"), 1u) << r.out;
+    EXPECT_NE(r.out.find("bad.obj"), std::string::npos) << r.out;
+    EXPECT_FALSE(std::filesystem::exists(dir + "/bad/lobes/lobe_1.ply"));
 }
 
 TEST(Cli, InfoSummarisesARecording)
