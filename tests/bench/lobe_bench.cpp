@@ -13,6 +13,16 @@
 #include "meshing/lobe_document.h"
 #include "meshing/mesh_quality.h"
 #include "meshing/remesh.h"
+#include "tests/bench/cgal_surface_mesh.h"
+
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wconversion"
+#pragma GCC diagnostic ignored "-Wshadow"
+#pragma GCC diagnostic ignored "-Wsign-conversion"
+#pragma GCC diagnostic ignored "-Wunused-parameter"
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#include <CGAL/Polygon_mesh_processing/remesh.h>
+#pragma GCC diagnostic pop
 
 using namespace lobe;
 
@@ -101,5 +111,27 @@ void BM_RemeshTenStrokeLobe(benchmark::State& state)
     state.counters["min_angle_deg"] = q.min_angle_deg;
 }
 BENCHMARK(BM_RemeshTenStrokeLobe)->Unit(benchmark::kMillisecond);
+
+/// The same lobe through a plain default CGAL::Polygon_mesh_processing::isotropic_remeshing
+/// call (10 iterations, same target, no constraints) on a CGAL::Surface_mesh, for the
+/// side-by-side comparison of time and quality.
+void BM_CgalDefaultRemeshTenStrokeLobe10Iterations(benchmark::State& state)
+{
+    Lobe lobe;
+    const auto strokes = ten_strokes();
+    for (std::size_t i = 0; i < strokes.size(); ++i) lobe.add_stroke(static_cast<std::int64_t>(i + 1), strokes[i]);
+    const bench::SurfaceMesh input = bench::to_surface_mesh(lobe.surface().mesh);
+    bench::SurfaceMesh sm;
+    for (auto _ : state) {
+        sm = input;
+        CGAL::Polygon_mesh_processing::isotropic_remeshing(faces(sm), 0.03, sm, CGAL::parameters::number_of_iterations(10));
+        benchmark::DoNotOptimize(sm.number_of_faces());
+    }
+    const MeshQuality q = measure_quality(bench::from_surface_mesh(sm));
+    state.counters["out_vertices"] = static_cast<double>(q.vertices);
+    state.counters["share_angles_ge_30"] = q.share_all_angles_ge_30;
+    state.counters["min_angle_deg"] = q.min_angle_deg;
+}
+BENCHMARK(BM_CgalDefaultRemeshTenStrokeLobe10Iterations)->Unit(benchmark::kMillisecond);
 
 } // namespace

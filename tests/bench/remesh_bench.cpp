@@ -26,8 +26,12 @@
 
 #include "meshing/mesh_quality.h"
 #include "meshing/remesh.h"
+#include "tests/bench/cgal_surface_mesh.h"
 
 using namespace lobe;
+using lobe::bench::SurfaceMesh;
+using lobe::bench::from_surface_mesh;
+using lobe::bench::to_surface_mesh;
 
 namespace {
 
@@ -96,37 +100,6 @@ void report_quality(benchmark::State& state, const TriangleMesh& out)
         samples.positions.push_back(0.5f * (a + b));
     }
     state.counters["hausdorff_mm"] = 1000.0 * max_vertex_distance(samples, bench_lobe());
-}
-
-using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-using SurfaceMesh = CGAL::Surface_mesh<Kernel::Point_3>;
-
-SurfaceMesh to_surface_mesh(const TriangleMesh& m)
-{
-    SurfaceMesh sm;
-    std::vector<SurfaceMesh::Vertex_index> v;
-    for (const auto& p : m.positions) v.push_back(sm.add_vertex(Kernel::Point_3(p.x, p.y, p.z)));
-    for (const auto& t : m.triangles)
-        sm.add_face(v[static_cast<std::size_t>(t[0])], v[static_cast<std::size_t>(t[1])], v[static_cast<std::size_t>(t[2])]);
-    return sm;
-}
-
-TriangleMesh from_surface_mesh(SurfaceMesh& sm)
-{
-    sm.collect_garbage();
-    TriangleMesh m;
-    for (auto v : sm.vertices()) {
-        const auto& p = sm.point(v);
-        m.positions.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
-    }
-    for (auto f : sm.faces()) {
-        std::array<int, 3> t{};
-        int k = 0;
-        for (auto v : CGAL::vertices_around_face(sm.halfedge(f), sm))
-            if (k < 3) t[static_cast<std::size_t>(k++)] = static_cast<int>(v.idx());
-        m.triangles.push_back(t);
-    }
-    return m;
 }
 
 } // namespace
