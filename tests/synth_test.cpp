@@ -196,7 +196,7 @@ TEST(SynthScenario, SameScenarioGivesBitIdenticalFramesTwice)
         EXPECT_TRUE(same_bits(a.recording.events[i].time, b.recording.events[i].time));
         EXPECT_EQ(a.recording.events[i].code, b.recording.events[i].code);
     }
-    EXPECT_EQ(ground_truth_to_json(a.truth).dump(), ground_truth_to_json(b.truth).dump());
+    EXPECT_EQ(ground_truth_to_json(a.truth, a.surfaces).dump(), ground_truth_to_json(b.truth, b.surfaces).dump());
 
     s.seed += 1;
     SynthResult c = synthesize(s);
@@ -276,6 +276,47 @@ TEST(SynthScenario, KidneyLobeOfTheFourLobeTreeIsNonConvex)
     ASSERT_GE(r.truth.size(), 14u);
     EXPECT_FALSE(turns_both_ways(r.truth[0])) << "the first loop of the top lobe is convex";
     for (std::size_t k = 11; k <= 13; ++k) EXPECT_TRUE(turns_both_ways(r.truth[k])) << "kidney loop " << k;
+}
+
+TEST(SynthScenario, SectionStrokesFollowTheirSurfaceInTheAskedDirection)
+{
+    json j = minimal_scenario();
+    j["noise"] = false;
+    j["dropouts"] = false;
+    j["surfaces"] = json::array({json{{"center", {0.05, 1.35, -0.42}}, {"radii", {0.12, 0.1, 0.14}},
+                                      {"dents", {{{"direction", {-1, 0, 0}}, {"depth_mm", 30}, {"width_deg", 60}}}}}});
+    j["steps"] = json::array();
+    for (int dir : {1, -1})
+        j["steps"].push_back({{"type", "stroke"},
+                              {"section", {{"surface", 0}, {"normal", {0, 1, 0}}, {"offset_m", 0.03},
+                                           {"direction", dir}, {"wobble_mm", 4}}}});
+    j["steps"].push_back({{"type", "stroke"},
+                          {"section", {{"surface", 0}, {"normal", {0, 0, 1}}, {"start_angle_deg", 20}, {"sweep_deg", 140}}}});
+    const Scenario sc = scenario_from_json(j);
+    ASSERT_EQ(sc.surfaces.size(), 1u);
+    const SynthResult r = synthesize(sc);
+    ASSERT_EQ(r.truth.size(), 3u);
+    const TruthSurface& s = r.surfaces[0];
+    for (const GroundTruthStroke& g : r.truth) {
+        EXPECT_EQ(g.surface, 0);
+        for (const glm::vec3& p : g.points) ASSERT_LT(std::abs(radial_gap(s, glm::dvec3(p))), 1e-5);
+    }
+    // Normal +Y: azimuth 0 is +X and 90° is −Z (far); −1 goes the other way round.
+    EXPECT_TRUE(r.truth[0].closed);
+    EXPECT_GT(r.truth[0].points.front().x, 0.1f);
+    EXPECT_LT(r.truth[0].points[40].z, -0.42f);
+    EXPECT_GT(r.truth[1].points[40].z, -0.42f);
+    // The wobble differs per step and leaves the plane by millimetres; the loop still closes.
+    double off0 = 0.0, off1 = 0.0;
+    for (const glm::vec3& p : r.truth[0].points) off0 = std::max(off0, std::abs(p.y - 1.38));
+    for (const glm::vec3& p : r.truth[1].points) off1 = std::max(off1, std::abs(p.y - 1.38));
+    EXPECT_GT(off0, 0.001);
+    EXPECT_LT(off0, 0.008);
+    EXPECT_NE(off0, off1);
+    EXPECT_LT(glm::distance(r.truth[0].points.front(), r.truth[0].points.back()), 1e-4f);
+    // An arc over the top is open and ends where asked.
+    EXPECT_FALSE(r.truth[2].closed);
+    EXPECT_GT(r.truth[2].points[r.truth[2].points.size() / 2].y, 1.44f);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -780,6 +821,44 @@ TEST(SynthScenarioErrors, BadScenariosGiveOneLineInvalidInputNamingTheField)
                                     {"dents", {{{"angle_deg", 0}, {"depth_mm", 90}, {"width_deg", 40}}}}};
         cases.push_back({"dent deeper than the ellipse", j, "steps[0].ellipse.dents[0].depth_mm"});
     }
+    auto with_section = [](json section) {
+        json j = minimal_scenario();
+        j["surfaces"] = json::array({json{{"center", {0.0, 1.3, -0.4}}, {"radii", {0.12, 0.1, 0.14}}}});
+        j["steps"][0].erase("curve");
+        j["steps"][0]["section"] = std::move(section);
+        return j;
+    };
+    cases.push_back({"section without surfaces",
+                     [&] { json j = with_section({{"surface", 0}}); j.erase("surfaces"); return j; }(),
+                     "steps[0].section.surface"});
+    cases.push_back({"section on surface 1 of 1", with_section({{"surface", 1}}), "steps[0].section.surface"});
+    cases.push_back({"section without a surface", with_section({{"normal", {0, 1, 0}}}), "steps[0].section"});
+    cases.push_back({"section misspelt field", with_section({{"surface", 0}, {"ofset_m", 0.02}}), "steps[0].section"});
+    cases.push_back({"section plane misses", with_section({{"surface", 0}, {"offset_m", 0.15}}), "steps[0].section.offset_m"});
+    cases.push_back({"section direction 2", with_section({{"surface", 0}, {"direction", 2}}), "steps[0].section.direction"});
+    cases.push_back({"section zero normal", with_section({{"surface", 0}, {"normal", {0, 0, 0}}}), "steps[0].section.normal"});
+    cases.push_back({"section sweep 400°", with_section({{"surface", 0}, {"sweep_deg", 400}}), "steps[0].section.sweep_deg"});
+    cases.push_back({"section wobble 30 mm", with_section({{"surface", 0}, {"wobble_mm", 30}}), "steps[0].section.wobble_mm"});
+    {
+        json j = with_section({{"surface", 0}});
+        j["steps"][0]["curve"] = json::array({json::array({0.0, 1.3, -0.4}), json::array({0.1, 1.3, -0.4})});
+        cases.push_back({"section and curve", j, "steps[0]"});
+    }
+    {
+        json j = with_section({{"surface", 0}});
+        j["surfaces"][0]["radii"] = {0.12, 0.1, 3.0};
+        cases.push_back({"surface radius 3 m", j, "surfaces[0].radii"});
+    }
+    {
+        json j = with_section({{"surface", 0}});
+        j["surfaces"][0]["dents"] = {{{"direction", {1, 0, 0}}, {"depth_mm", 100}}};
+        cases.push_back({"dent leaving 17 %", j, "surfaces[0].dents"});
+    }
+    {
+        json j = with_section({{"surface", 0}});
+        j["surfaces"] = json::object();
+        cases.push_back({"surfaces not an array", j, "surfaces"});
+    }
     for (const Case& c : cases) {
         SCOPED_TRACE(c.what);
         std::string msg = invalid_input_message([&] { scenario_from_json(c.scenario); });
@@ -800,6 +879,15 @@ TEST(SynthScenarioErrors, ScenariosBuiltInCodeAreCheckedToo)
     s = scenario_from_json(minimal_scenario());
     s.rate_hz = 0.0;
     EXPECT_NE(invalid_input_message([&] { synthesize(s); }).find("rate_hz"), std::string::npos);
+    // A stroke said to lie on a surface must name one and lie on it.
+    s = scenario_from_json(minimal_scenario());
+    s.steps[0].stroke.surface = 0;
+    EXPECT_NE(invalid_input_message([&] { synthesize(s); }).find("steps[0].surface"), std::string::npos);
+    s.surfaces.push_back(TruthSurface{});
+    s.surfaces[0].center = glm::dvec3(0.1, 1.3, -0.4);
+    EXPECT_NE(invalid_input_message([&] { synthesize(s); }).find("off surface 0"), std::string::npos);
+    s.surfaces[0].radii.y = 0.01;
+    EXPECT_NE(invalid_input_message([&] { synthesize(s); }).find("surfaces[0].radii"), std::string::npos);
 }
 
 TEST(SynthScenarioErrors, BadFilesGiveOneLineFileErrorsNamingTheFile)
@@ -844,9 +932,12 @@ TEST(SynthGroundTruth, JsonRoundTripKeepsEveryField)
     const SynthResult& r = shipped(kShipped[3].file);
     const std::string dir = test::temp_dir("synth-truth");
     const std::string path = dir + "/pinch-edit.truth.json";
-    json j = ground_truth_to_json(r.truth);
+    json j = ground_truth_to_json(r.truth, r.surfaces);
     EXPECT_EQ(j["format"], "lobesketch-ground-truth");
     EXPECT_EQ(j["version"], 1);
+    const std::vector<TruthSurface> surfaces = truth_surfaces_from_json(j);
+    ASSERT_EQ(surfaces.size(), r.surfaces.size());
+    for (std::size_t k = 0; k < surfaces.size(); ++k) EXPECT_EQ(truth_surface_to_json(surfaces[k]), truth_surface_to_json(r.surfaces[k]));
     std::ofstream(path) << j.dump();
     std::vector<GroundTruthStroke> back = load_ground_truth(path);
     ASSERT_EQ(back.size(), r.truth.size());
@@ -857,6 +948,7 @@ TEST(SynthGroundTruth, JsonRoundTripKeepsEveryField)
         EXPECT_EQ(back[k].drag, r.truth[k].drag);
         EXPECT_EQ(back[k].t_begin, r.truth[k].t_begin);
         EXPECT_EQ(back[k].t_end, r.truth[k].t_end);
+        EXPECT_EQ(back[k].surface, r.truth[k].surface);
         ASSERT_EQ(back[k].points.size(), r.truth[k].points.size());
         for (std::size_t i = 0; i < back[k].points.size(); ++i) ASSERT_EQ(back[k].points[i], r.truth[k].points[i]);
     }
@@ -869,7 +961,10 @@ TEST(SynthGroundTruth, BadTruthFilesGiveFileErrors)
     std::ofstream(dir + "/a.json") << R"({"format":"lobesketch-ground-truth","version":1,"strokes":[{"kind":"leaf","points":[]}]})";
     std::ofstream(dir + "/b.json") << R"({"format":"lobesketch-ground-truth","version":1,"strokes":[{"kind":"lobe","points":[[0,1]]}]})";
     std::ofstream(dir + "/c.json") << "{\"format\":";
-    for (const char* name : {"/a.json", "/b.json", "/c.json", "/missing.json"}) {
+    std::ofstream(dir + "/d.json")
+        << R"({"format":"lobesketch-ground-truth","version":1,"strokes":[{"kind":"lobe","surface":0,"points":[[0,1,0]]}]})";
+    std::ofstream(dir + "/e.json") << R"({"format":"lobesketch-ground-truth","version":1,"surfaces":[{"center":[0,1,0],"radii":[0.1,0.1,5]}],"strokes":[]})";
+    for (const char* name : {"/a.json", "/b.json", "/c.json", "/d.json", "/e.json", "/missing.json"}) {
         const std::string path = dir + name;
         try {
             load_ground_truth(path);
