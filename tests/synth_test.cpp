@@ -32,12 +32,13 @@ struct Shipped {
     int lobe_strokes;
     int trunk_strokes;
     int drags;
+    std::vector<int> lobe_strokes_per_lobe; ///< one lobe surface each
 };
 const Shipped kShipped[] = {
-    {"recordings/table1-1lobe-5strokes.scenario.json", 5, 3, 0},
-    {"recordings/table1-4lobes-22strokes.scenario.json", 22, 4, 0},
-    {"recordings/table1-3lobes-16strokes.scenario.json", 16, 3, 0},
-    {"recordings/pinch-edit.scenario.json", 5, 0, 2},
+    {"recordings/table1-1lobe-5strokes.scenario.json", 5, 3, 0, {5}},
+    {"recordings/table1-4lobes-22strokes.scenario.json", 22, 4, 0, {6, 5, 6, 5}},
+    {"recordings/table1-3lobes-16strokes.scenario.json", 16, 3, 0, {6, 5, 5}},
+    {"recordings/pinch-edit.scenario.json", 5, 0, 2, {5}},
 };
 
 /// Each shipped scenario synthesized once per test run.
@@ -276,6 +277,120 @@ TEST(SynthScenario, KidneyLobeOfTheFourLobeTreeIsNonConvex)
     ASSERT_GE(r.truth.size(), 14u);
     EXPECT_FALSE(turns_both_ways(r.truth[0])) << "the first loop of the top lobe is convex";
     for (std::size_t k = 11; k <= 13; ++k) EXPECT_TRUE(turns_both_ways(r.truth[k])) << "kidney loop " << k;
+}
+
+TEST(SynthScenario, ShippedLobeStrokesAreDrawnOnOneSurfacePerLobe)
+{
+    for (const Shipped& sc : kShipped) {
+        SCOPED_TRACE(sc.file);
+        const SynthResult& r = shipped(sc.file);
+        ASSERT_EQ(r.surfaces.size(), sc.lobe_strokes_per_lobe.size());
+        std::vector<double> new_lobe; // N presses: the next lobe stroke starts the next lobe
+        for (const InputEvent& e : r.recording.events)
+            if (e.kind == InputEventKind::Key && e.code == keys::kNewLobe && e.value == 1) new_lobe.push_back(e.time);
+        std::vector<int> per_lobe(r.surfaces.size(), 0);
+        for (const GroundTruthStroke& g : r.truth) {
+            if (g.drag || g.kind != StrokeKind::Lobe) {
+                EXPECT_EQ(g.surface, -1);
+                continue;
+            }
+            ASSERT_GE(g.surface, 0);
+            ASSERT_LT(static_cast<std::size_t>(g.surface), r.surfaces.size());
+            ++per_lobe[static_cast<std::size_t>(g.surface)];
+            const auto presses = std::count_if(new_lobe.begin(), new_lobe.end(), [&](double t) { return t < g.t_begin; });
+            EXPECT_EQ(g.surface, presses) << "lobe strokes between two N keys share their surface";
+            // The path the fingertip follows is on the surface (float rounding only).
+            for (const glm::vec3& p : g.points)
+                ASSERT_LT(std::abs(radial_gap(r.surfaces[static_cast<std::size_t>(g.surface)], glm::dvec3(p))), 1e-5);
+        }
+        EXPECT_EQ(per_lobe, sc.lobe_strokes_per_lobe);
+    }
+}
+
+TEST(SynthScenario, ShippedLobesAreEnclosedByTheirStrokes)
+{
+    // A person enclosing foliage leaves no empty patch wider than about 60° of arc seen from
+    // the lobe's centre: every direction is within 30° of a stroke.
+    std::vector<glm::dvec3> probes;
+    for (int i = 0; i < 4000; ++i) {
+        const double z = 1.0 - (2.0 * i + 1.0) / 4000.0, rho = std::sqrt(1.0 - z * z);
+        const double phi = kPi * (3.0 - std::sqrt(5.0)) * i;
+        probes.emplace_back(rho * std::cos(phi), rho * std::sin(phi), z);
+    }
+    for (const Shipped& sc : kShipped) {
+        const SynthResult& r = shipped(sc.file);
+        for (std::size_t k = 0; k < r.surfaces.size(); ++k) {
+            SCOPED_TRACE(std::string(sc.file) + " lobe " + std::to_string(k));
+            std::vector<glm::dvec3> dirs;
+            bool closed = false, open = false;
+            for (const GroundTruthStroke& g : r.truth) {
+                if (g.surface != static_cast<int>(k)) continue;
+                (g.closed ? closed : open) = true;
+                for (std::size_t i = 0; i < g.points.size(); i += 4)
+                    dirs.push_back(glm::normalize(glm::dvec3(g.points[i]) - r.surfaces[k].center));
+            }
+            EXPECT_TRUE(closed) << "every lobe has loops";
+            double widest = 0.0;
+            for (const glm::dvec3& u : probes) {
+                double nearest = kPi;
+                for (const glm::dvec3& d : dirs) nearest = std::min(nearest, std::acos(std::clamp(glm::dot(u, d), -1.0, 1.0)));
+                widest = std::max(widest, nearest);
+            }
+            EXPECT_LE(widest * 180.0 / kPi, 30.0);
+        }
+    }
+}
+
+TEST(SynthScenario, KidneyLobeSurfaceHasADeepWideDentThatItsStrokesCross)
+{
+    const SynthResult& r = shipped(kShipped[1].file);
+    ASSERT_EQ(r.surfaces.size(), 4u);
+    const TruthSurface& kidney = r.surfaces[2];
+    ASSERT_EQ(kidney.dents.size(), 1u);
+    const SurfaceDent& dent = kidney.dents[0];
+    EXPECT_GE(dent.depth_mm, 40.0);
+    EXPECT_GE(dent.width_deg, 60.0);
+    EXPECT_LT(dent.direction.x, -0.9) << "the dent faces the trunk";
+    // Clearly non-convex: the chord between the surface points 50° either side of the dent
+    // passes more than 1.5 cm outside the surface.
+    const double side = 50.0 * kPi / 180.0;
+    const glm::dvec3 a = point(kidney, glm::dvec3(-std::cos(side), 0.0, std::sin(side)));
+    const glm::dvec3 b = point(kidney, glm::dvec3(-std::cos(side), 0.0, -std::sin(side)));
+    EXPECT_GT(radial_gap(kidney, 0.5 * (a + b)), 0.015);
+    // Its strokes cross the dent (pass well inside its width), so the dent shows in them.
+    int crossing = 0;
+    for (const GroundTruthStroke& g : r.truth) {
+        if (g.surface != 2) continue;
+        double closest = kPi;
+        for (const glm::vec3& p : g.points)
+            closest = std::min(closest, std::acos(std::clamp(glm::dot(glm::normalize(glm::dvec3(p) - kidney.center),
+                                                                      dent.direction), -1.0, 1.0)));
+        crossing += closest < 0.75 * dent.width_deg * kPi / 180.0;
+    }
+    EXPECT_GE(crossing, 4);
+}
+
+TEST(SynthScenario, PinchEditDragsStartOnTheLobeAndPullFiveCentimetresOutwards)
+{
+    const SynthResult& r = shipped(kShipped[3].file);
+    ASSERT_EQ(r.surfaces.size(), 1u);
+    const TruthSurface& lobe = r.surfaces[0];
+    int drags = 0;
+    for (const GroundTruthStroke& g : r.truth) {
+        if (!g.drag) continue;
+        ++drags;
+        const glm::dvec3 from(g.points.front()), to(g.points.back());
+        EXPECT_LT(std::abs(radial_gap(lobe, from)), 0.001) << "starts on the surface";
+        EXPECT_NEAR(glm::distance(from, to), 0.05, 0.002);
+        const glm::dvec3 n = normal(lobe, glm::normalize(from - lobe.center));
+        EXPECT_GT(glm::dot(glm::normalize(to - from), n), std::cos(10.0 * kPi / 180.0)) << "along the normal";
+        // On a drawn stroke, within its wobble.
+        double nearest = 1.0;
+        for (const GroundTruthStroke& s : r.truth)
+            if (!s.drag) nearest = std::min(nearest, distance_to_polyline(g.points.front(), s.points));
+        EXPECT_LT(nearest, 0.006);
+    }
+    EXPECT_EQ(drags, 2);
 }
 
 TEST(SynthScenario, SectionStrokesFollowTheirSurfaceInTheAskedDirection)
@@ -953,6 +1068,10 @@ TEST(SynthGroundTruth, JsonRoundTripKeepsEveryField)
         for (std::size_t i = 0; i < back[k].points.size(); ++i) ASSERT_EQ(back[k].points[i], r.truth[k].points[i]);
     }
     EXPECT_TRUE(back[5].drag);
+    EXPECT_EQ(back[0].surface, 0);
+    EXPECT_EQ(back[5].surface, -1);
+    // A stroke naming a surface the file does not have cannot be written.
+    EXPECT_THROW(ground_truth_to_json(r.truth), InvalidInput);
 }
 
 TEST(SynthGroundTruth, BadTruthFilesGiveFileErrors)

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <string>
 #include <utility>
@@ -15,6 +17,7 @@
 #include "core/errors.h"
 #include "input/truth_surface.h"
 #include "meshing/polyline.h"
+#include "tests/test_paths.h"
 
 using namespace lobe;
 using json = nlohmann::json;
@@ -404,4 +407,38 @@ TEST(TruthSurfaceJson, BadSurfacesGiveOneLineInvalidInputNamingTheField)
     s = kidney();
     s.dents[0].depth_mm = 80.0;
     EXPECT_EQ(invalid_input_message([&] { validate_truth_surface(s, "lobe"); }).rfind("lobe.dents:", 0), 0u);
+}
+
+// ---------------------------------------------------------------------------------------
+// Shipped truth files: everything a test needs is in the truth file alone
+// ---------------------------------------------------------------------------------------
+
+TEST(TruthSurfaceShipped, TruthFilesCarryTheScenarioSurfacesAndStrokesLieOnThem)
+{
+    int checked = 0;
+    for (const auto& e : std::filesystem::directory_iterator(test::source_path("recordings"))) {
+        const std::string name = e.path().filename().string();
+        if (!name.ends_with(".scenario.json")) continue;
+        SCOPED_TRACE(name);
+        const std::string stem = e.path().string().substr(0, e.path().string().size() - 14);
+        json truth, scenario;
+        std::ifstream(stem + ".truth.json") >> truth;
+        std::ifstream(stem + ".scenario.json") >> scenario;
+        const std::vector<TruthSurface> surfaces = truth_surfaces_from_json(truth);
+        const std::vector<TruthSurface> expected = truth_surfaces_from_json(scenario);
+        ASSERT_EQ(surfaces.size(), expected.size());
+        for (std::size_t k = 0; k < surfaces.size(); ++k)
+            EXPECT_EQ(truth_surface_to_json(surfaces[k]), truth_surface_to_json(expected[k]));
+        for (const json& st : truth["strokes"]) {
+            if (!st.contains("surface")) continue;
+            EXPECT_EQ(st["kind"], "lobe");
+            const TruthSurface& s = surfaces.at(st["surface"].get<std::size_t>());
+            for (const json& p : st["points"]) {
+                const dvec3 q(p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
+                ASSERT_LT(std::abs(radial_gap(s, q)), 0.0005);
+            }
+            ++checked;
+        }
+    }
+    EXPECT_GE(checked, 48) << "the Table 1 scenes and pinch-edit draw every lobe stroke on a surface";
 }
