@@ -57,7 +57,8 @@ glm::dvec3 normal(const TruthSurface& s, const glm::dvec3& unit_dir);
 /// value bounds the distance from `p` to the surface from above (the surface point on the
 /// same ray is one point of the surface).
 double radial_gap(const TruthSurface& s, const glm::dvec3& p);
-/// `p` moved along its ray from the centre onto the surface. \pre p ≠ center.
+/// `p` moved along its ray from the centre onto the surface.
+/// \throw InvalidInput when `p` is the centre (it has no ray).
 glm::dvec3 project_radially(const TruthSurface& s, const glm::dvec3& p);
 
 /// Checks a surface built in code as the JSON reader does: finite centre, radii 0.02–2 m,
