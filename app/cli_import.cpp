@@ -78,7 +78,7 @@ void add_synth_command(CLI::App& app, int& exit_code)
         for (const char* ext : {".txt", ".lrec"})
             if (stem.size() > std::strlen(ext) && stem.ends_with(ext)) stem.resize(stem.size() - std::strlen(ext));
         truth.replace_filename(stem + ".truth.json");
-        write_file_atomic(truth.string(), ground_truth_to_json(r.truth).dump(1) + "\n");
+        write_file_atomic(truth.string(), ground_truth_to_json(r.truth, r.surfaces).dump(1) + "\n");
         const double duration = r.recording.frames.empty() ? 0.0 : r.recording.frames.back().time;
         progress("wrote " + *out + " (" + std::to_string(r.recording.frames.size()) + " frames, " +
                  std::to_string(duration).substr(0, 6) + " s) and " + truth.string() + " (" +

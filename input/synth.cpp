@@ -48,6 +48,8 @@ constexpr double kMaxRateHz = 240.0;
 constexpr std::size_t kMaxScenarioBytes = std::size_t{64} << 20;
 constexpr std::size_t kMaxTruthBytes = std::size_t{512} << 20;
 constexpr std::size_t kMaxDents = 8;
+constexpr double kMaxSurfaceGap = 0.001;      // control points of a stroke on a surface, metres
+constexpr double kMaxSectionWobble = 0.02;    // metres
 
 constexpr const char* kScenarioFormat = "lobesketch-scenario";
 constexpr const char* kTruthFormat = "lobesketch-ground-truth";
@@ -254,6 +256,15 @@ std::vector<glm::vec3> resample(const DenseCurve& c)
     return out;
 }
 
+/// Moves every point of a densified curve radially onto a lobe surface (the control points
+/// already lie on it; the spline between them strays by micrometres) and redoes the
+/// arc-length table.
+void on_surface(DenseCurve& c, const TruthSurface& surface)
+{
+    for (dvec3& p : c.p) p = project_radially(surface, p);
+    for (std::size_t i = 1; i < c.p.size(); ++i) c.s[i] = c.s[i - 1] + glm::distance(c.p[i - 1], c.p[i]);
+}
+
 double polyline_length(const std::vector<glm::vec3>& c, bool closed)
 {
     double len = 0.0;
@@ -299,6 +310,8 @@ void validate_scenario(const Scenario& s)
         fail("steps", std::to_string(s.steps.size()) + " steps exceed the limit of " + std::to_string(kMaxSteps));
     if (!(s.uniform_joint_radius_m >= 0.0 && s.uniform_joint_radius_m <= 0.05))
         fail("uniform_joint_radius", num(s.uniform_joint_radius_m) + " m is outside [0, 0.05]");
+    for (std::size_t k = 0; k < s.surfaces.size(); ++k)
+        validate_truth_surface(s.surfaces[k], "surfaces[" + std::to_string(k) + "]");
     double estimate = 1.5;
     double total_length = 0.0;
     for (std::size_t i = 0; i < s.steps.size(); ++i) {
@@ -322,6 +335,20 @@ void validate_scenario(const Scenario& s)
             total_length += len;
             if (total_length > kMaxTotalStrokeLength)
                 fail("steps", "strokes add up to more than " + num(kMaxTotalStrokeLength) + " m");
+            if (sk.surface != -1) {
+                if (st.type == ScenarioStep::Type::Drag || sk.surface < 0 ||
+                    static_cast<std::size_t>(sk.surface) >= s.surfaces.size())
+                    fail(step_field(i, "surface"), "names no surface (the scenario has " +
+                                                       std::to_string(s.surfaces.size()) + ")");
+                const TruthSurface& surf = s.surfaces[static_cast<std::size_t>(sk.surface)];
+                for (std::size_t k = 0; k < sk.curve.size(); ++k) {
+                    const double gap = radial_gap(surf, to_d(sk.curve[k]));
+                    if (!(std::abs(gap) <= kMaxSurfaceGap) || glm::distance(to_d(sk.curve[k]), surf.center) < 1e-6)
+                        fail(field + "[" + std::to_string(k) + "]",
+                             "lies " + num(gap * 1000.0) + " mm off surface " + std::to_string(sk.surface) +
+                                 " (a stroke drawn on a surface must lie on it within 1 mm)");
+                }
+            }
             if (sk.speed_mps != 0.0 && !(sk.speed_mps >= kMinSpeed && sk.speed_mps <= kMaxSpeed))
                 fail(step_field(i, "speed"), num(sk.speed_mps) + " m/s is outside [" + num(kMinSpeed) + ", " +
                                                  num(kMaxSpeed) + "]");
@@ -522,7 +549,70 @@ std::vector<glm::vec3> ellipse_curve(const json& e, const std::string& field, st
     return out;
 }
 
-ScenarioStroke parse_stroke_path(const json& s, const std::string& field, std::uint64_t gen_seed, bool drag)
+/// The "section" generator: the intersection of a lobe surface with a plane, every 2° of
+/// azimuth, with an optional smooth wobble that slides the points along the surface
+/// (docs/scenario-format.md). Returns the control polyline; `full` tells a whole loop and
+/// `surface` which surface it lies on.
+std::vector<glm::vec3> section_curve(const json& e, const std::string& field, std::uint64_t seed,
+                                     const std::vector<TruthSurface>& surfaces, bool& full, int& surface)
+{
+    if (!e.is_object()) fail(field, "expected an object");
+    allow_only(e, field, {"surface", "normal", "offset_m", "start_angle_deg", "sweep_deg", "wobble_mm", "direction"});
+    auto sit = e.find("surface");
+    if (sit == e.end()) fail(field, "missing 'surface'");
+    if (!sit->is_number_integer() || sit->get<std::int64_t>() < 0 ||
+        sit->get<std::int64_t>() >= static_cast<std::int64_t>(surfaces.size()))
+        fail(field + ".surface", surfaces.empty() ? std::string("the scenario defines no \"surfaces\"")
+                                                  : "expected an index 0–" + std::to_string(surfaces.size() - 1) +
+                                                        " into \"surfaces\"");
+    surface = static_cast<int>(sit->get<std::int64_t>());
+    SurfaceSection sec;
+    if (e.contains("normal")) sec.plane_normal = to_d(parse_vec3(e["normal"], field + ".normal"));
+    if (glm::length(sec.plane_normal) < 1e-6) fail(field + ".normal", "must not be zero");
+    sec.plane_normal = glm::normalize(sec.plane_normal);
+    sec.offset_m = get_number(e, "offset_m", field, 0.0);
+    if (!(std::abs(sec.offset_m) <= kMaxSurfaceRadius)) fail(field + ".offset_m", "expected a distance within ±2 m");
+    sec.start_angle_deg = get_number(e, "start_angle_deg", field, 0.0);
+    sec.sweep_deg = get_number(e, "sweep_deg", field, 360.0);
+    if (!(std::abs(sec.start_angle_deg) <= 3600.0)) fail(field + ".start_angle_deg", "expected a finite angle within ±3600°");
+    if (!(sec.sweep_deg > 0.0 && sec.sweep_deg <= 360.0)) fail(field + ".sweep_deg", num(sec.sweep_deg) + "° is outside (0, 360]");
+    if (e.contains("direction")) {
+        const json& d = e["direction"];
+        if (!d.is_number_integer() || (d.get<std::int64_t>() != 1 && d.get<std::int64_t>() != -1))
+            fail(field + ".direction", "expected 1 (counter-clockwise about the normal) or -1");
+        sec.direction = static_cast<int>(d.get<std::int64_t>());
+    }
+    const double wobble = get_number(e, "wobble_mm", field, 0.0) * 0.001;
+    if (!(wobble >= 0.0 && wobble <= kMaxSectionWobble)) fail(field + ".wobble_mm", "expected 0–20 mm");
+    sec.step_deg = 2.0;
+
+    // Smooth wobble across the curve: integer harmonics of the azimuth, so a loop closes on
+    // itself. It slides the points along the surface (section_points), never off it.
+    Rng rng(seed);
+    std::array<double, 3> amp{}, ph{};
+    const std::array<double, 3> harm = {2.0, 3.0, 4.0};
+    const std::array<double, 3> share = {0.5, 0.3, 0.2};
+    for (int h = 0; h < 3; ++h) {
+        amp[h] = wobble * share[h] * rng.uniform(0.7, 1.3);
+        ph[h] = rng.uniform(0.0, kTwoPi);
+    }
+    SectionAcross across;
+    if (wobble > 0.0)
+        across = [amp, ph, harm](double phi) {
+            double off = 0.0;
+            for (int h = 0; h < 3; ++h) off += amp[h] * std::sin(harm[h] * phi + ph[h]);
+            return off;
+        };
+    full = sec.sweep_deg >= 360.0;
+    const std::vector<dvec3> pts = section_points(surfaces[static_cast<std::size_t>(surface)], sec, field, across);
+    std::vector<glm::vec3> out;
+    out.reserve(pts.size());
+    for (const dvec3& p : pts) out.push_back(glm::vec3(p));
+    return out;
+}
+
+ScenarioStroke parse_stroke_path(const json& s, const std::string& field, std::uint64_t gen_seed, bool drag,
+                                 const std::vector<TruthSurface>& surfaces)
 {
     ScenarioStroke st;
     st.hand = parse_hand(s, field);
@@ -550,8 +640,15 @@ ScenarioStroke parse_stroke_path(const json& s, const std::string& field, std::u
         st.curve = {required_vec3(s, "from", field), required_vec3(s, "to", field)};
         ++sources;
     }
+    if (!drag && s.contains("section")) {
+        bool full = false;
+        st.curve = section_curve(s["section"], field + ".section", gen_seed, surfaces, full, st.surface);
+        default_closed = full;
+        ++sources;
+    }
     if (sources != 1)
-        fail(field, drag ? "give exactly one of 'curve' or 'from'/'to'" : "give exactly one of 'curve' or 'ellipse'");
+        fail(field, drag ? "give exactly one of 'curve' or 'from'/'to'"
+                         : "give exactly one of 'curve', 'ellipse' or 'section'");
     st.closed = default_closed;
     if (s.contains("closed")) {
         if (!s["closed"].is_boolean()) fail(field + ".closed", "expected true or false");
@@ -563,7 +660,7 @@ ScenarioStroke parse_stroke_path(const json& s, const std::string& field, std::u
     return st;
 }
 
-ScenarioStep parse_step(const json& s, std::size_t i, std::uint64_t seed)
+ScenarioStep parse_step(const json& s, std::size_t i, std::uint64_t seed, const std::vector<TruthSurface>& surfaces)
 {
     const std::string field = step_field(i, "");
     if (!s.is_object()) fail(field, "expected an object");
@@ -573,14 +670,14 @@ ScenarioStep parse_step(const json& s, std::size_t i, std::uint64_t seed)
     ScenarioStep st;
     const std::uint64_t gen_seed = stream_seed(seed, kTagGenerator + i);
     if (type == "stroke") {
-        allow_only(s, field, {"type", "kind", "hand", "closed", "curve", "ellipse", "speed"});
+        allow_only(s, field, {"type", "kind", "hand", "closed", "curve", "ellipse", "section", "speed"});
         st.type = ScenarioStep::Type::Stroke;
-        st.stroke = parse_stroke_path(s, field, gen_seed, false);
+        st.stroke = parse_stroke_path(s, field, gen_seed, false, surfaces);
         st.hand = st.stroke.hand;
     } else if (type == "drag") {
         allow_only(s, field, {"type", "hand", "closed", "curve", "from", "to", "speed"});
         st.type = ScenarioStep::Type::Drag;
-        st.stroke = parse_stroke_path(s, field, gen_seed, true);
+        st.stroke = parse_stroke_path(s, field, gen_seed, true, surfaces);
         st.hand = st.stroke.hand;
     } else if (type == "near_pinch" || type == "grab") {
         allow_only(s, field, {"type", "hand", "at", "duration"});
@@ -773,6 +870,7 @@ struct Instant {
 
 struct Synth {
     Person person;
+    std::vector<TruthSurface> surfaces;
     std::vector<DenseCurve> curves;
     std::array<Track, kHandCount> tracks;
     dvec3 work_centre{0.0, 1.3, -0.45};
@@ -964,6 +1062,7 @@ void build_stroke(Synth& sy, Build& out, const ScenarioStep& step, Rng& rng)
     const ScenarioStroke& sk = step.stroke;
     const int curve_id = static_cast<int>(sy.curves.size());
     sy.curves.push_back(densify(sk.curve, sk.closed));
+    if (sk.surface >= 0) on_surface(sy.curves.back(), sy.surfaces[static_cast<std::size_t>(sk.surface)]);
     const DenseCurve& curve = sy.curves.back();
     const bool drag = step.type == ScenarioStep::Type::Drag;
     const double speed = choose_speed(sk, curve.length(), drag, rng);
@@ -995,6 +1094,7 @@ void build_stroke(Synth& sy, Build& out, const ScenarioStep& step, Rng& rng)
     gt.hand = sk.hand;
     gt.closed = sk.closed;
     gt.drag = drag;
+    gt.surface = sk.surface;
     gt.points = resample(curve);
     out.truth.push_back(std::move(gt));
 }
@@ -1248,7 +1348,7 @@ Scenario scenario_from_json(const nlohmann::json& j)
 {
     if (!j.is_object()) fail("scenario", "expected a JSON object");
     allow_only(j, "scenario", {"format", "version", "name", "description", "seed", "rate_hz", "steps",
-                               "uniform_joint_radius", "noise", "dropouts"});
+                               "uniform_joint_radius", "noise", "dropouts", "surfaces"});
     auto fit = j.find("format");
     if (fit == j.end() || !fit->is_string() || *fit != kScenarioFormat)
         fail("format", std::string("expected \"") + kScenarioFormat + "\"");
@@ -1274,12 +1374,13 @@ Scenario scenario_from_json(const nlohmann::json& j)
         if (!j[flag].is_boolean()) fail(flag, "expected true or false");
         (std::string(flag) == "noise" ? s.noise : s.dropouts) = j[flag].get<bool>();
     }
+    s.surfaces = truth_surfaces_from_json(j);
     auto sit = j.find("steps");
     if (sit == j.end() || !sit->is_array()) fail("steps", "missing array of steps");
     if (sit->size() > kMaxSteps)
         fail("steps", std::to_string(sit->size()) + " steps exceed the limit of " + std::to_string(kMaxSteps));
     s.steps.reserve(sit->size());
-    for (std::size_t i = 0; i < sit->size(); ++i) s.steps.push_back(parse_step((*sit)[i], i, s.seed));
+    for (std::size_t i = 0; i < sit->size(); ++i) s.steps.push_back(parse_step((*sit)[i], i, s.seed, s.surfaces));
     validate_scenario(s);
     return s;
 }
@@ -1307,6 +1408,7 @@ SynthResult synthesize(const Scenario& scenario)
     validate_scenario(scenario);
     Synth sy;
     sy.person = make_person(scenario.seed, scenario.uniform_joint_radius_m);
+    sy.surfaces = scenario.surfaces;
 
     // Where the work is (the head looks there between strokes).
     {
@@ -1447,24 +1549,34 @@ SynthResult synthesize(const Scenario& scenario)
     }
     result.truth = std::move(out.truth);
     result.spans = std::move(out.spans);
+    result.surfaces = scenario.surfaces;
     return result;
 }
 
-nlohmann::json ground_truth_to_json(const std::vector<GroundTruthStroke>& truth)
+nlohmann::json ground_truth_to_json(const std::vector<GroundTruthStroke>& truth, const std::vector<TruthSurface>& surfaces)
 {
+    json surf = json::array();
+    for (const TruthSurface& s : surfaces) surf.push_back(truth_surface_to_json(s));
     json strokes = json::array();
     for (const GroundTruthStroke& g : truth) {
         json pts = json::array();
         for (const glm::vec3& p : g.points) pts.push_back({p.x, p.y, p.z});
-        strokes.push_back({{"kind", stroke_kind_name(g.kind)},
-                           {"hand", hand_name(g.hand)},
-                           {"closed", g.closed},
-                           {"drag", g.drag},
-                           {"t_begin", g.t_begin},
-                           {"t_end", g.t_end},
-                           {"points", std::move(pts)}});
+        json stroke = {{"kind", stroke_kind_name(g.kind)},
+                       {"hand", hand_name(g.hand)},
+                       {"closed", g.closed},
+                       {"drag", g.drag},
+                       {"t_begin", g.t_begin},
+                       {"t_end", g.t_end}};
+        if (g.surface >= 0) {
+            if (static_cast<std::size_t>(g.surface) >= surfaces.size())
+                throw InvalidInput("ground_truth_to_json: a stroke names surface " + std::to_string(g.surface) + " of " +
+                                   std::to_string(surfaces.size()) + " given surfaces");
+            stroke["surface"] = g.surface;
+        }
+        stroke["points"] = std::move(pts);
+        strokes.push_back(std::move(stroke));
     }
-    return {{"format", kTruthFormat}, {"version", 1}, {"strokes", std::move(strokes)}};
+    return {{"format", kTruthFormat}, {"version", 1}, {"surfaces", std::move(surf)}, {"strokes", std::move(strokes)}};
 }
 
 std::vector<GroundTruthStroke> load_ground_truth(const std::string& path)
@@ -1482,6 +1594,7 @@ std::vector<GroundTruthStroke> load_ground_truth(const std::string& path)
         if (!j.contains("version") || !j["version"].is_number_integer() || j["version"].get<std::int64_t>() != 1)
             fail("version", "unsupported (this build reads 1)");
         if (!j.contains("strokes") || !j["strokes"].is_array()) fail("strokes", "missing array");
+        const std::size_t surface_count = truth_surfaces_from_json(j).size();
         std::vector<GroundTruthStroke> out;
         const json& arr = j["strokes"];
         for (std::size_t i = 0; i < arr.size(); ++i) {
@@ -1505,6 +1618,14 @@ std::vector<GroundTruthStroke> load_ground_truth(const std::string& path)
             g.t_end = get_number(s, "t_end", field, 0.0);
             if (!std::isfinite(g.t_begin) || !std::isfinite(g.t_end) || g.t_end < g.t_begin)
                 fail(field, "t_begin/t_end are not a time span");
+            if (s.contains("surface")) {
+                const json& sf = s["surface"];
+                if (!sf.is_number_integer() || sf.get<std::int64_t>() < 0 ||
+                    sf.get<std::int64_t>() >= static_cast<std::int64_t>(surface_count))
+                    fail(field + ".surface", "expected an index into the file's " + std::to_string(surface_count) +
+                                                 " surfaces");
+                g.surface = static_cast<int>(sf.get<std::int64_t>());
+            }
             if (!s.contains("points")) fail(field + ".points", "missing");
             g.points = parse_curve(s["points"], field + ".points");
             out.push_back(std::move(g));

@@ -14,6 +14,7 @@
 
 #include "core/stroke.h"
 #include "input/recording.h"
+#include "input/truth_surface.h"
 
 namespace lobe {
 
@@ -24,6 +25,10 @@ struct ScenarioStroke {
     std::vector<glm::vec3> curve; ///< control polyline in metres (densified by the synthesizer)
     bool closed = false;          ///< the curve returns to its start
     double speed_mps = 0.0;       ///< peak speed; 0 = chosen by the synthesizer in [0.2, 1] m/s
+    /// Index into Scenario::surfaces of the lobe surface the stroke is drawn on (−1: none).
+    /// The control points must lie on it (within 1 mm); the densified path is then moved
+    /// radially onto it, so the hand and the ground truth follow the surface exactly.
+    int surface = -1;
 };
 
 /// A scenario step: a stroke, a distractor gesture or a raw input event.
@@ -41,6 +46,7 @@ struct ScenarioStep {
 
 struct Scenario {
     std::string name;
+    std::vector<TruthSurface> surfaces; ///< the lobe surfaces ("surfaces"; strokes may be drawn on them)
     std::uint64_t seed = 1;
     double rate_hz = 90.0;
     std::vector<ScenarioStep> steps;
@@ -63,6 +69,7 @@ struct GroundTruthStroke {
     double t_begin = 0.0;          ///< recording time of the pinch start and end
     double t_end = 0.0;
     bool drag = false;             ///< from a Drag step (an edit, not a drawn stroke)
+    int surface = -1;              ///< index of the lobe surface it was drawn on (−1: none)
 };
 
 /// When a distractor or a tracking drop-out happened, for tests.
@@ -78,6 +85,7 @@ struct SynthSpan {
 struct SynthResult {
     Recording recording;
     std::vector<GroundTruthStroke> truth;
+    std::vector<TruthSurface> surfaces; ///< the scenario's lobe surfaces (GroundTruthStroke::surface indexes them)
     std::vector<SynthSpan> spans; ///< sorted by t_begin
 };
 
@@ -85,8 +93,12 @@ struct SynthResult {
 /// \throw InvalidInput naming the field when the scenario is out of bounds.
 SynthResult synthesize(const Scenario& scenario);
 
-nlohmann::json ground_truth_to_json(const std::vector<GroundTruthStroke>& truth);
-/// \throw FileError
+/// The ground-truth file (docs/scenario-format.md, "Ground truth"): the strokes and the
+/// scenario's lobe surfaces (read them back with truth_surfaces_from_json).
+/// \throw InvalidInput when a stroke's `surface` indexes none of `surfaces`.
+nlohmann::json ground_truth_to_json(const std::vector<GroundTruthStroke>& truth,
+                                    const std::vector<TruthSurface>& surfaces = {});
+/// \throw FileError (also for a stroke's "surface" index that names no surface of the file)
 std::vector<GroundTruthStroke> load_ground_truth(const std::string& path);
 
 } // namespace lobe

@@ -3,9 +3,12 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <limits>
+#include <sstream>
 
 #include <glm/geometric.hpp>
+#include <nlohmann/json.hpp>
 
 #include "input/importers.h"
 #include "input/pipeline.h"
@@ -162,6 +165,28 @@ TEST(ReplayScenario, FreshlySynthesizedScenariosRecoverEachGroundTruthStrokeOnce
         expect_strokes_match_truth(run_input_pipeline(fresh.recording), fresh.truth, sc);
         Recording text = parse_recording(encode_recording_text(fresh.recording), sc + " (text)");
         expect_strokes_match_truth(run_input_pipeline(text), fresh.truth, sc + " (text)");
+    }
+}
+
+TEST(ReplayScenario, ShippedRecordingsAreUpToDateWithTheirScenarios)
+{
+    // The synthesizer is deterministic, so each shipped recording and truth file must be what
+    // its scenario gives today; when this fails, run scripts/make-recordings.sh.
+    auto read_all = [](const std::string& path) {
+        std::ifstream in(path, std::ios::binary);
+        std::ostringstream os;
+        os << in.rdbuf();
+        return os.str();
+    };
+    for (const std::string& sc : shipped_scenarios()) {
+        SCOPED_TRACE(sc);
+        const std::string stem = sc.substr(0, sc.size() - std::string(".scenario.json").size());
+        const SynthResult fresh = synthesize(load_scenario(sc));
+        EXPECT_TRUE(encode_recording_binary(fresh.recording) == read_all(stem + ".lrec"))
+            << stem << ".lrec is stale: run scripts/make-recordings.sh";
+        const nlohmann::json truth = nlohmann::json::parse(read_all(stem + ".truth.json"));
+        EXPECT_TRUE(truth == ground_truth_to_json(fresh.truth, fresh.surfaces))
+            << stem << ".truth.json is stale: run scripts/make-recordings.sh";
     }
 }
 

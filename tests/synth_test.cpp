@@ -32,12 +32,13 @@ struct Shipped {
     int lobe_strokes;
     int trunk_strokes;
     int drags;
+    std::vector<int> lobe_strokes_per_lobe; ///< one lobe surface each
 };
 const Shipped kShipped[] = {
-    {"recordings/table1-1lobe-5strokes.scenario.json", 5, 3, 0},
-    {"recordings/table1-4lobes-22strokes.scenario.json", 22, 4, 0},
-    {"recordings/table1-3lobes-16strokes.scenario.json", 16, 3, 0},
-    {"recordings/pinch-edit.scenario.json", 5, 0, 2},
+    {"recordings/table1-1lobe-5strokes.scenario.json", 5, 3, 0, {5}},
+    {"recordings/table1-4lobes-22strokes.scenario.json", 22, 4, 0, {6, 5, 6, 5}},
+    {"recordings/table1-3lobes-16strokes.scenario.json", 16, 3, 0, {6, 5, 5}},
+    {"recordings/pinch-edit.scenario.json", 5, 0, 2, {5}},
 };
 
 /// Each shipped scenario synthesized once per test run.
@@ -196,7 +197,7 @@ TEST(SynthScenario, SameScenarioGivesBitIdenticalFramesTwice)
         EXPECT_TRUE(same_bits(a.recording.events[i].time, b.recording.events[i].time));
         EXPECT_EQ(a.recording.events[i].code, b.recording.events[i].code);
     }
-    EXPECT_EQ(ground_truth_to_json(a.truth).dump(), ground_truth_to_json(b.truth).dump());
+    EXPECT_EQ(ground_truth_to_json(a.truth, a.surfaces).dump(), ground_truth_to_json(b.truth, b.surfaces).dump());
 
     s.seed += 1;
     SynthResult c = synthesize(s);
@@ -276,6 +277,161 @@ TEST(SynthScenario, KidneyLobeOfTheFourLobeTreeIsNonConvex)
     ASSERT_GE(r.truth.size(), 14u);
     EXPECT_FALSE(turns_both_ways(r.truth[0])) << "the first loop of the top lobe is convex";
     for (std::size_t k = 11; k <= 13; ++k) EXPECT_TRUE(turns_both_ways(r.truth[k])) << "kidney loop " << k;
+}
+
+TEST(SynthScenario, ShippedLobeStrokesAreDrawnOnOneSurfacePerLobe)
+{
+    for (const Shipped& sc : kShipped) {
+        SCOPED_TRACE(sc.file);
+        const SynthResult& r = shipped(sc.file);
+        ASSERT_EQ(r.surfaces.size(), sc.lobe_strokes_per_lobe.size());
+        std::vector<double> new_lobe; // N presses: the next lobe stroke starts the next lobe
+        for (const InputEvent& e : r.recording.events)
+            if (e.kind == InputEventKind::Key && e.code == keys::kNewLobe && e.value == 1) new_lobe.push_back(e.time);
+        std::vector<int> per_lobe(r.surfaces.size(), 0);
+        for (const GroundTruthStroke& g : r.truth) {
+            if (g.drag || g.kind != StrokeKind::Lobe) {
+                EXPECT_EQ(g.surface, -1);
+                continue;
+            }
+            ASSERT_GE(g.surface, 0);
+            ASSERT_LT(static_cast<std::size_t>(g.surface), r.surfaces.size());
+            ++per_lobe[static_cast<std::size_t>(g.surface)];
+            const auto presses = std::count_if(new_lobe.begin(), new_lobe.end(), [&](double t) { return t < g.t_begin; });
+            EXPECT_EQ(g.surface, presses) << "lobe strokes between two N keys share their surface";
+            // The path the fingertip follows is on the surface (float rounding only).
+            for (const glm::vec3& p : g.points)
+                ASSERT_LT(std::abs(radial_gap(r.surfaces[static_cast<std::size_t>(g.surface)], glm::dvec3(p))), 1e-5);
+        }
+        EXPECT_EQ(per_lobe, sc.lobe_strokes_per_lobe);
+    }
+}
+
+TEST(SynthScenario, ShippedLobesAreEnclosedByTheirStrokes)
+{
+    // A person enclosing foliage leaves no empty patch wider than about 60° of arc seen from
+    // the lobe's centre: every direction is within 30° of a stroke.
+    std::vector<glm::dvec3> probes;
+    for (int i = 0; i < 4000; ++i) {
+        const double z = 1.0 - (2.0 * i + 1.0) / 4000.0, rho = std::sqrt(1.0 - z * z);
+        const double phi = kPi * (3.0 - std::sqrt(5.0)) * i;
+        probes.emplace_back(rho * std::cos(phi), rho * std::sin(phi), z);
+    }
+    for (const Shipped& sc : kShipped) {
+        const SynthResult& r = shipped(sc.file);
+        for (std::size_t k = 0; k < r.surfaces.size(); ++k) {
+            SCOPED_TRACE(std::string(sc.file) + " lobe " + std::to_string(k));
+            std::vector<glm::dvec3> dirs;
+            bool closed = false, open = false;
+            for (const GroundTruthStroke& g : r.truth) {
+                if (g.surface != static_cast<int>(k)) continue;
+                (g.closed ? closed : open) = true;
+                for (std::size_t i = 0; i < g.points.size(); i += 4)
+                    dirs.push_back(glm::normalize(glm::dvec3(g.points[i]) - r.surfaces[k].center));
+            }
+            EXPECT_TRUE(closed) << "every lobe has loops";
+            double widest = 0.0;
+            for (const glm::dvec3& u : probes) {
+                double nearest = kPi;
+                for (const glm::dvec3& d : dirs) nearest = std::min(nearest, std::acos(std::clamp(glm::dot(u, d), -1.0, 1.0)));
+                widest = std::max(widest, nearest);
+            }
+            EXPECT_LE(widest * 180.0 / kPi, 30.0);
+        }
+    }
+}
+
+TEST(SynthScenario, KidneyLobeSurfaceHasADeepWideDentThatItsStrokesCross)
+{
+    const SynthResult& r = shipped(kShipped[1].file);
+    ASSERT_EQ(r.surfaces.size(), 4u);
+    const TruthSurface& kidney = r.surfaces[2];
+    ASSERT_EQ(kidney.dents.size(), 1u);
+    const SurfaceDent& dent = kidney.dents[0];
+    EXPECT_GE(dent.depth_mm, 40.0);
+    EXPECT_GE(dent.width_deg, 60.0);
+    EXPECT_LT(dent.direction.x, -0.9) << "the dent faces the trunk";
+    // Clearly non-convex: the chord between the surface points 50° either side of the dent
+    // passes more than 1.5 cm outside the surface.
+    const double side = 50.0 * kPi / 180.0;
+    const glm::dvec3 a = point(kidney, glm::dvec3(-std::cos(side), 0.0, std::sin(side)));
+    const glm::dvec3 b = point(kidney, glm::dvec3(-std::cos(side), 0.0, -std::sin(side)));
+    EXPECT_GT(radial_gap(kidney, 0.5 * (a + b)), 0.015);
+    // Its strokes cross the dent (pass well inside its width), so the dent shows in them.
+    int crossing = 0;
+    for (const GroundTruthStroke& g : r.truth) {
+        if (g.surface != 2) continue;
+        double closest = kPi;
+        for (const glm::vec3& p : g.points)
+            closest = std::min(closest, std::acos(std::clamp(glm::dot(glm::normalize(glm::dvec3(p) - kidney.center),
+                                                                      dent.direction), -1.0, 1.0)));
+        crossing += closest < 0.75 * dent.width_deg * kPi / 180.0;
+    }
+    EXPECT_GE(crossing, 4);
+}
+
+TEST(SynthScenario, PinchEditDragsStartOnTheLobeAndPullFiveCentimetresOutwards)
+{
+    const SynthResult& r = shipped(kShipped[3].file);
+    ASSERT_EQ(r.surfaces.size(), 1u);
+    const TruthSurface& lobe = r.surfaces[0];
+    int drags = 0;
+    for (const GroundTruthStroke& g : r.truth) {
+        if (!g.drag) continue;
+        ++drags;
+        const glm::dvec3 from(g.points.front()), to(g.points.back());
+        EXPECT_LT(std::abs(radial_gap(lobe, from)), 0.001) << "starts on the surface";
+        EXPECT_NEAR(glm::distance(from, to), 0.05, 0.002);
+        const glm::dvec3 n = normal(lobe, glm::normalize(from - lobe.center));
+        EXPECT_GT(glm::dot(glm::normalize(to - from), n), std::cos(10.0 * kPi / 180.0)) << "along the normal";
+        // On a drawn stroke, within its wobble.
+        double nearest = 1.0;
+        for (const GroundTruthStroke& s : r.truth)
+            if (!s.drag) nearest = std::min(nearest, distance_to_polyline(g.points.front(), s.points));
+        EXPECT_LT(nearest, 0.006);
+    }
+    EXPECT_EQ(drags, 2);
+}
+
+TEST(SynthScenario, SectionStrokesFollowTheirSurfaceInTheAskedDirection)
+{
+    json j = minimal_scenario();
+    j["noise"] = false;
+    j["dropouts"] = false;
+    j["surfaces"] = json::array({json{{"center", {0.05, 1.35, -0.42}}, {"radii", {0.12, 0.1, 0.14}},
+                                      {"dents", {{{"direction", {-1, 0, 0}}, {"depth_mm", 30}, {"width_deg", 60}}}}}});
+    j["steps"] = json::array();
+    for (int dir : {1, -1})
+        j["steps"].push_back({{"type", "stroke"},
+                              {"section", {{"surface", 0}, {"normal", {0, 1, 0}}, {"offset_m", 0.03},
+                                           {"direction", dir}, {"wobble_mm", 4}}}});
+    j["steps"].push_back({{"type", "stroke"},
+                          {"section", {{"surface", 0}, {"normal", {0, 0, 1}}, {"start_angle_deg", 20}, {"sweep_deg", 140}}}});
+    const Scenario sc = scenario_from_json(j);
+    ASSERT_EQ(sc.surfaces.size(), 1u);
+    const SynthResult r = synthesize(sc);
+    ASSERT_EQ(r.truth.size(), 3u);
+    const TruthSurface& s = r.surfaces[0];
+    for (const GroundTruthStroke& g : r.truth) {
+        EXPECT_EQ(g.surface, 0);
+        for (const glm::vec3& p : g.points) ASSERT_LT(std::abs(radial_gap(s, glm::dvec3(p))), 1e-5);
+    }
+    // Normal +Y: azimuth 0 is +X and 90° is −Z (far); −1 goes the other way round.
+    EXPECT_TRUE(r.truth[0].closed);
+    EXPECT_GT(r.truth[0].points.front().x, 0.1f);
+    EXPECT_LT(r.truth[0].points[40].z, -0.42f);
+    EXPECT_GT(r.truth[1].points[40].z, -0.42f);
+    // The wobble differs per step and leaves the plane by millimetres; the loop still closes.
+    double off0 = 0.0, off1 = 0.0;
+    for (const glm::vec3& p : r.truth[0].points) off0 = std::max(off0, std::abs(p.y - 1.38));
+    for (const glm::vec3& p : r.truth[1].points) off1 = std::max(off1, std::abs(p.y - 1.38));
+    EXPECT_GT(off0, 0.001);
+    EXPECT_LT(off0, 0.008);
+    EXPECT_NE(off0, off1);
+    EXPECT_LT(glm::distance(r.truth[0].points.front(), r.truth[0].points.back()), 1e-4f);
+    // An arc over the top is open and ends where asked.
+    EXPECT_FALSE(r.truth[2].closed);
+    EXPECT_GT(r.truth[2].points[r.truth[2].points.size() / 2].y, 1.44f);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -780,6 +936,44 @@ TEST(SynthScenarioErrors, BadScenariosGiveOneLineInvalidInputNamingTheField)
                                     {"dents", {{{"angle_deg", 0}, {"depth_mm", 90}, {"width_deg", 40}}}}};
         cases.push_back({"dent deeper than the ellipse", j, "steps[0].ellipse.dents[0].depth_mm"});
     }
+    auto with_section = [](json section) {
+        json j = minimal_scenario();
+        j["surfaces"] = json::array({json{{"center", {0.0, 1.3, -0.4}}, {"radii", {0.12, 0.1, 0.14}}}});
+        j["steps"][0].erase("curve");
+        j["steps"][0]["section"] = std::move(section);
+        return j;
+    };
+    cases.push_back({"section without surfaces",
+                     [&] { json j = with_section({{"surface", 0}}); j.erase("surfaces"); return j; }(),
+                     "steps[0].section.surface"});
+    cases.push_back({"section on surface 1 of 1", with_section({{"surface", 1}}), "steps[0].section.surface"});
+    cases.push_back({"section without a surface", with_section({{"normal", {0, 1, 0}}}), "steps[0].section"});
+    cases.push_back({"section misspelt field", with_section({{"surface", 0}, {"ofset_m", 0.02}}), "steps[0].section"});
+    cases.push_back({"section plane misses", with_section({{"surface", 0}, {"offset_m", 0.15}}), "steps[0].section.offset_m"});
+    cases.push_back({"section direction 2", with_section({{"surface", 0}, {"direction", 2}}), "steps[0].section.direction"});
+    cases.push_back({"section zero normal", with_section({{"surface", 0}, {"normal", {0, 0, 0}}}), "steps[0].section.normal"});
+    cases.push_back({"section sweep 400°", with_section({{"surface", 0}, {"sweep_deg", 400}}), "steps[0].section.sweep_deg"});
+    cases.push_back({"section wobble 30 mm", with_section({{"surface", 0}, {"wobble_mm", 30}}), "steps[0].section.wobble_mm"});
+    {
+        json j = with_section({{"surface", 0}});
+        j["steps"][0]["curve"] = json::array({json::array({0.0, 1.3, -0.4}), json::array({0.1, 1.3, -0.4})});
+        cases.push_back({"section and curve", j, "steps[0]"});
+    }
+    {
+        json j = with_section({{"surface", 0}});
+        j["surfaces"][0]["radii"] = {0.12, 0.1, 3.0};
+        cases.push_back({"surface radius 3 m", j, "surfaces[0].radii"});
+    }
+    {
+        json j = with_section({{"surface", 0}});
+        j["surfaces"][0]["dents"] = {{{"direction", {1, 0, 0}}, {"depth_mm", 100}}};
+        cases.push_back({"dent leaving 17 %", j, "surfaces[0].dents"});
+    }
+    {
+        json j = with_section({{"surface", 0}});
+        j["surfaces"] = json::object();
+        cases.push_back({"surfaces not an array", j, "surfaces"});
+    }
     for (const Case& c : cases) {
         SCOPED_TRACE(c.what);
         std::string msg = invalid_input_message([&] { scenario_from_json(c.scenario); });
@@ -800,6 +994,15 @@ TEST(SynthScenarioErrors, ScenariosBuiltInCodeAreCheckedToo)
     s = scenario_from_json(minimal_scenario());
     s.rate_hz = 0.0;
     EXPECT_NE(invalid_input_message([&] { synthesize(s); }).find("rate_hz"), std::string::npos);
+    // A stroke said to lie on a surface must name one and lie on it.
+    s = scenario_from_json(minimal_scenario());
+    s.steps[0].stroke.surface = 0;
+    EXPECT_NE(invalid_input_message([&] { synthesize(s); }).find("steps[0].surface"), std::string::npos);
+    s.surfaces.push_back(TruthSurface{});
+    s.surfaces[0].center = glm::dvec3(0.1, 1.3, -0.4);
+    EXPECT_NE(invalid_input_message([&] { synthesize(s); }).find("off surface 0"), std::string::npos);
+    s.surfaces[0].radii.y = 0.01;
+    EXPECT_NE(invalid_input_message([&] { synthesize(s); }).find("surfaces[0].radii"), std::string::npos);
 }
 
 TEST(SynthScenarioErrors, BadFilesGiveOneLineFileErrorsNamingTheFile)
@@ -844,9 +1047,12 @@ TEST(SynthGroundTruth, JsonRoundTripKeepsEveryField)
     const SynthResult& r = shipped(kShipped[3].file);
     const std::string dir = test::temp_dir("synth-truth");
     const std::string path = dir + "/pinch-edit.truth.json";
-    json j = ground_truth_to_json(r.truth);
+    json j = ground_truth_to_json(r.truth, r.surfaces);
     EXPECT_EQ(j["format"], "lobesketch-ground-truth");
     EXPECT_EQ(j["version"], 1);
+    const std::vector<TruthSurface> surfaces = truth_surfaces_from_json(j);
+    ASSERT_EQ(surfaces.size(), r.surfaces.size());
+    for (std::size_t k = 0; k < surfaces.size(); ++k) EXPECT_EQ(truth_surface_to_json(surfaces[k]), truth_surface_to_json(r.surfaces[k]));
     std::ofstream(path) << j.dump();
     std::vector<GroundTruthStroke> back = load_ground_truth(path);
     ASSERT_EQ(back.size(), r.truth.size());
@@ -857,10 +1063,15 @@ TEST(SynthGroundTruth, JsonRoundTripKeepsEveryField)
         EXPECT_EQ(back[k].drag, r.truth[k].drag);
         EXPECT_EQ(back[k].t_begin, r.truth[k].t_begin);
         EXPECT_EQ(back[k].t_end, r.truth[k].t_end);
+        EXPECT_EQ(back[k].surface, r.truth[k].surface);
         ASSERT_EQ(back[k].points.size(), r.truth[k].points.size());
         for (std::size_t i = 0; i < back[k].points.size(); ++i) ASSERT_EQ(back[k].points[i], r.truth[k].points[i]);
     }
     EXPECT_TRUE(back[5].drag);
+    EXPECT_EQ(back[0].surface, 0);
+    EXPECT_EQ(back[5].surface, -1);
+    // A stroke naming a surface the file does not have cannot be written.
+    EXPECT_THROW(ground_truth_to_json(r.truth), InvalidInput);
 }
 
 TEST(SynthGroundTruth, BadTruthFilesGiveFileErrors)
@@ -869,7 +1080,10 @@ TEST(SynthGroundTruth, BadTruthFilesGiveFileErrors)
     std::ofstream(dir + "/a.json") << R"({"format":"lobesketch-ground-truth","version":1,"strokes":[{"kind":"leaf","points":[]}]})";
     std::ofstream(dir + "/b.json") << R"({"format":"lobesketch-ground-truth","version":1,"strokes":[{"kind":"lobe","points":[[0,1]]}]})";
     std::ofstream(dir + "/c.json") << "{\"format\":";
-    for (const char* name : {"/a.json", "/b.json", "/c.json", "/missing.json"}) {
+    std::ofstream(dir + "/d.json")
+        << R"({"format":"lobesketch-ground-truth","version":1,"strokes":[{"kind":"lobe","surface":0,"points":[[0,1,0]]}]})";
+    std::ofstream(dir + "/e.json") << R"({"format":"lobesketch-ground-truth","version":1,"surfaces":[{"center":[0,1,0],"radii":[0.1,0.1,5]}],"strokes":[]})";
+    for (const char* name : {"/a.json", "/b.json", "/c.json", "/d.json", "/e.json", "/missing.json"}) {
         const std::string path = dir + name;
         try {
             load_ground_truth(path);
