@@ -38,6 +38,7 @@ const Shipped kShipped[] = {
     {"recordings/table1-4lobes-22strokes.scenario.json", 22, 4, 0},
     {"recordings/table1-3lobes-16strokes.scenario.json", 16, 3, 0},
     {"recordings/pinch-edit.scenario.json", 5, 0, 2},
+    {"recordings/edit-stroke-transform.scenario.json", 5, 0, 4},
 };
 
 /// Each shipped scenario synthesized once per test run.
