@@ -100,6 +100,7 @@ bool SessionBuilder::add_drag(const InputAction& a)
         return false;
     };
     if (drag.path.empty()) return nothing("it has no points");
+    if (drag.tool == Tool::DrawLobe || drag.tool == Tool::DrawTrunk) return nothing("not an editing tool");
     const glm::dvec3 start(drag.path.front().position);
     const std::vector<Stroke> view = hooks_.current_strokes ? hooks_.current_strokes(doc_) : doc_.strokes;
 

@@ -267,8 +267,11 @@ std::string check_edit_operation(const Document& doc, const EditOperation& op, c
     else lobe_transform(with, op.target, with.edits.size(), options, &skipped);
     // Only the new operation's fate matters (earlier ones were reported when they were
     // made); being the last operation, it is reported last.
-    if (!skipped.empty() && skipped.back().id == op.id) return skipped.back().message;
-    return {};
+    if (skipped.empty() || skipped.back().id != op.id) return {};
+    // The operation is not in any document yet: the reason without "edit N (type): ".
+    const std::string prefix = "edit " + std::to_string(op.id) + " (" + op.type + "): ";
+    const std::string& m = skipped.back().message;
+    return m.rfind(prefix, 0) == 0 ? m.substr(prefix.size()) : m;
 }
 
 } // namespace lobe
