@@ -7,6 +7,7 @@
 
 #include "app/cli.h"
 #include "app/cli_common.h"
+#include "app/edit_hooks.h"
 #include "app/outputs.h"
 #include "core/errors.h"
 #include "input/pipeline.h"
@@ -41,8 +42,9 @@ void add_replay_command(CLI::App& app, int& exit_code)
         doc.seed = a->seed;
         doc.settings = settings;
         doc.source_recording = std::filesystem::absolute(a->rec).lexically_normal().string();
-        SessionBuilder builder(std::move(doc));
+        SessionBuilder builder(std::move(doc), EditPickOptions{}, meshing_edit_hooks());
         builder.apply(result.actions);
+        for (const std::string& m : builder.messages()) warn(a->rec + ": " + m);
         Document out_doc = builder.take_document();
 
         std::error_code ec;
@@ -60,7 +62,8 @@ void add_replay_command(CLI::App& app, int& exit_code)
         for (const Stroke& s : out_doc.strokes) (s.kind == StrokeKind::Lobe ? lobe_strokes : trunk_strokes)++;
         progress("derived " + std::to_string(out_doc.strokes.size()) + " strokes (" + std::to_string(lobe_strokes) +
                  " lobe, " + std::to_string(trunk_strokes) + " trunk) in " + std::to_string(out_doc.lobes.size()) +
-                 " lobe group(s), " + std::to_string(result.drags.size()) + " drag edit(s)");
+                 " lobe group(s), " + std::to_string(out_doc.edits.size()) + " edit(s) from " +
+                 std::to_string(result.drags.size()) + " drag(s)");
         progress("wrote " + a->out + "/strokes.json, " + a->out + "/session.json and " + std::to_string(lobe_files) +
                  " lobe mesh(es) in " + a->out + "/lobes");
         if (out_doc.strokes.empty() && result.drags.empty()) {

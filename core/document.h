@@ -21,8 +21,8 @@ inline constexpr int kDocumentVersion = 1;
 /// An edit stored as an operation, re-applied whenever the thing it edits is rebuilt.
 struct EditOperation {
     std::int64_t id = 0;
-    std::string type;      ///< e.g. "pinch_deform", "bezier_stroke", "transform_lobe"
-    std::int64_t target = 0; ///< lobe or stroke id
+    std::string type;      ///< "drag:<tool>", e.g. "drag:edit-stroke", "drag:rotate-lobe" (docs/session-format.md)
+    std::int64_t target = 0; ///< the stroke or lobe id the edit picked when it was made
     nlohmann::json params = nlohmann::json::object();
 };
 

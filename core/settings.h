@@ -51,7 +51,7 @@ struct LobeSettings {
     /// large lobes carry the same attractor density.
     double edge_length_m = 0.03;
     /// Rounds of isotropic remeshing.
-    int remesh_iterations = 3;
+    int remesh_iterations = 5;
     /// A stroke is closed when the gap between its ends is below this fraction of its length
     /// (and below closed_gap_max_m).
     double closed_gap_fraction = 0.15;

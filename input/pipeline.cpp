@@ -42,6 +42,8 @@ void InputPipeline::push_event(const InputEvent& event)
     case keys::kDeformLobe: set_tool(Tool::DeformLobe); break;
     case keys::kEditStroke: set_tool(Tool::EditStroke); break;
     case keys::kMoveLobe: set_tool(Tool::MoveLobe); break;
+    case keys::kRotateLobe: set_tool(Tool::RotateLobe); break;
+    case keys::kScaleLobe: set_tool(Tool::ScaleLobe); break;
     case keys::kNewLobe:
         // Starting a new lobe also returns to lobe drawing.
         tool_ = Tool::DrawLobe;
@@ -67,6 +69,9 @@ void InputPipeline::pen_down(int h, const HandGesture& g, double t)
     pen.stroke.hand = static_cast<Hand>(h);
     pen.stroke.points.push_back({g.index_tip, t});
     pen.last_good_t = t;
+    // Stroke edits with two fingertips: the other hand points at the segment's other end.
+    const HandGesture& other = gestures_.hand(static_cast<Hand>(1 - h));
+    if (tool_ == Tool::EditStroke && other.tracked && other.pointing) pen.other_tip = other.index_tip;
 }
 
 void InputPipeline::pen_move(int h, const HandGesture& g, double t)
@@ -84,9 +89,11 @@ void InputPipeline::pen_up(int h, double t)
     if (!pen.down) return;
     pen.down = false;
     // Keep where the stroke really ended when the last movement was shorter than the spacing.
+    // A drag always keeps it: its end decides the edit (a move, a Bézier displacement).
     const HandGesture& g = gestures_.hand(static_cast<Hand>(h));
+    const double min_last = pen.drag ? 0.0 : 0.5 * options_.min_point_distance_m;
     if (g.tracked && pen.stroke.points.size() >= 1 &&
-        glm::distance(g.index_tip, pen.stroke.points.back().position) >= 0.5 * options_.min_point_distance_m)
+        glm::distance(g.index_tip, pen.stroke.points.back().position) > min_last)
         pen.stroke.points.push_back({g.index_tip, std::max(t, pen.stroke.points.back().time)});
 
     InputAction a;
@@ -96,6 +103,7 @@ void InputPipeline::pen_up(int h, double t)
         a.drag.tool = pen.tool;
         a.drag.hand = pen.stroke.hand;
         a.drag.path = std::move(pen.stroke.points);
+        a.drag.other_tip = pen.other_tip;
         actions_.push_back(std::move(a));
         return;
     }

@@ -6,6 +6,7 @@
 /// a deterministic function of its recording and settings.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -17,12 +18,16 @@
 
 namespace lobe {
 
-/// A pinch-move-release made under an editing tool (deform a lobe, move a stroke's control
-/// point, move a lobe): the path of the pinch point.
+/// A pinch-move-release made under an editing tool (deform a lobe, bend a stroke segment,
+/// move, rotate or scale a lobe): the path of the pinch point.
 struct Drag {
     Tool tool = Tool::DeformLobe;
     Hand hand = Hand::Right;
     std::vector<StrokePoint> path;
+    /// EditStroke only: the other hand's filtered index tip when the drag started, present
+    /// when that hand was tracked and pointing (index straight, the other fingers curled).
+    /// The two fingertips then pick the ends of the stroke segment (docs/editing.md).
+    std::optional<glm::vec3> other_tip;
 };
 
 /// Something the person did, derived from raw input, in the order it happened.
@@ -68,6 +73,7 @@ private:
         bool drag = false;   ///< an editing-tool pinch rather than a drawn stroke
         Tool tool = Tool::DrawLobe;
         Stroke stroke;
+        std::optional<glm::vec3> other_tip; ///< see Drag::other_tip
         double last_good_t = 0.0;
     };
     void pen_down(int h, const HandGesture& g, double t);

@@ -2,8 +2,11 @@
 /// \file session_builder.h
 /// Applies the actions derived from raw input to a session document: completed strokes are
 /// added (lobe strokes to the current lobe, "new lobe" starts another), drags become edit
-/// operations, undo/redo walk the history of those changes.
+/// operations aimed at what they picked, undo/redo walk the history of those changes.
+/// Operation types and params: docs/session-format.md; gestures: docs/editing.md.
 
+#include <functional>
+#include <string>
 #include <vector>
 
 #include "core/document.h"
@@ -11,26 +14,68 @@
 
 namespace lobe {
 
+/// Where a drag picks what it edits. The paper gives no numbers; these are ours.
+struct EditPickOptions {
+    /// Edit-stroke drags: the drag start (and the pointing fingertip of the other hand)
+    /// must be within this of a stroke point (metres). Recorded in the operation.
+    double stroke_pick_distance_m = 0.03;
+    /// Edit-stroke drags with one hand: arc length of the bent segment on each side of the
+    /// picked point (metres). Recorded in the operation.
+    double stroke_half_length_m = 0.08;
+    /// Lobe drags (deform, move, rotate, scale) pick a lobe when they start within this of
+    /// one of its stroke points, or inside its bounding sphere (centre: lobe_centre; radius:
+    /// its farthest stroke point).
+    double lobe_pick_distance_m = 0.05;
+};
+
+/// How a SessionBuilder sees the geometry that drags pick from. The defaults see the
+/// strokes as drawn and accept every operation; the meshing stage provides hooks that see
+/// earlier edits applied and check that an operation applies (app/edit_hooks.h), so that a
+/// drag on a moved lobe or a bent stroke picks what the person saw.
+struct EditHooks {
+    /// Every stroke of the document (same ids) where the person sees it now, stage space.
+    std::function<std::vector<Stroke>(const Document&)> current_strokes;
+    /// Empty when the operation, appended to the document, applies; else why not (one line).
+    std::function<std::string(const Document&, const EditOperation&)> check;
+};
+
+/// Centre of a lobe used by rotate and scale: the length-weighted barycentre of its strokes
+/// (each stroke's segments weighted by their length, so dense sampling does not pull it),
+/// the mean of the points for strokes of zero length. `strokes` holds the strokes to look
+/// the lobe's ids up in (e.g. EditHooks::current_strokes).
+/// \return false when none of the lobe's strokes is there.
+bool lobe_centre(const LobeRecord& lobe, const std::vector<Stroke>& strokes, glm::dvec3& centre);
+
 class SessionBuilder {
 public:
     /// A lobe stroke whose points all stay farther than this (or half the lobe's radius,
     /// when larger) from every lobe's strokes starts a new lobe.
     static constexpr double kJoinDistanceM = 0.10;
 
-    explicit SessionBuilder(Document doc = {});
+    explicit SessionBuilder(Document doc = {}, EditPickOptions pick = {}, EditHooks hooks = {});
 
-    /// Applies one action; returns true when the document changed.
+    /// Applies one action; returns true when the document changed. A drag that picks nothing
+    /// (too far from every stroke or lobe, or an edit that does not apply) changes nothing
+    /// and adds a warning to messages().
     bool apply(const InputAction& action);
     void apply(const std::vector<InputAction>& actions);
 
     const Document& document() const { return doc_; }
     Document take_document() { return std::move(doc_); }
+    /// Warnings (one line each) about drags that edited nothing, in order.
+    const std::vector<std::string>& messages() const { return messages_; }
 
 private:
     void add_stroke(const Stroke& stroke);
+    bool add_drag(const InputAction& action);
+    void snapshot();
+
     Document doc_;
+    EditPickOptions pick_;
+    EditHooks hooks_;
     bool new_lobe_pending_ = false;
     std::vector<Document> undo_, redo_;
+    std::vector<std::string> messages_;
     std::int64_t next_edit_id_ = 1;
     std::int64_t next_lobe_id_ = 1;
 };

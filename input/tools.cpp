@@ -10,6 +10,8 @@ const char* tool_name(Tool t)
     case Tool::DeformLobe: return "deform-lobe";
     case Tool::EditStroke: return "edit-stroke";
     case Tool::MoveLobe: return "move-lobe";
+    case Tool::RotateLobe: return "rotate-lobe";
+    case Tool::ScaleLobe: return "scale-lobe";
     }
     return "unknown";
 }

@@ -12,8 +12,10 @@ enum class Tool : std::uint8_t {
     DrawLobe = 0,  ///< pinch draws a lobe stroke (the default)
     DrawTrunk,     ///< pinch draws a trunk stroke
     DeformLobe,    ///< pinch near a lobe surface drags a handle (Laplacian editing)
-    EditStroke,    ///< two fingertips select a stroke segment, pinch moves its control point
-    MoveLobe,      ///< grab moves/rotates/scales a lobe
+    EditStroke,    ///< a drag bends a stroke segment as a Bézier curve (docs/editing.md)
+    MoveLobe,      ///< a drag moves the lobe it starts on
+    RotateLobe,    ///< a drag turns the lobe about its centre
+    ScaleLobe,     ///< a drag scales the lobe uniformly about its centre
 };
 
 namespace keys {
@@ -23,6 +25,8 @@ inline constexpr int kNewLobe = 78;    // GLFW_KEY_N: the next lobe stroke start
 inline constexpr int kDeformLobe = 68; // GLFW_KEY_D
 inline constexpr int kEditStroke = 69; // GLFW_KEY_E
 inline constexpr int kMoveLobe = 77;   // GLFW_KEY_M
+inline constexpr int kRotateLobe = 82; // GLFW_KEY_R
+inline constexpr int kScaleLobe = 75;  // GLFW_KEY_K (S is the desktop app's save key)
 inline constexpr int kGrow = 71;       // GLFW_KEY_G
 inline constexpr int kUndo = 90;       // GLFW_KEY_Z
 inline constexpr int kRedo = 89;       // GLFW_KEY_Y

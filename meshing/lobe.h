@@ -22,13 +22,18 @@ struct LobeOptions {
     /// A stroke whose samples all lie within this distance of one stroke of the lobe
     /// duplicates it and is refused.
     double duplicate_distance_m = 0.004;
+    /// Raw points are kept between the curvature samples (Eq. 1) where the chord between two
+    /// samples would leave the drawn stroke by more than this (Douglas–Peucker), so the lobe
+    /// passes within it of every drawn point. 0 keeps the samples alone.
+    double max_chord_deviation_m = 0.0015;
     /// The lobe's centre stays where it is while the centroid of its strokes is within
     /// this fraction of the lobe's mean radius of it, so adding a stroke changes only the
     /// region around that stroke; beyond it the centre moves and the lobe is re-laid.
     double recentre_fraction = 0.2;
 };
 
-/// Sampling (Eq. 1) and closing (§4.1) of one raw lobe stroke.
+/// Sampling (Eq. 1) and closing (§4.1) of one raw lobe stroke, plus the raw points needed to
+/// keep the stroke within LobeOptions::max_chord_deviation_m.
 /// \throw InvalidInput for degenerate strokes (fewer than 4 points, zero length, all on one
 /// line, not finite, beyond 1 km).
 LobeStrokeSamples prepare_lobe_stroke(std::int64_t id, const std::vector<glm::vec3>& raw,

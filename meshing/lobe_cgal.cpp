@@ -13,6 +13,59 @@
 
 namespace lobe {
 
+namespace {
+
+/// Douglas–Peucker between consecutive samples: raw points are added where the chord
+/// between two samples would leave the drawn stroke by more than `tolerance`, so the lobe
+/// passes through the stroke itself, not only through its samples.
+void refine_interval(const std::vector<glm::vec3>& raw, std::size_t a, std::size_t b, double tolerance,
+                     std::vector<glm::vec3>& out, int depth = 0)
+{
+    const std::size_t n = raw.size();
+    const std::size_t count = (b + n - a) % n; // raw steps from a to b (b may wrap)
+    if (count < 2 || depth > 40) return;
+    const glm::dvec3 p(raw[a]), q(raw[b % n]);
+    const glm::dvec3 pq = q - p;
+    const double len2 = glm::dot(pq, pq);
+    double worst = -1;
+    std::size_t worst_k = 0;
+    for (std::size_t k = 1; k < count; ++k) {
+        const glm::dvec3 x(raw[(a + k) % n]);
+        const double t = len2 > 0 ? std::clamp(glm::dot(x - p, pq) / len2, 0.0, 1.0) : 0.0;
+        const double d = glm::distance(x, p + t * pq);
+        if (d > worst) {
+            worst = d;
+            worst_k = k;
+        }
+    }
+    if (worst <= tolerance) return;
+    const std::size_t m = (a + worst_k) % n;
+    refine_interval(raw, a, m, tolerance, out, depth + 1);
+    out.push_back(raw[m]);
+    refine_interval(raw, m, b, tolerance, out, depth + 1);
+}
+
+std::vector<glm::vec3> refine_samples(const std::vector<glm::vec3>& raw, const std::vector<int>& indices, bool closed,
+                                      double tolerance)
+{
+    if (tolerance <= 0) {
+        std::vector<glm::vec3> out;
+        for (int i : indices) out.push_back(raw[static_cast<std::size_t>(i)]);
+        return out;
+    }
+    std::vector<glm::vec3> out;
+    const std::size_t m = indices.size();
+    for (std::size_t i = 0; i < m; ++i) {
+        const std::size_t a = static_cast<std::size_t>(indices[i]);
+        out.push_back(raw[a]);
+        if (!closed && i + 1 == m) break;
+        refine_interval(raw, a, static_cast<std::size_t>(indices[(i + 1) % m]), tolerance, out);
+    }
+    return out;
+}
+
+} // namespace
+
 LobeStrokeSamples prepare_lobe_stroke(std::int64_t id, const std::vector<glm::vec3>& raw, const LobeOptions& options)
 {
     const std::string who = "lobe stroke " + std::to_string(id);
@@ -20,18 +73,17 @@ LobeStrokeSamples prepare_lobe_stroke(std::int64_t id, const std::vector<glm::ve
     LobeStrokeSamples out;
     out.id = id;
     out.closed = is_closed_stroke(raw, options.closure);
-    if (out.closed) {
-        const std::vector<glm::vec3> loop = close_stroke(raw, options.closure);
-        out.points = sample_by_curvature(loop, true, options.sampling);
-    } else {
-        out.points = sample_by_curvature(raw, false, options.sampling);
-    }
+    const std::vector<glm::vec3> line = out.closed ? close_stroke(raw, options.closure) : raw;
+    const CurvatureSampling sampling = sample_by_curvature_detailed(line, out.closed, options.sampling);
+    out.points = refine_samples(line, sampling.indices, out.closed, options.max_chord_deviation_m);
     if (out.points.size() < 4) throw InvalidInput(who + " is too short to sample");
-    // A stroke that reverses (turns by more than 160° from one sample to the next) folds back
-    // on itself: its two legs would make a zero-width sliver of the lobe.
-    const std::size_t n = out.points.size();
+    // A stroke that reverses (turns by more than 160° from one Eq. 1 sample to the next)
+    // folds back on itself: its two legs would make a zero-width sliver of the lobe.
+    std::vector<glm::vec3> samples;
+    for (int i : sampling.indices) samples.push_back(line[static_cast<std::size_t>(i)]);
+    const std::size_t n = samples.size();
     for (std::size_t i = out.closed ? 0 : 1; i < (out.closed ? n : n - 1); ++i) {
-        const glm::dvec3 a(out.points[(i + n - 1) % n]), b(out.points[i]), c(out.points[(i + 1) % n]);
+        const glm::dvec3 a(samples[(i + n - 1) % n]), b(samples[i]), c(samples[(i + 1) % n]);
         const glm::dvec3 u = b - a, v = c - b;
         const double lu = glm::length(u), lv = glm::length(v);
         if (lu > 0 && lv > 0 && glm::dot(u, v) < std::cos(160.0 * 3.14159265358979323846 / 180.0) * lu * lv)

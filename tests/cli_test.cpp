@@ -178,3 +178,31 @@ TEST(Cli, ImportedLeapCaptureReplaysWithoutStrokesFromAGrab)
     EXPECT_EQ(rep.code, 1) << rep.out; // nothing drawn: "no strokes"
     EXPECT_NE(rep.out.find("no strokes"), std::string::npos) << rep.out;
 }
+
+TEST(Cli, ReplayStoresEditsAndWarnsAboutADragThatPicksNothing)
+{
+    const std::string dir = test::temp_dir("cli-edits");
+    CliRun shipped = run("replay " + test::source_path("recordings/edit-stroke-transform.lrec") + " --out " + dir + "/a");
+    ASSERT_EQ(shipped.code, 0) << shipped.out;
+    EXPECT_EQ(count_lines_with(shipped.out, "warning:"), 0u) << shipped.out;
+    const Document doc = load_document(dir + "/a/session.json");
+    ASSERT_EQ(doc.edits.size(), 4u);
+    EXPECT_EQ(doc.edits[0].type, "drag:edit-stroke");
+    EXPECT_EQ(doc.edits[3].type, "drag:scale-lobe");
+
+    // One loop, then a move drag 45 cm to its side: recorded as nothing, with a warning.
+    {
+        std::ofstream sc(dir + "/far.scenario.json");
+        sc << R"({"format": "lobesketch-scenario", "version": 1, "seed": 5, "steps": [
+            {"type": "stroke", "ellipse": {"center": [0.1, 1.35, -0.4], "radii": [0.1, 0.1]}},
+            {"type": "key", "key": "M"},
+            {"type": "drag", "from": [0.1, 1.35, 0.05], "to": [0.15, 1.35, 0.05], "speed": 0.15}]})";
+    }
+    ASSERT_EQ(run("synth " + dir + "/far.scenario.json -o " + dir + "/far.lrec").code, 0);
+    CliRun far = run("replay " + dir + "/far.lrec --out " + dir + "/b");
+    EXPECT_EQ(far.code, 0) << far.out;
+    EXPECT_EQ(count_lines_with(far.out, "warning:"), 1u) << far.out;
+    EXPECT_NE(far.out.find("move-lobe drag at t="), std::string::npos) << far.out;
+    EXPECT_NE(far.out.find("edits nothing: its start is outside every lobe"), std::string::npos) << far.out;
+    EXPECT_TRUE(load_document(dir + "/b/session.json").edits.empty());
+}

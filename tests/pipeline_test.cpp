@@ -178,6 +178,58 @@ TEST(Pipeline, ToolKeysDecideWhatAPinchDoes)
     EXPECT_GT(d.drags[0].path.size(), 10u);
 }
 
+TEST(Pipeline, EveryEditingToolKeyMakesDragsThatEndWhereTheFingertipStopped)
+{
+    const Recording rec = line_recording();
+    const std::pair<int, Tool> tools[] = {{keys::kDeformLobe, Tool::DeformLobe}, {keys::kEditStroke, Tool::EditStroke},
+                                          {keys::kMoveLobe, Tool::MoveLobe},     {keys::kRotateLobe, Tool::RotateLobe},
+                                          {keys::kScaleLobe, Tool::ScaleLobe}};
+    for (const auto& [key, tool] : tools) {
+        Recording r = rec;
+        r.events.push_back({0.1, InputEventKind::Key, key, 1, 0, 0});
+        InputResult d = run_input_pipeline(r);
+        ASSERT_EQ(d.actions.front().type, InputAction::Type::ToolChanged);
+        EXPECT_EQ(d.actions.front().tool, tool);
+        EXPECT_TRUE(d.strokes.empty());
+        ASSERT_EQ(d.drags.size(), 1u) << tool_name(tool);
+        EXPECT_EQ(d.drags[0].tool, tool);
+        // The drag's last point is where the tip stopped (the filter settles while the thumb
+        // opens), even when that is closer than the point spacing to the point before.
+        EXPECT_NEAR(d.drags[0].path.back().position.x, 0.1f, 0.0005f) << tool_name(tool);
+        EXPECT_FALSE(d.drags[0].other_tip.has_value());
+    }
+    EXPECT_EQ(keys::kRotateLobe, 82); // GLFW_KEY_R
+    EXPECT_EQ(keys::kScaleLobe, 75);  // GLFW_KEY_K
+    EXPECT_STREQ(tool_name(Tool::RotateLobe), "rotate-lobe");
+    EXPECT_STREQ(tool_name(Tool::ScaleLobe), "scale-lobe");
+}
+
+TEST(Pipeline, StrokeEditDragRecordsTheOtherHandOnlyWhenItPoints)
+{
+    // The right hand drags under E while the left hand is straight (not pointing), pointing
+    // (index straight, the others curled), or pointing under another tool.
+    const glm::vec3 left_tip(-0.2f, 1.25f, -0.45f);
+    auto with_left = [&](bool pointing, int key) {
+        Recording rec = line_recording();
+        for (HandFrame& f : rec.frames) f.hand(Hand::Left) = make_hand(left_tip, 0.05f, /*fist=*/pointing);
+        rec.events.push_back({0.1, InputEventKind::Key, key, 1, 0, 0});
+        return run_input_pipeline(rec);
+    };
+    InputResult relaxed = with_left(false, keys::kEditStroke);
+    ASSERT_EQ(relaxed.drags.size(), 1u);
+    EXPECT_FALSE(relaxed.drags[0].other_tip.has_value());
+
+    InputResult pointing = with_left(true, keys::kEditStroke);
+    ASSERT_EQ(pointing.drags.size(), 1u);
+    ASSERT_TRUE(pointing.drags[0].other_tip.has_value());
+    EXPECT_LT(glm::distance(*pointing.drags[0].other_tip, left_tip), 0.001f);
+    EXPECT_EQ(pointing.drags[0].hand, Hand::Right);
+
+    InputResult moving = with_left(true, keys::kMoveLobe);
+    ASSERT_EQ(moving.drags.size(), 1u);
+    EXPECT_FALSE(moving.drags[0].other_tip.has_value());
+}
+
 TEST(Pipeline, AnnotationsAreCheckedNeverApplied)
 {
     Recording rec = line_recording();

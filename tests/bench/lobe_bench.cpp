@@ -91,7 +91,7 @@ void BM_PrepareStroke(benchmark::State& state)
 BENCHMARK(BM_PrepareStroke)->Unit(benchmark::kMillisecond);
 
 /// Remeshing the ten-stroke lobe to 3 cm with the strokes as constraints, as lobes are
-/// remeshed (3 iterations, feature edges split and collapsed along their stroke).
+/// remeshed (the default rounds, feature edges split and collapsed along their stroke).
 void BM_RemeshTenStrokeLobe(benchmark::State& state)
 {
     Lobe lobe;
@@ -99,6 +99,7 @@ void BM_RemeshTenStrokeLobe(benchmark::State& state)
     for (std::size_t i = 0; i < strokes.size(); ++i) lobe.add_stroke(static_cast<std::int64_t>(i + 1), strokes[i]);
     RemeshOptions options;
     options.relax_feature_edges = true;
+    options.iterations = static_cast<unsigned>(LobeSettings{}.remesh_iterations);
     TriangleMesh out;
     for (auto _ : state) {
         out = remesh_isotropic(lobe.surface().mesh, options);

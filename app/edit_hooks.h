@@ -1,0 +1,22 @@
+#pragma once
+/// \file edit_hooks.h
+/// Connects the session builder (input/) with the meshing stage's view of edits, so that
+/// drags pick strokes and lobes where the person sees them (earlier stroke edits and lobe
+/// transforms applied) and an edit that would not apply is refused when it is made.
+
+#include "input/session_builder.h"
+#include "meshing/edit_ops.h"
+
+namespace lobe {
+
+inline EditHooks meshing_edit_hooks(const EditApplyOptions& options = {})
+{
+    EditHooks hooks;
+    hooks.current_strokes = [options](const Document& doc) { return effective_strokes(doc, options); };
+    hooks.check = [options](const Document& doc, const EditOperation& op) {
+        return check_edit_operation(doc, op, options);
+    };
+    return hooks;
+}
+
+} // namespace lobe
