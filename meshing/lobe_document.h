@@ -1,8 +1,9 @@
 #pragma once
 /// \file lobe_document.h
 /// Every lobe of a session document, rebuilt from what the person did: the lobe's strokes
-/// joined in drawing order (lobe.h), remeshed to the attractor spacing (remesh.h), then
-/// the document's edit operations re-applied in order (pinch edits, Laplacian editing). A
+/// (with their stroke edits, edit_ops.h) joined in drawing order (lobe.h), remeshed to the
+/// attractor spacing (remesh.h), the pinch edits (Laplacian editing) re-applied in order,
+/// then the lobe moved, rotated and scaled as its transform operations say. A
 /// stroke that cannot join its lobe is left out of the mesh with a warning; it stays in
 /// the document. See docs/lobes.md.
 
@@ -20,8 +21,8 @@ namespace lobe {
 struct BuiltLobe {
     std::int64_t lobe_id = 0;
     std::vector<std::int64_t> stroke_ids; ///< the strokes that joined, in order
-    LobeSurface surface;                  ///< the surface through the strokes, before remeshing
-    TriangleMesh mesh;                    ///< remeshed, edits applied: closed, outward
+    LobeSurface surface;                  ///< the surface through the strokes (stroke edits applied), before remeshing, in the lobe's own frame
+    TriangleMesh mesh;                    ///< remeshed, pinch edits applied, moved/rotated/scaled into stage space: closed, outward
     std::size_t edits_applied = 0;
 };
 

@@ -6,9 +6,12 @@
 #include <map>
 
 #include <glm/geometric.hpp>
+#include <glm/matrix.hpp>
 
 #include "core/errors.h"
+#include "meshing/edit_ops.h"
 #include "meshing/laplacian_edit.h"
+#include "meshing/lobe_transform.h"
 #include "meshing/remesh.h"
 
 namespace lobe {
@@ -17,9 +20,9 @@ namespace {
 
 constexpr const char* kPinchEditType = "drag:deform-lobe";
 
-const Stroke* find_stroke(const Document& doc, std::int64_t id)
+const Stroke* find_stroke(const std::vector<Stroke>& strokes, std::int64_t id)
 {
-    for (const Stroke& s : doc.strokes)
+    for (const Stroke& s : strokes)
         if (s.id == id) return &s;
     return nullptr;
 }
@@ -49,7 +52,10 @@ double nearest_vertex_distance(const TriangleMesh& mesh, const glm::vec3& p)
 }
 
 /// Applies one pinch edit to `mesh`; false (and a warning) when it cannot be applied.
-bool apply_pinch(const Document& doc, const EditOperation& op, TriangleMesh& mesh, std::vector<std::string>* warnings)
+/// `frame` maps the lobe's own frame to stage space at the time of the edit: the pinch,
+/// recorded in stage space, is mapped back into the frame the mesh is in.
+bool apply_pinch(const Document& doc, const EditOperation& op, TriangleMesh& mesh, std::vector<std::string>* warnings,
+                 const glm::dmat4& frame = glm::dmat4(1.0))
 {
     glm::vec3 from, to;
     const std::string who = "edit " + std::to_string(op.id);
@@ -57,6 +63,9 @@ bool apply_pinch(const Document& doc, const EditOperation& op, TriangleMesh& mes
         if (warnings) warnings->push_back(who + ": no fingertip path, skipped");
         return false;
     }
+    const glm::dmat4 back = glm::inverse(frame);
+    from = glm::vec3(back * glm::dvec4(glm::dvec3(from), 1.0));
+    to = glm::vec3(back * glm::dvec4(glm::dvec3(to), 1.0));
     PinchEditOptions options;
     options.roi_radius_m = doc.settings.lobes.pinch_roi_radius_m;
     try {
@@ -92,13 +101,18 @@ std::vector<BuiltLobe> build_document_lobes(const Document& doc, std::vector<std
     remesh.target_edge_length_m = doc.settings.lobes.edge_length_m;
     remesh.iterations = static_cast<unsigned>(doc.settings.lobes.remesh_iterations);
     remesh.relax_feature_edges = true;
+    // Strokes with their stroke edits (Bézier, Fig. 6a) applied, each lobe's in its own frame.
+    std::vector<SkippedEdit> skipped;
+    const std::vector<Stroke> strokes = edited_strokes(doc, {}, &skipped);
+    for (const SkippedEdit& e : skipped)
+        if (warnings) warnings->push_back(e.message);
     std::vector<BuiltLobe> out;
     for (const LobeRecord& rec : doc.lobes) {
         Lobe lobe(options);
         BuiltLobe built;
         built.lobe_id = rec.id;
         for (std::int64_t id : rec.stroke_ids) {
-            const Stroke* s = find_stroke(doc, id);
+            const Stroke* s = find_stroke(strokes, id);
             if (!s) {
                 if (warnings) warnings->push_back("lobe " + std::to_string(rec.id) + ": stroke " + std::to_string(id) + " is missing");
                 continue;
@@ -125,7 +139,8 @@ std::vector<BuiltLobe> build_document_lobes(const Document& doc, std::vector<std
     }
     // Edits in document order. A pinch edit goes to its target lobe, or (no target) to the
     // lobe with a vertex nearest the pinch.
-    for (const EditOperation& op : doc.edits) {
+    for (std::size_t k = 0; k < doc.edits.size(); ++k) {
+        const EditOperation& op = doc.edits[k];
         if (op.type != kPinchEditType) continue;
         BuiltLobe* target = nullptr;
         if (op.target > 0) {
@@ -148,7 +163,13 @@ std::vector<BuiltLobe> build_document_lobes(const Document& doc, std::vector<std
             if (warnings) warnings->push_back("edit " + std::to_string(op.id) + ": no lobe to edit, skipped");
             continue;
         }
-        if (apply_pinch(doc, op, target->mesh, warnings)) ++target->edits_applied;
+        if (apply_pinch(doc, op, target->mesh, warnings, lobe_transform(doc, target->lobe_id, k)))
+            ++target->edits_applied;
+    }
+    // Move, rotate and scale (in document order) take each lobe to where the person put it.
+    for (BuiltLobe& b : out) {
+        const glm::dmat4 t = lobe_transform(doc, b.lobe_id);
+        if (t != glm::dmat4(1.0)) transform_mesh(b.mesh, t);
     }
     return out;
 }
