@@ -368,26 +368,26 @@ void Builder::find_crossings()
     }
     SegmentGrid grid(std::move(segs));
     crossing_count_.assign(strokes_.size(), 0);
-    std::vector<std::vector<int>> pair_count(strokes_.size(), std::vector<int>(strokes_.size(), 0));
+    std::map<std::pair<int, int>, std::size_t> pair_count; // (lower, higher stroke) → crossings
     grid.for_each_candidate([&](const SegmentGrid::Seg& a, const SegmentGrid::Seg& b) {
         double s = 0, t = 0;
         if (!segment_crossing(a.p0, a.p1, b.p0, b.p1, s, t)) return;
         if (a.stroke == b.stroke)
             throw InvalidInput(stroke_name(a.stroke) + " folds back over itself as seen from the lobe's centre");
+        if (crossings_.size() >= 100000) throw InvalidInput("the lobe's strokes cross each other too often to mesh");
         crossings_.push_back({a.stroke, a.index, b.stroke, b.index, s, t});
         ++crossing_count_[static_cast<Index>(a.stroke)];
         ++crossing_count_[static_cast<Index>(b.stroke)];
-        ++pair_count[static_cast<Index>(a.stroke)][static_cast<Index>(b.stroke)];
+        ++pair_count[{std::min(a.stroke, b.stroke), std::max(a.stroke, b.stroke)}];
     });
-    // Two strokes that retrace each other cross again and again.
-    for (Index a = 0; a < strokes_.size(); ++a)
-        for (Index b = 0; b < strokes_.size(); ++b) {
-            const std::size_t c = static_cast<std::size_t>(pair_count[a][b] + (a < b ? pair_count[b][a] : 0));
-            if (a < b && c > std::max<std::size_t>(16, std::min(plane_[a].size(), plane_[b].size()) / 2))
-                throw InvalidInput(stroke_name(static_cast<int>(b)) + " runs along " + stroke_name(static_cast<int>(a)) +
-                                   " as seen from the lobe's centre (they cross " + std::to_string(c) +
-                                   " times; is one inside the lobe?)");
-        }
+    // Two strokes that run along each other (seen from the centre) cross again and again.
+    for (const auto& [pair, c] : pair_count) {
+        const Index a = static_cast<Index>(pair.first), b = static_cast<Index>(pair.second);
+        if (c > std::max<std::size_t>(16, std::min(plane_[a].size(), plane_[b].size()) / 2))
+            throw InvalidInput(stroke_name(pair.second) + " runs along " + stroke_name(pair.first) +
+                               " as seen from the lobe's centre (they cross " + std::to_string(c) +
+                               " times; is one inside the lobe?)");
+    }
     if (crossings_.size() > 100000) throw InvalidInput("the lobe's strokes cross each other too often to mesh");
     std::sort(crossings_.begin(), crossings_.end(), [](const Crossing& x, const Crossing& y) {
         return std::tie(x.a, x.seg, x.s, x.b, x.other_seg) < std::tie(y.a, y.seg, y.s, y.b, y.other_seg);
