@@ -181,8 +181,12 @@ public:
         std::vector<std::pair<int, int>> pairs;
         for (const auto& cell : cells_)
             for (Index i = 0; i < cell.size(); ++i)
-                for (Index j = i + 1; j < cell.size(); ++j)
+                for (Index j = i + 1; j < cell.size(); ++j) {
+                    // Bounded work and memory on any input (a dense scribble in one spot).
+                    if (pairs.size() >= 20000000)
+                        throw InvalidInput("the lobe's strokes are too densely tangled to mesh");
                     pairs.emplace_back(std::min(cell[i], cell[j]), std::max(cell[i], cell[j]));
+                }
         std::sort(pairs.begin(), pairs.end());
         pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
         for (const auto& [i, j] : pairs) f(segs_[static_cast<Index>(i)], segs_[static_cast<Index>(j)]);
