@@ -1,6 +1,7 @@
 #include "core/document.h"
 
 #include <cmath>
+#include <type_traits>
 
 #include "core/atomic_file.h"
 #include "core/errors.h"
@@ -14,6 +15,46 @@ namespace {
 // Upper bounds on what a document may hold; a file beyond them is refused.
 constexpr std::size_t kMaxStrokes = 100000;
 constexpr std::size_t kMaxPointsPerStroke = 1000000;
+
+json rgb_json(const double (&c)[3]) { return json::array({c[0], c[1], c[2]}); }
+
+} // namespace
+
+json growth_settings_to_json(const GrowthSettings& g)
+{
+    json weights = json::object();
+    for (const auto& [name, w] : g.subtree_weights) weights[name] = w;
+    return json{{"species", g.species},
+                {"split_angle_deg", g.split_angle_deg},
+                {"alpha", g.alpha},
+                {"beta", g.beta},
+                {"growth_ratio", g.growth_ratio},
+                {"stop_distance_m", g.stop_distance_m},
+                {"kill_distance_m", g.kill_distance_m},
+                {"skeleton_spacing_m", g.skeleton_spacing_m},
+                {"max_iterations", g.max_iterations},
+                {"max_nodes", g.max_nodes},
+                {"subtree_weights", std::move(weights)}};
+}
+
+json branch_settings_to_json(const BranchSettings& b)
+{
+    return json{{"pipe_exponent", b.pipe_exponent},
+                {"tip_radius_m", b.tip_radius_m},
+                {"radial_segments", b.radial_segments},
+                {"ring_spacing_m", b.ring_spacing_m},
+                {"smoothing_iterations", b.smoothing_iterations},
+                {"bark_color", rgb_json(b.bark_color)},
+                {"lod_count", b.lod_count}};
+}
+
+json leaf_settings_to_json(const LeafSettings& l)
+{
+    return json{{"length_m", l.length_m},   {"width_m", l.width_m}, {"per_node", l.per_node},
+                {"deviation_deg", l.deviation_deg}, {"color", rgb_json(l.color)}, {"shape", l.shape}};
+}
+
+namespace {
 
 json settings_to_json(const Settings& s)
 {
@@ -46,6 +87,9 @@ json settings_to_json(const Settings& s)
           {"closed_gap_max_m", s.lobes.closed_gap_max_m},
           {"pinch_roi_radius_m", s.lobes.pinch_roi_radius_m},
           {"pinch_pick_distance_m", s.lobes.pinch_pick_distance_m}}},
+        {"growth", growth_settings_to_json(s.growth)},
+        {"branches", branch_settings_to_json(s.branches)},
+        {"leaves", leaf_settings_to_json(s.leaves)},
     };
 }
 
@@ -58,6 +102,11 @@ void read_number(const json& obj, const char* key, T& out, const std::string& wh
         throw InvalidInput(where + "." + key + ": expected a number");
     double v = it->get<double>();
     if (!std::isfinite(v)) throw InvalidInput(where + "." + key + ": not a finite number");
+    if constexpr (std::is_integral_v<T>) {
+        // Casting an out-of-range double to an integer is undefined: refuse it first.
+        if (v != std::floor(v) || v < -1e9 || v > 1e9)
+            throw InvalidInput(where + "." + key + ": expected an integer in [-1e9, 1e9]");
+    }
     out = static_cast<T>(v);
 }
 
@@ -70,11 +119,103 @@ void check_keys(const json& obj, std::initializer_list<const char*> known, const
     }
 }
 
+void read_rgb(const json& obj, const char* key, double (&out)[3], const std::string& where)
+{
+    auto it = obj.find(key);
+    if (it == obj.end()) return;
+    const std::string w = where + "." + key;
+    if (!it->is_array() || it->size() != 3) throw InvalidInput(w + ": expected [r, g, b]");
+    for (int i = 0; i < 3; ++i) {
+        if (!(*it)[i].is_number()) throw InvalidInput(w + ": expected [r, g, b] numbers");
+        const double v = (*it)[i].get<double>();
+        if (!(v >= 0.0 && v <= 1.0)) throw InvalidInput(w + ": components must be in [0, 1]");
+        out[i] = v;
+    }
+}
+
+void read_string(const json& obj, const char* key, std::string& out, const std::string& where)
+{
+    auto it = obj.find(key);
+    if (it == obj.end()) return;
+    if (!it->is_string()) throw InvalidInput(where + "." + key + ": expected a string");
+    out = it->get<std::string>();
+}
+
+const json* section(const json& j, const char* key)
+{
+    auto it = j.find(key);
+    if (it == j.end()) return nullptr;
+    if (!it->is_object()) throw InvalidInput(std::string("settings.") + key + ": expected an object");
+    return &*it;
+}
+
+} // namespace
+
+void read_growth_settings(const json& g, GrowthSettings& out, const std::string& w)
+{
+    check_keys(g,
+               {"species", "split_angle_deg", "alpha", "beta", "growth_ratio", "stop_distance_m", "kill_distance_m",
+                "skeleton_spacing_m", "max_iterations", "max_nodes", "subtree_weights"},
+               w);
+    read_string(g, "species", out.species, w);
+    read_number(g, "split_angle_deg", out.split_angle_deg, w);
+    read_number(g, "alpha", out.alpha, w);
+    read_number(g, "beta", out.beta, w);
+    read_number(g, "growth_ratio", out.growth_ratio, w);
+    read_number(g, "stop_distance_m", out.stop_distance_m, w);
+    read_number(g, "kill_distance_m", out.kill_distance_m, w);
+    read_number(g, "skeleton_spacing_m", out.skeleton_spacing_m, w);
+    read_number(g, "max_iterations", out.max_iterations, w);
+    read_number(g, "max_nodes", out.max_nodes, w);
+    if (auto it = g.find("subtree_weights"); it != g.end()) {
+        if (!it->is_object()) throw InvalidInput(w + ".subtree_weights: expected an object of name: weight");
+        if (it->size() > 256) throw InvalidInput(w + ".subtree_weights: too many entries");
+        out.subtree_weights.clear();
+        for (auto e = it->begin(); e != it->end(); ++e) {
+            if (!e->is_number()) throw InvalidInput(w + ".subtree_weights." + e.key() + ": expected a number");
+            const double v = e->get<double>();
+            if (!(v >= 0.0 && v <= 1e6)) throw InvalidInput(w + ".subtree_weights." + e.key() + ": must be in [0, 1e6]");
+            out.subtree_weights[e.key()] = v;
+        }
+    }
+}
+
+void read_branch_settings(const json& b, BranchSettings& out, const std::string& w)
+{
+    check_keys(b,
+               {"pipe_exponent", "tip_radius_m", "radial_segments", "ring_spacing_m", "smoothing_iterations",
+                "bark_color", "lod_count"},
+               w);
+    read_number(b, "pipe_exponent", out.pipe_exponent, w);
+    read_number(b, "tip_radius_m", out.tip_radius_m, w);
+    read_number(b, "radial_segments", out.radial_segments, w);
+    read_number(b, "ring_spacing_m", out.ring_spacing_m, w);
+    read_number(b, "smoothing_iterations", out.smoothing_iterations, w);
+    read_rgb(b, "bark_color", out.bark_color, w);
+    read_number(b, "lod_count", out.lod_count, w);
+}
+
+void read_leaf_settings(const json& l, LeafSettings& out, const std::string& w)
+{
+    check_keys(l, {"length_m", "width_m", "per_node", "deviation_deg", "color", "shape"}, w);
+    read_number(l, "length_m", out.length_m, w);
+    read_number(l, "width_m", out.width_m, w);
+    read_number(l, "per_node", out.per_node, w);
+    read_number(l, "deviation_deg", out.deviation_deg, w);
+    read_rgb(l, "color", out.color, w);
+    read_string(l, "shape", out.shape, w);
+}
+
+namespace {
+
 Settings settings_from_json(const json& j)
 {
     Settings s;
     if (!j.is_object()) throw InvalidInput("settings: expected an object");
-    check_keys(j, {"input", "lobes"}, "settings");
+    check_keys(j, {"input", "lobes", "growth", "branches", "leaves"}, "settings");
+    if (const json* g = section(j, "growth")) read_growth_settings(*g, s.growth, "settings.growth");
+    if (const json* b = section(j, "branches")) read_branch_settings(*b, s.branches, "settings.branches");
+    if (const json* l = section(j, "leaves")) read_leaf_settings(*l, s.leaves, "settings.leaves");
     if (auto it = j.find("lobes"); it != j.end()) {
         if (!it->is_object()) throw InvalidInput("settings.lobes: expected an object");
         const std::string w = "settings.lobes";
@@ -228,6 +369,52 @@ void validate_settings(const Settings& s)
     require_lobes(l.pinch_roi_radius_m >= 0.01 && l.pinch_roi_radius_m <= 2, "pinch_roi_radius_m must be in [0.01, 2]");
     require_lobes(l.pinch_pick_distance_m > 0 && l.pinch_pick_distance_m <= 0.5,
                   "pinch_pick_distance_m must be in (0, 0.5]");
+    validate_growth_settings(s.growth);
+    validate_branch_settings(s.branches);
+    validate_leaf_settings(s.leaves);
+}
+
+void validate_growth_settings(const GrowthSettings& g)
+{
+    auto require = [](bool ok, const char* what) {
+        if (!ok) throw InvalidInput(std::string("settings.growth.") + what);
+    };
+    require(!g.species.empty() && g.species.size() <= 64, "species must be a name of 1 to 64 characters");
+    require(g.split_angle_deg >= 5 && g.split_angle_deg <= 180, "split_angle_deg must be in [5, 180]");
+    require(g.alpha >= -10 && g.alpha <= 10, "alpha must be in [-10, 10]");
+    require(g.beta >= -10 && g.beta <= 10, "beta must be in [-10, 10]");
+    require(g.growth_ratio > 0 && g.growth_ratio <= 1, "growth_ratio must be in (0, 1]");
+    require(g.stop_distance_m >= 0.001 && g.stop_distance_m <= 0.5, "stop_distance_m must be in [0.001, 0.5]");
+    require(g.kill_distance_m >= 0.002 && g.kill_distance_m <= 1, "kill_distance_m must be in [0.002, 1]");
+    require(g.skeleton_spacing_m >= 0.002 && g.skeleton_spacing_m <= 0.5, "skeleton_spacing_m must be in [0.002, 0.5]");
+    require(g.max_iterations >= 1 && g.max_iterations <= 1000, "max_iterations must be in [1, 1000]");
+    require(g.max_nodes >= 100 && g.max_nodes <= 5000000, "max_nodes must be in [100, 5000000]");
+}
+
+void validate_branch_settings(const BranchSettings& b)
+{
+    auto require = [](bool ok, const char* what) {
+        if (!ok) throw InvalidInput(std::string("settings.branches.") + what);
+    };
+    require(b.pipe_exponent >= 1 && b.pipe_exponent <= 4, "pipe_exponent must be in [1, 4]");
+    require(b.tip_radius_m >= 0.0001 && b.tip_radius_m <= 0.05, "tip_radius_m must be in [0.0001, 0.05]");
+    require(b.radial_segments >= 3 && b.radial_segments <= 64, "radial_segments must be in [3, 64]");
+    require(b.ring_spacing_m >= 0.002 && b.ring_spacing_m <= 1, "ring_spacing_m must be in [0.002, 1]");
+    require(b.smoothing_iterations >= 0 && b.smoothing_iterations <= 20, "smoothing_iterations must be in [0, 20]");
+    require(b.lod_count >= 1 && b.lod_count <= 6, "lod_count must be in [1, 6]");
+}
+
+void validate_leaf_settings(const LeafSettings& l)
+{
+    auto require = [](bool ok, const char* what) {
+        if (!ok) throw InvalidInput(std::string("settings.leaves.") + what);
+    };
+    require(l.length_m >= 0.002 && l.length_m <= 1, "length_m must be in [0.002, 1]");
+    require(l.width_m >= 0.001 && l.width_m <= 1, "width_m must be in [0.001, 1]");
+    require(l.per_node >= 0 && l.per_node <= 64, "per_node must be in [0, 64]");
+    require(l.deviation_deg >= 0 && l.deviation_deg <= 180, "deviation_deg must be in [0, 180]");
+    require(l.shape == "ovate" || l.shape == "round" || l.shape == "needle",
+            "shape must be \"ovate\", \"round\" or \"needle\"");
 }
 
 nlohmann::json settings_json(const Settings& s) { return settings_to_json(s); }
@@ -239,7 +426,12 @@ json document_to_json(const Document& doc)
     for (const Stroke& s : doc.strokes) strokes.push_back(stroke_to_json(s));
     json lobes = json::array();
     for (const LobeRecord& l : doc.lobes)
-        lobes.push_back({{"id", l.id}, {"strokes", l.stroke_ids}, {"mesh", l.mesh_file}});
+    {
+        json r{{"id", l.id}, {"strokes", l.stroke_ids}, {"mesh", l.mesh_file}};
+        if (l.split_angle_deg) r["split_angle_deg"] = *l.split_angle_deg;
+        if (!l.species.empty()) r["species"] = l.species;
+        lobes.push_back(std::move(r));
+    }
     json edits = json::array();
     for (const EditOperation& e : doc.edits)
         edits.push_back({{"id", e.id}, {"type", e.type}, {"target", e.target}, {"params", e.params}});
@@ -309,6 +501,17 @@ Document document_from_json(const json& j)
                 }
             }
             if (auto m = l.find("mesh"); m != l.end() && m->is_string()) r.mesh_file = m->get<std::string>();
+            if (auto t = l.find("split_angle_deg"); t != l.end()) {
+                if (!t->is_number()) throw InvalidInput(w + ".split_angle_deg: expected a number");
+                const double v = t->get<double>();
+                if (!(v >= 5 && v <= 180)) throw InvalidInput(w + ".split_angle_deg: must be in [5, 180]");
+                r.split_angle_deg = v;
+            }
+            if (auto sp = l.find("species"); sp != l.end()) {
+                if (!sp->is_string() || sp->get<std::string>().size() > 64)
+                    throw InvalidInput(w + ".species: expected a name of at most 64 characters");
+                r.species = sp->get<std::string>();
+            }
             doc.lobes.push_back(std::move(r));
         }
     }

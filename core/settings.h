@@ -4,6 +4,8 @@
 /// Every field is settable from the CLI/settings files and stored in the session document.
 
 #include <cstdint>
+#include <map>
+#include <string>
 
 namespace lobe {
 
@@ -62,10 +64,61 @@ struct LobeSettings {
     double pinch_pick_distance_m = 0.05;
 };
 
+/// Tree growth inside the lobes (§5.2). α and β are the paper's; the rest are ours, since the
+/// paper's thresholds are in scene units of unknown scale. docs/growth.md explains each.
+struct GrowthSettings {
+    /// Species preset (growth/data/species/<name>.json) the appearance settings came from.
+    std::string species = "broadleaf";
+    /// Split angle t: a cluster whose horizontal or vertical span exceeds it is split into
+    /// ⌈θh/t⌉ × ⌈θv/t⌉ pieces. Smaller t gives denser branching.
+    double split_angle_deg = 30.0;
+    double alpha = 0.8;  ///< weight of the node's own direction in V_A
+    double beta = -0.3;  ///< weight of gravity (0, −1, 0) in V_A: negative grows upwards
+    /// A subtree's length is this fraction of the signed distance from its node to the lobe
+    /// surface along V_A.
+    double growth_ratio = 0.45;
+    /// A node whose signed distance to the surface along V_A falls below this stops; its
+    /// attractors leave the next iteration.
+    double stop_distance_m = 0.012;
+    /// An attractor is reached (and removed) when a node comes within this distance.
+    double kill_distance_m = 0.05;
+    /// Spacing of skeleton nodes along trunk strokes.
+    double skeleton_spacing_m = 0.02;
+    int max_iterations = 64;
+    int max_nodes = 500000;
+    /// Relative weights of the library subtrees (growth/data/subtrees.json) by name; missing
+    /// names weigh 0. Empty: all subtrees weigh the same.
+    std::map<std::string, double> subtree_weights;
+};
+
+/// Branch radii (pipe model) and generalised-cylinder geometry.
+struct BranchSettings {
+    double pipe_exponent = 2.0;   ///< r_parent^e = Σ r_child^e
+    double tip_radius_m = 0.0012; ///< radius at every tip
+    int radial_segments = 8;      ///< around a branch at LOD0
+    double ring_spacing_m = 0.015; ///< largest distance between rings along a branch at LOD0
+    int smoothing_iterations = 2; ///< Laplacian smoothing passes of branch curves
+    double bark_color[3] = {0.36, 0.25, 0.17}; ///< linear RGB
+    int lod_count = 3;            ///< levels of detail written (LOD0 … LOD{n−1})
+};
+
+/// Leaves: alpha-tested textured quads at tip nodes.
+struct LeafSettings {
+    double length_m = 0.055;
+    double width_m = 0.032;
+    int per_node = 4;            ///< leaves at each tip node
+    double deviation_deg = 35.0; ///< random deviation from the branch direction
+    double color[3] = {0.20, 0.42, 0.12}; ///< linear RGB
+    std::string shape = "ovate"; ///< leaf texture: "ovate", "round" or "needle"
+};
+
 /// All settings of a session.
 struct Settings {
     InputOptions input;
     LobeSettings lobes;
+    GrowthSettings growth;
+    BranchSettings branches;
+    LeafSettings leaves;
 };
 
 } // namespace lobe

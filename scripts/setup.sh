@@ -11,6 +11,7 @@ PACKAGES=(
   nlohmann-json3-dev libcli11-dev libglm-dev libeigen3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libcgal-dev libopenmesh-dev libgmp-dev libmpfr-dev
+  libnanoflann-dev libtinygltf-dev libstb-dev
 )
 
 missing=()
