@@ -63,7 +63,7 @@ void add_lobes_command(CLI::App& app, int& exit_code)
             std::filesystem::create_directories(a->out + "/lobes", ec);
             if (ec) throw FileError(a->out + "/lobes", "cannot create folder: " + ec.message());
             write_ply(a->out + "/lobes/lobe_1.ply", mesh);
-            doc.lobes.push_back({1, {}, "lobes/lobe_1.ply"});
+            doc.lobes.push_back({1, {}, "lobes/lobe_1.ply", std::nullopt, {}});
             save_document(a->out + "/session.json", doc);
             const MeshQuality q = measure_quality(mesh);
             progress("wrote " + a->out + "/lobes/lobe_1.ply (" + std::to_string(q.vertices) + " vertices, " +

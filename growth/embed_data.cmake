@@ -1,4 +1,5 @@
-# Writes OUT: a C++ table of the files in FILES (paths relative to ROOT) and their bytes.
+# Writes OUT: a C++ table of the files in FILES ("|"-separated; names relative to ROOT) and their bytes.
+string(REPLACE "|" ";" FILES "${FILES}")
 set(body "// Generated from growth/data by embed_data.cmake: do not edit.\n#include \"growth/embedded_data.h\"\n\nnamespace lobe {\nnamespace {\n")
 set(table "")
 set(i 0)

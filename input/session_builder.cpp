@@ -124,7 +124,7 @@ void SessionBuilder::add_stroke(const Stroke& stroke)
         }
     }
     if (!target) {
-        doc_.lobes.push_back(LobeRecord{next_lobe_id_++, {}, {}});
+        doc_.lobes.push_back(LobeRecord{next_lobe_id_++, {}, {}, std::nullopt, {}});
         target = &doc_.lobes.back();
     }
     new_lobe_pending_ = false;

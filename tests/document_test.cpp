@@ -22,7 +22,12 @@ Document sample_document()
     s.closed = true;
     s.points = {{{0.1f, 1.2f, -0.3f}, 0.5}, {{0.11f, 1.25f, -0.31f}, 0.51}};
     d.strokes.push_back(s);
-    d.lobes.push_back({7, {3}, "lobes/lobe_7.ply"});
+    d.lobes.push_back({7, {3}, "lobes/lobe_7.ply", 22.5, "willow"});
+    d.settings.growth.split_angle_deg = 40;
+    d.settings.growth.subtree_weights = {{"fork", 2.0}, {"whorl", 0.5}};
+    d.settings.branches.radial_segments = 11;
+    d.settings.leaves.shape = "needle";
+    d.settings.leaves.color[1] = 0.7;
     d.edits.push_back({1, "pinch_deform", 7, {{"handle", {0.1, 0.2, 0.3}}}});
     TreeInstance t;
     t.id = 1;
@@ -89,6 +94,16 @@ TEST(Document, BadDocumentsGiveOneLineMessagesNamingTheFile)
         {"{\"format\":\"lobesketch-session\",\"version\":1,\"settings\":{\"input\":{\"bogus\":1}}}", "unknown key 'bogus'"},
         {"{\"format\":\"lobesketch-session\",\"version\":1,\"settings\":{\"input\":{\"pinch_start_m\":5}}}",
          "pinch_start_m must be"},
+        {"{\"format\":\"lobesketch-session\",\"version\":1,\"settings\":{\"growth\":{\"split_angle_deg\":2}}}",
+         "settings.growth.split_angle_deg must be in [5, 180]"},
+        {"{\"format\":\"lobesketch-session\",\"version\":1,\"settings\":{\"growth\":{\"max_nodes\":1e30}}}",
+         "settings.growth.max_nodes: expected an integer"},
+        {"{\"format\":\"lobesketch-session\",\"version\":1,\"settings\":{\"leaves\":{\"shape\":\"star\"}}}",
+         "settings.leaves.shape must be"},
+        {"{\"format\":\"lobesketch-session\",\"version\":1,\"settings\":{\"branches\":{\"bark_color\":[1,2]}}}",
+         "settings.branches.bark_color: expected [r, g, b]"},
+        {"{\"format\":\"lobesketch-session\",\"version\":1,\"lobes\":[{\"id\":1,\"split_angle_deg\":500}]}",
+         "lobes[0].split_angle_deg: must be in [5, 180]"},
     };
     for (const Case& c : cases) {
         std::string path = dir + "/bad.json";

@@ -1,0 +1,64 @@
+#include "app/tree_pipeline.h"
+
+#include "growth/radii.h"
+#include "growth/species.h"
+#include "meshing/edit_ops.h"
+
+namespace lobe {
+
+std::vector<GrowthLobe> growth_lobes(const Document& doc, const std::vector<BuiltLobe>& lobes)
+{
+    const SubtreeLibrary& library = default_subtree_library();
+    const std::vector<double> tree_weights = subtree_weights(library, doc.settings.growth.subtree_weights);
+    std::vector<GrowthLobe> out;
+    for (const BuiltLobe& b : lobes) {
+        GrowthLobe g;
+        g.id = b.lobe_id;
+        g.mesh = b.mesh;
+        g.split_angle_deg = doc.settings.growth.split_angle_deg;
+        g.subtree_weights = tree_weights;
+        for (const LobeRecord& r : doc.lobes) {
+            if (r.id != b.lobe_id) continue;
+            if (!r.species.empty()) {
+                // The lobe's species brings its own split angle and subtree mix.
+                Settings s = doc.settings;
+                apply_species(s, load_species(r.species));
+                g.split_angle_deg = s.growth.split_angle_deg;
+                g.subtree_weights = subtree_weights(library, s.growth.subtree_weights);
+            }
+            if (r.split_angle_deg) g.split_angle_deg = *r.split_angle_deg;
+        }
+        out.push_back(std::move(g));
+    }
+    return out;
+}
+
+BuiltTree grow_document_tree(const Document& doc, std::vector<BuiltLobe> lobes)
+{
+    BuiltTree t;
+    t.lobes = std::move(lobes);
+    std::vector<std::vector<glm::vec3>> trunk;
+    for (const Stroke& s : effective_strokes(doc)) {
+        if (s.kind != StrokeKind::Trunk) continue;
+        std::vector<glm::vec3> pts;
+        pts.reserve(s.points.size());
+        for (const StrokePoint& p : s.points) pts.push_back(p.position);
+        trunk.push_back(std::move(pts));
+    }
+    t.growth = grow_tree(trunk, growth_lobes(doc, t.lobes), doc.settings.growth, default_subtree_library(), doc.seed);
+    assign_pipe_radii(t.growth.tree, doc.settings.branches.pipe_exponent, doc.settings.branches.tip_radius_m);
+    for (const std::string& m : t.growth.messages) t.warnings.push_back("growth: " + m);
+    return t;
+}
+
+BuiltTree build_document_tree(const Document& doc)
+{
+    std::vector<std::string> warnings;
+    std::vector<BuiltLobe> lobes = build_document_lobes(doc, &warnings);
+    BuiltTree t = grow_document_tree(doc, std::move(lobes));
+    warnings.insert(warnings.end(), t.warnings.begin(), t.warnings.end());
+    t.warnings = std::move(warnings);
+    return t;
+}
+
+} // namespace lobe

@@ -1,0 +1,95 @@
+#pragma once
+/// \file grow.h
+/// Lobe-guided growth (Zhang et al., §5.2, Fig. 7–8). The lobe vertices are attractors. Each
+/// iteration assigns every live attractor to its nearest branch node; nodes with attractors
+/// are active; an active node's cluster is split by its angular spans into pieces, and each
+/// piece grows one library subtree along V_A = V_cluster + α·V_default + β·V_gravity, scaled
+/// to the signed distance from the node to the lobe surface along V_A. A piece whose distance
+/// is below the stop threshold stops and its attractors leave the next iteration; attractors
+/// within the kill distance of a node are reached and removed. docs/growth.md.
+///
+/// Each lobe grows on its own from the shared skeleton (plus limbs made for it), with random
+/// streams keyed by (seed, lobe id, node), so editing one lobe leaves the branches grown in
+/// the others bit-identical.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "core/mesh.h"
+#include "core/settings.h"
+#include "core/tree.h"
+#include "growth/skeleton.h"
+#include "growth/subtree_library.h"
+
+namespace lobe {
+
+/// One lobe to grow in.
+struct GrowthLobe {
+    std::int64_t id = 0;    ///< the lobe's id: keys its random streams
+    TriangleMesh mesh;      ///< closed, outward, stage space; its vertices are the attractors
+    double split_angle_deg = 30.0;       ///< t for this lobe (the tree's, or the lobe's override)
+    std::vector<double> subtree_weights; ///< per library subtree (subtree_weights()); empty = all equal
+};
+
+struct LobeGrowthStats {
+    std::size_t attractors = 0;
+    std::size_t reached = 0;  ///< came within the kill distance of a node
+    std::size_t stopped = 0;  ///< left with a node that stopped (too close to the surface)
+    std::size_t nodes = 0;    ///< nodes grown in this lobe
+    std::size_t subtrees = 0; ///< subtrees grown
+    int iterations = 0;
+    bool iteration_cap = false;
+    bool node_cap = false;
+    double coverage() const { return attractors ? static_cast<double>(reached) / static_cast<double>(attractors) : 1.0; }
+};
+
+struct GrowthResult {
+    TreeGraph tree; ///< skeleton nodes first, then each lobe's grown nodes in lobe order; radii unset
+    std::size_t skeleton_nodes = 0;
+    std::vector<LobeGrowthStats> lobes;
+    std::vector<std::string> messages; ///< one line each (skeleton messages, caps hit)
+};
+
+/// Most nodes a single piece's cluster split may make (⌈θh/t⌉ × ⌈θv/t⌉ is capped to this).
+inline constexpr int kMaxPiecesPerNode = 256;
+/// A node grows at most this many times (once per iteration it is active in).
+inline constexpr int kMaxGrowthsPerNode = 4;
+
+/// V_A = V_cluster + α·V_default + β·(0, −1, 0), unnormalised (§5.2).
+glm::dvec3 growth_vector(const glm::dvec3& v_cluster, const glm::dvec3& v_default, double alpha, double beta);
+
+/// Angular spans of a cluster of unit directions: θh the smallest arc of azimuths (about +Y)
+/// that holds them all, θv the range of elevations; both in degrees.
+struct ClusterSpan {
+    double horizontal_deg = 0.0;
+    double vertical_deg = 0.0;
+};
+ClusterSpan cluster_span(const std::vector<glm::vec3>& unit_dirs);
+
+/// Splits a cluster into ⌈θh/t⌉ × ⌈θv/t⌉ pieces by azimuth and elevation (one piece when
+/// neither span exceeds t). Returns the non-empty pieces as indices into `unit_dirs`, in
+/// bin order; `grid` (when given) receives the number of bins horizontally and vertically.
+std::vector<std::vector<int>> split_cluster(const std::vector<glm::vec3>& unit_dirs, double split_angle_deg,
+                                            int* grid_h = nullptr, int* grid_v = nullptr);
+
+/// V_cluster: the mean of the unit vectors from `node` to `attractors`, each weighted by the
+/// inverse of its distance (nearer attractors pull harder), normalised.
+glm::dvec3 cluster_direction(const glm::vec3& node, const std::vector<glm::vec3>& attractors);
+
+/// Grows one lobe from `skeleton` (its shared nodes and the limbs made for lobe
+/// `lobe_index`). The returned nodes' parents index `skeleton.graph.nodes` when below
+/// skeleton.graph.size() and the returned nodes (offset by that size) otherwise.
+std::vector<TreeNode> grow_in_lobe(const Skeleton& skeleton, int lobe_index, const GrowthLobe& lobe,
+                                   const GrowthSettings& settings, const SubtreeLibrary& library,
+                                   std::uint64_t seed, LobeGrowthStats& stats);
+
+/// The whole tree: skeleton from the trunk strokes (or the default trunk), then every lobe's
+/// growth, merged into one graph rooted at the trunk base. Radii are left to
+/// assign_pipe_radii (radii.h).
+GrowthResult grow_tree(const std::vector<std::vector<glm::vec3>>& trunk_strokes, const std::vector<GrowthLobe>& lobes,
+                       const GrowthSettings& settings, const SubtreeLibrary& library, std::uint64_t seed);
+
+} // namespace lobe

@@ -1,0 +1,98 @@
+#include "growth/species.h"
+
+#include <algorithm>
+
+#include "core/atomic_file.h"
+#include "core/document.h"
+#include "core/errors.h"
+#include "growth/embedded_data.h"
+
+namespace lobe {
+
+using nlohmann::json;
+
+namespace {
+constexpr std::size_t kMaxSpeciesBytes = 1u << 20;
+const std::string kPrefix = "species/";
+} // namespace
+
+std::vector<std::string> species_names()
+{
+    std::vector<std::string> names;
+    for (const EmbeddedFile& f : embedded_growth_data())
+        if (f.name.rfind(kPrefix, 0) == 0 && f.name.size() > kPrefix.size() + 5)
+            names.push_back(f.name.substr(kPrefix.size(), f.name.size() - kPrefix.size() - 5));
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+SpeciesPreset parse_species(const std::string& text, const std::string& where)
+{
+    const json j = json::parse(text, nullptr, /*allow_exceptions=*/false);
+    if (j.is_discarded()) throw InvalidInput(where + ": not valid JSON");
+    if (!j.is_object() || j.value("format", std::string()) != "lobesketch-species")
+        throw InvalidInput(where + ": not a species preset (missing \"format\": \"lobesketch-species\")");
+    if (!j.contains("version") || !j["version"].is_number_integer() || j["version"].get<int>() != 1)
+        throw InvalidInput(where + ": unsupported species preset version (this program reads version 1)");
+    for (auto it = j.begin(); it != j.end(); ++it) {
+        const std::string& k = it.key();
+        if (k != "format" && k != "version" && k != "name" && k != "description" && k != "growth" &&
+            k != "branches" && k != "leaves")
+            throw InvalidInput(where + ": unknown key '" + k + "'");
+    }
+    SpeciesPreset p;
+    if (!j.contains("name") || !j["name"].is_string() || j["name"].get<std::string>().empty() ||
+        j["name"].get<std::string>().size() > 64)
+        throw InvalidInput(where + ": \"name\" must be a name of 1 to 64 characters");
+    p.name = j["name"].get<std::string>();
+    if (j.contains("description")) {
+        if (!j["description"].is_string()) throw InvalidInput(where + ": \"description\" must be a string");
+        p.description = j["description"].get<std::string>();
+    }
+    auto part = [&](const char* key, json& out) {
+        if (!j.contains(key)) return;
+        if (!j[key].is_object()) throw InvalidInput(where + ": \"" + key + "\" must be an object");
+        out = j[key];
+    };
+    part("growth", p.growth);
+    part("branches", p.branches);
+    part("leaves", p.leaves);
+    if (p.growth.contains("species")) throw InvalidInput(where + ": growth.species is the preset's own name");
+    // Every key and type is checked now, so a bad preset fails when it is read, not when used.
+    Settings probe;
+    apply_species(probe, p);
+    return p;
+}
+
+SpeciesPreset load_species(const std::string& name_or_path)
+{
+    const bool is_file = name_or_path.size() > 5 && name_or_path.compare(name_or_path.size() - 5, 5, ".json") == 0;
+    if (is_file) {
+        const std::string text = read_file_limited(name_or_path, kMaxSpeciesBytes);
+        return parse_species(text, name_or_path);
+    }
+    for (const EmbeddedFile& f : embedded_growth_data())
+        if (f.name == kPrefix + name_or_path + ".json") return parse_species(std::string(f.text), f.name);
+    std::string known;
+    for (const std::string& n : species_names()) known += (known.empty() ? "" : ", ") + n;
+    throw InvalidInput("unknown species '" + name_or_path + "' (known: " + known + ", or a preset .json file)");
+}
+
+void apply_species(Settings& settings, const SpeciesPreset& preset)
+{
+    Settings s = settings;
+    try {
+        read_growth_settings(preset.growth, s.growth, "growth");
+        read_branch_settings(preset.branches, s.branches, "branches");
+        read_leaf_settings(preset.leaves, s.leaves, "leaves");
+        s.growth.species = preset.name;
+        validate_growth_settings(s.growth);
+        validate_branch_settings(s.branches);
+        validate_leaf_settings(s.leaves);
+    } catch (const InvalidInput& e) {
+        throw InvalidInput("species '" + preset.name + "': " + e.what());
+    }
+    settings = std::move(s);
+}
+
+} // namespace lobe

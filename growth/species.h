@@ -1,0 +1,37 @@
+#pragma once
+/// \file species.h
+/// Species presets: settings files that overlay the growth, branch and leaf settings so that
+/// one choice gives a visibly different tree (broadleaf, conifer, willow, birch ship in
+/// growth/data/species/; format in docs/growth.md).
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/settings.h"
+
+namespace lobe {
+
+struct SpeciesPreset {
+    std::string name;
+    std::string description;
+    nlohmann::json growth = nlohmann::json::object();   ///< partial settings.growth
+    nlohmann::json branches = nlohmann::json::object(); ///< partial settings.branches
+    nlohmann::json leaves = nlohmann::json::object();   ///< partial settings.leaves
+};
+
+/// Names of the presets compiled into the program, sorted.
+std::vector<std::string> species_names();
+/// Parses a preset file's text; checks every key and type against the settings it overlays.
+/// \throw InvalidInput with a one-line reason naming `where`.
+SpeciesPreset parse_species(const std::string& text, const std::string& where);
+/// A shipped preset by name, or a preset file when `name_or_path` ends in ".json".
+/// \throw InvalidInput (unknown name, listing the known ones) or FileError (unreadable file).
+SpeciesPreset load_species(const std::string& name_or_path);
+/// Overlays `preset` on `settings` (growth, branches, leaves; growth.species = its name) and
+/// range-checks the result. Strong guarantee: on a throw `settings` is unchanged.
+/// \throw InvalidInput
+void apply_species(Settings& settings, const SpeciesPreset& preset);
+
+} // namespace lobe
