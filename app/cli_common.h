@@ -34,5 +34,7 @@ void add_replay_command(CLI::App& app, int& exit_code);
 void add_import_commands(CLI::App& app, int& exit_code);
 void add_synth_command(CLI::App& app, int& exit_code);
 void add_lobes_command(CLI::App& app, int& exit_code);
+void add_grow_command(CLI::App& app, int& exit_code);
+void add_export_command(CLI::App& app, int& exit_code);
 
 } // namespace lobe::cli

@@ -23,6 +23,8 @@ int run_cli(int argc, char** argv)
     cli::add_import_commands(app, exit_code);
     cli::add_synth_command(app, exit_code);
     cli::add_lobes_command(app, exit_code);
+    cli::add_grow_command(app, exit_code);
+    cli::add_export_command(app, exit_code);
     app.parse_complete_callback([&] { cli::set_quiet(quiet); });
     try {
         app.parse(argc, argv);

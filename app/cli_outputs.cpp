@@ -36,9 +36,10 @@ void write_strokes_json(const std::string& path, const std::vector<Stroke>& stro
 
 namespace lobe {
 
-std::size_t write_document_lobes(Document& doc, const std::string& out_dir, std::vector<std::string>& warnings)
+std::size_t write_document_lobes(Document& doc, const std::string& out_dir, std::vector<std::string>& warnings,
+                                 std::vector<BuiltLobe>* built)
 {
-    const std::vector<BuiltLobe> lobes = build_document_lobes(doc, &warnings);
+    std::vector<BuiltLobe> lobes = build_document_lobes(doc, &warnings);
     const std::string dir = out_dir + "/lobes";
     std::error_code ec;
     std::filesystem::create_directories(dir, ec);
@@ -54,6 +55,7 @@ std::size_t write_document_lobes(Document& doc, const std::string& out_dir, std:
             ++written;
         }
     }
+    if (built) *built = std::move(lobes);
     return written;
 }
 

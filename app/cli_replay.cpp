@@ -9,6 +9,7 @@
 #include "app/cli_common.h"
 #include "app/edit_hooks.h"
 #include "app/outputs.h"
+#include "app/tree_output.h"
 #include "core/errors.h"
 #include "input/pipeline.h"
 #include "input/session_builder.h"
@@ -24,7 +25,7 @@ void add_replay_command(CLI::App& app, int& exit_code)
     };
     auto a = std::make_shared<Args>();
     cmd->add_option("REC", a->rec, "Recording (binary or text form)")->required();
-    cmd->add_option("-o,--out", a->out, "Output folder (created): strokes.json, session.json, lobes/lobe_N.ply")
+    cmd->add_option("-o,--out", a->out, "Output folder (created): strokes.json, session.json, lobes/lobe_N.ply, tree.glb")
         ->required();
     cmd->add_option("--settings", a->settings, "Settings JSON (a settings object or a session document)");
     cmd->add_option("--seed", a->seed, "Seed of every random choice downstream")->capture_default_str();
@@ -55,17 +56,32 @@ void add_replay_command(CLI::App& app, int& exit_code)
         // the session again with their files.
         save_document(a->out + "/session.json", out_doc);
         std::vector<std::string> warnings;
-        const std::size_t lobe_files = write_document_lobes(out_doc, a->out, warnings);
+        std::vector<BuiltLobe> lobes;
+        const std::size_t lobe_files = write_document_lobes(out_doc, a->out, warnings, &lobes);
         for (const std::string& w : warnings) warn(a->rec + ": " + w);
         save_document(a->out + "/session.json", out_doc);
+        // Then the tree grown in those lobes (docs/growth.md, docs/export.md).
+        bool tree_written = false;
+        if (!lobes.empty()) {
+            const BuiltTree tree = grow_document_tree(out_doc, std::move(lobes));
+            for (const std::string& w : tree.warnings) warn(a->rec + ": " + w);
+            const TreeGeometry geometry = document_tree_geometry(out_doc, tree);
+            write_tree_file(a->out + "/tree.glb", out_doc, tree, geometry, ExportOptions{});
+            tree_written = true;
+            std::string lods;
+            for (std::size_t i = 0; i < geometry.lods.size(); ++i)
+                lods += (i ? ", " : "") + std::string("LOD") + std::to_string(i) + " " +
+                        std::to_string(lod_triangles(geometry.lods[i]));
+            progress("grew a tree of " + std::to_string(tree.growth.tree.size()) + " nodes (triangles " + lods + ")");
+        }
         std::size_t lobe_strokes = 0, trunk_strokes = 0;
         for (const Stroke& s : out_doc.strokes) (s.kind == StrokeKind::Lobe ? lobe_strokes : trunk_strokes)++;
         progress("derived " + std::to_string(out_doc.strokes.size()) + " strokes (" + std::to_string(lobe_strokes) +
                  " lobe, " + std::to_string(trunk_strokes) + " trunk) in " + std::to_string(out_doc.lobes.size()) +
                  " lobe group(s), " + std::to_string(out_doc.edits.size()) + " edit(s) from " +
                  std::to_string(result.drags.size()) + " drag(s)");
-        progress("wrote " + a->out + "/strokes.json, " + a->out + "/session.json and " + std::to_string(lobe_files) +
-                 " lobe mesh(es) in " + a->out + "/lobes");
+        progress("wrote " + a->out + "/strokes.json, " + a->out + "/session.json, " + std::to_string(lobe_files) +
+                 " lobe mesh(es) in " + a->out + "/lobes" + (tree_written ? " and " + a->out + "/tree.glb" : ""));
         if (out_doc.strokes.empty() && result.drags.empty()) {
             error(a->rec + ": no strokes in this recording");
             exit_code = kExitFailure;

@@ -7,6 +7,7 @@
 
 #include "core/document.h"
 #include "core/stroke.h"
+#include "meshing/lobe_document.h"
 
 namespace lobe {
 
@@ -17,7 +18,9 @@ void write_strokes_json(const std::string& path, const std::vector<Stroke>& stro
 /// Rebuilds every lobe of `doc` (meshing/lobe_document.h) and writes each as
 /// `out_dir/lobes/lobe_<id>.ply`, recording the relative path in the lobe's mesh_file.
 /// Lobes that cannot be built get an empty mesh_file. Warnings are appended, one line each.
-/// Returns the number of lobe files written. 	hrow FileError
-std::size_t write_document_lobes(Document& doc, const std::string& out_dir, std::vector<std::string>& warnings);
+/// Returns the number of lobe files written; `built` (when given) receives the lobes.
+/// \throw FileError
+std::size_t write_document_lobes(Document& doc, const std::string& out_dir, std::vector<std::string>& warnings,
+                                 std::vector<BuiltLobe>* built = nullptr);
 
 } // namespace lobe

@@ -1,0 +1,82 @@
+#include "app/regrow_worker.h"
+
+#include "app/tree_output.h"
+#include "core/errors.h"
+
+namespace lobe {
+
+RegrowWorker::RegrowWorker() : thread_([this] { run(); }) {}
+
+RegrowWorker::~RegrowWorker()
+{
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        stop_ = true;
+    }
+    wake_.notify_all();
+    thread_.join();
+}
+
+std::uint64_t RegrowWorker::submit(Document doc)
+{
+    std::uint64_t generation = 0;
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        generation = ++submitted_;
+        pending_ = std::move(doc); // replaces a waiting submission: latest wins
+        pending_generation_ = generation;
+    }
+    wake_.notify_one();
+    return generation;
+}
+
+std::optional<RegrowResult> RegrowWorker::take()
+{
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::optional<RegrowResult> out = std::move(ready_);
+    ready_.reset();
+    return out;
+}
+
+RegrowResult RegrowWorker::wait_for(std::uint64_t generation)
+{
+    std::unique_lock<std::mutex> lock(mutex_);
+    done_.wait(lock, [&] { return ready_ && ready_->generation >= generation; });
+    RegrowResult out = std::move(*ready_);
+    ready_.reset();
+    return out;
+}
+
+void RegrowWorker::run()
+{
+    for (;;) {
+        Document doc;
+        std::uint64_t generation = 0;
+        {
+            std::unique_lock<std::mutex> lock(mutex_);
+            wake_.wait(lock, [&] { return stop_ || pending_.has_value(); });
+            if (stop_) return;
+            doc = std::move(*pending_);
+            pending_.reset();
+            generation = pending_generation_;
+        }
+        RegrowResult result;
+        result.generation = generation;
+        try {
+            result.tree = build_document_tree(doc);
+            result.geometry = document_tree_geometry(doc, result.tree);
+        } catch (const Error& e) {
+            result.error = e.what();
+        } catch (const std::bad_alloc&) {
+            result.error = "out of memory while regrowing the tree";
+        }
+        {
+            std::lock_guard<std::mutex> lock(mutex_);
+            // A result older than a waiting submission is superseded: drop it.
+            if (!pending_ || pending_generation_ <= generation) ready_ = std::move(result);
+        }
+        done_.notify_all();
+    }
+}
+
+} // namespace lobe

@@ -1,0 +1,54 @@
+#pragma once
+/// \file regrow_worker.h
+/// Regrowth off the thread that draws frames: the interactive apps submit the document after
+/// every change and pick up the newest finished tree when it is ready, so a frame never waits
+/// for growth or geometry. Latest wins: a submission made while a regrowth runs replaces any
+/// waiting one, and results of superseded submissions are dropped.
+
+#include <condition_variable>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <thread>
+
+#include "app/tree_pipeline.h"
+#include "growth/tree_geometry.h"
+
+namespace lobe {
+
+struct RegrowResult {
+    std::uint64_t generation = 0; ///< the submit() call this result answers
+    BuiltTree tree;
+    TreeGeometry geometry;
+    std::string error; ///< non-empty when the document could not be grown (one line)
+};
+
+class RegrowWorker {
+public:
+    RegrowWorker();
+    ~RegrowWorker(); ///< stops the worker thread (a running regrowth finishes first)
+    RegrowWorker(const RegrowWorker&) = delete;
+    RegrowWorker& operator=(const RegrowWorker&) = delete;
+
+    /// Queues `doc` for regrowth and returns its generation number (1, 2, …). Never blocks on
+    /// growth.
+    std::uint64_t submit(Document doc);
+    /// The newest finished result newer than the last one taken, if any. Never blocks on growth.
+    std::optional<RegrowResult> take();
+    /// Waits until the result of `generation` (or a newer one) is ready; for tests and batch use.
+    RegrowResult wait_for(std::uint64_t generation);
+
+private:
+    void run();
+
+    std::mutex mutex_;
+    std::condition_variable wake_, done_;
+    std::optional<Document> pending_;
+    std::uint64_t submitted_ = 0, pending_generation_ = 0;
+    std::optional<RegrowResult> ready_;
+    bool stop_ = false;
+    std::thread thread_;
+};
+
+} // namespace lobe
