@@ -74,7 +74,6 @@ struct PreparedExport {
 };
 
 /// Checks `scene` and `options` and transforms the geometry: x' = (x − base) · scale.
-/// \pre scene.tree points to the geometry to export.
 /// \throw InvalidInput (one line) for a missing tree, a bad name, an unknown or repeated LOD
 /// index, a non-finite or negative target height, a tree with no height to scale, array
 /// sizes that disagree, non-finite positions/normals/uvs, zero normals, out-of-range or
