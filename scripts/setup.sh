@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages Lobesketch needs (only those missing, quietly) and builds
-# the given CMake preset (default: release). Safe to run again and again.
+# Installs the Debian 12 packages Lobesketch needs (only those missing, quietly), the Khronos
+# glTF validator the export tests run (npm, pinned, into build/tools/gltf-validator) and
+# builds the given CMake preset (default: release). Safe to run again and again.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -20,6 +21,9 @@ for p in "${PACKAGES[@]}"; do
     missing+=("$p")
   fi
 done
+# Node.js runs the glTF validator; a node/npm already on PATH (from any source) is kept.
+command -v node >/dev/null || missing+=(nodejs)
+command -v npm >/dev/null || missing+=(npm)
 
 if ((${#missing[@]})); then
   SUDO=""
@@ -32,6 +36,17 @@ if ((${#missing[@]})); then
   export DEBIAN_FRONTEND=noninteractive
   $SUDO apt-get update -qq
   $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+# The Khronos glTF validator, pinned; tests/gltf_validate.mjs and the export tests use it.
+GLTF_VALIDATOR_VERSION="2.0.0-dev.3.10"
+GLTF_VALIDATOR_DIR="build/tools/gltf-validator"
+installed="$(node -p "require('./$GLTF_VALIDATOR_DIR/node_modules/gltf-validator/package.json').version" 2>/dev/null || true)"
+if [ "$installed" != "$GLTF_VALIDATOR_VERSION" ]; then
+  echo "setup: installing gltf-validator@$GLTF_VALIDATOR_VERSION into $GLTF_VALIDATOR_DIR"
+  mkdir -p "$GLTF_VALIDATOR_DIR"
+  npm install --prefix "$GLTF_VALIDATOR_DIR" --no-audit --no-fund --save-exact --loglevel=error \
+    "gltf-validator@$GLTF_VALIDATOR_VERSION" >/dev/null
 fi
 
 cmake --preset "$PRESET" >/dev/null
