@@ -1,0 +1,58 @@
+#pragma once
+/// \file leaves.h
+/// Leaves (§5, "leaves are added at the tips of the branches"): alpha-tested textured quads at
+/// the tip nodes of a tree graph, and the procedural leaf textures they use.
+///
+/// Leaf quads: a quad's base edge is centred on its tip node, its axis follows the branch
+/// direction turned by a random angle of at most deviation_deg, and it is rolled by a random
+/// angle about that axis. Texture coordinates: u = 0 … 1 across the leaf, v = 1 at the base
+/// and 0 at the leaf's tip (image rows run top to bottom, glTF's convention, so the leaf in
+/// the texture points up). Random choices come from a stream keyed by (seed, node.lobe,
+/// ordinal of the node among the nodes of its lobe), so editing one lobe leaves the leaves of
+/// every other lobe bit-identical.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/settings.h"
+#include "core/tree.h"
+#include "growth/tree_geometry.h"
+
+namespace lobe {
+
+/// A procedural leaf texture, size × size: the leaf's blade (alpha 255) on alpha 0, its stalk
+/// at the bottom centre and its tip at the top centre, a light midrib and side veins and a
+/// soft mottling. The colours are light (near white, slightly green) because the material's
+/// leaf colour multiplies them. Deterministic.
+/// \param shape "ovate" (pointed, widest below the middle), "round" or "needle" (narrow).
+/// \throw InvalidInput for another shape or a size outside [8, 4096].
+RgbaImage make_leaf_texture(const std::string& shape, int size = 128);
+
+/// How a level of detail thins the leaves.
+struct LeafLodOptions {
+    /// Share of the LOD0 leaves kept, in (0, 1]. Each tip keeps ⌊per_node · keep + r⌋ of its
+    /// LOD0 leaves (r a random number of the tip's stream, so the expected total is exact and
+    /// tips keep a leaf in proportion), and every kept leaf's area is scaled by 1 / keep, so
+    /// the total leaf area stays about the same.
+    double keep_fraction = 1.0;
+};
+
+/// Tip nodes that carry leaves: nodes without children that are neither the root nor on the
+/// skeleton (TreeNodeKind::Grown).
+std::vector<int> leaf_tip_nodes(const TreeGraph& graph);
+
+/// Leaf quads at the tips of `graph`: leaves.per_node quads per tip at LOD0 (fewer, larger
+/// ones at keep_fraction < 1; those are the first of the tip's LOD0 leaves, scaled), each of
+/// length_m × width_m. Four vertices per quad (no vertex shared between quads), normals the
+/// quad's face normal (render two-sided). A tip whose parent is at the same position takes
+/// the direction of the nearest ancestor that is not; if none, +Y.
+/// \param quad_nodes when not null, receives the tip node of each quad.
+/// \throw InvalidInput when keep_fraction is not in (0, 1].
+SurfaceGeometry build_leaf_quads(const TreeGraph& graph, const LeafSettings& leaves, std::uint64_t seed,
+                                 const LeafLodOptions& lod = {}, std::vector<int>* quad_nodes = nullptr);
+
+/// Share of the LOD0 leaves kept at level `lod`: 0.5^lod.
+double leaf_lod_keep_fraction(int lod);
+
+} // namespace lobe
