@@ -18,7 +18,6 @@
 #include "growth/species.h"
 #include "input/pipeline.h"
 #include "input/session_builder.h"
-#include "meshing/model_import.h"
 
 namespace lobe::cli {
 
@@ -131,21 +130,7 @@ void add_grow_command(CLI::App& app, int& exit_code)
         if (a->seed) doc.seed = *a->seed;
         BuiltTree tree;
         if (is_mesh_file(a->input)) {
-            // A mesh becomes one lobe (docs/lobes-from-models.md), raised by half its height
-            // so the default trunk has room below it.
-            LobeFromModelOptions mo;
-            mo.size_m = a->size;
-            mo.target_edge_length_m = doc.settings.lobes.edge_length_m;
-            mo.iterations = static_cast<unsigned>(doc.settings.lobes.remesh_iterations);
-            BuiltLobe lobe;
-            lobe.lobe_id = 1;
-            lobe.mesh = lobe_from_model(a->input, mo);
-            float lo = 1e30f, hi = -1e30f;
-            for (const glm::vec3& p : lobe.mesh.positions) {
-                lo = std::min(lo, p.y);
-                hi = std::max(hi, p.y);
-            }
-            for (glm::vec3& p : lobe.mesh.positions) p.y += 0.5f * (hi - lo);
+            const BuiltLobe lobe = model_lobe(a->input, doc.settings, a->size);
             doc.lobes.push_back({1, {}, "", std::nullopt, {}});
             tree = grow_document_tree(doc, {lobe});
         } else {

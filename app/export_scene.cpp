@@ -64,14 +64,15 @@ std::vector<int> chosen_lods(const TreeGeometry& tree, const std::vector<int>& r
     return lods;
 }
 
-/// Height of the tallest tree vertex above the base, over all LODs (so that exporting a
-/// subset of LODs scales exactly like exporting all of them).
+/// Height of the tallest vertex of LOD0 (the tree itself; coarser LODs' larger leaves may
+/// reach a little higher) above the base, so that exporting any subset of LODs scales
+/// exactly like exporting all of them.
 double tree_height(const TreeGeometry& tree, const glm::vec3& base)
 {
     double top = -std::numeric_limits<double>::infinity();
-    for (const TreeLod& lod : tree.lods)
-        for (const SurfaceGeometry* g : {&lod.branches, &lod.leaves})
-            for (const glm::vec3& p : g->positions) top = std::max(top, double(p.y) - double(base.y));
+    if (tree.lods.empty()) return top;
+    for (const SurfaceGeometry* g : {&tree.lods[0].branches, &tree.lods[0].leaves})
+        for (const glm::vec3& p : g->positions) top = std::max(top, double(p.y) - double(base.y));
     return top;
 }
 

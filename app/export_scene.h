@@ -28,8 +28,9 @@ struct ExportScene {
 };
 
 struct ExportOptions {
-    /// > 0: scale uniformly (about the base) so the tallest vertex of the tree, branches and
-    /// leaves over all its LODs, lies this many metres above the base. 0: keep the size.
+    /// > 0: scale uniformly (about the base) so the tallest vertex of LOD0 (branches and
+    /// leaves) lies this many metres above the base; every written LOD gets that scale.
+    /// 0: keep the size.
     double target_height_m = 0.0;
     /// Indices of the LODs to write (any order, no repeats); empty = all.
     std::vector<int> lods;

@@ -1,8 +1,12 @@
 #include "app/tree_pipeline.h"
 
+#include <algorithm>
+#include <limits>
+
 #include "growth/radii.h"
 #include "growth/species.h"
 #include "meshing/edit_ops.h"
+#include "meshing/model_import.h"
 
 namespace lobe {
 
@@ -59,6 +63,24 @@ BuiltTree build_document_tree(const Document& doc)
     warnings.insert(warnings.end(), t.warnings.begin(), t.warnings.end());
     t.warnings = std::move(warnings);
     return t;
+}
+
+BuiltLobe model_lobe(const std::string& path, const Settings& settings, double size_m, std::int64_t id)
+{
+    LobeFromModelOptions mo;
+    mo.size_m = size_m;
+    mo.target_edge_length_m = settings.lobes.edge_length_m;
+    mo.iterations = static_cast<unsigned>(settings.lobes.remesh_iterations);
+    BuiltLobe lobe;
+    lobe.lobe_id = id;
+    lobe.mesh = lobe_from_model(path, mo);
+    float lo = std::numeric_limits<float>::max(), hi = -lo;
+    for (const glm::vec3& p : lobe.mesh.positions) {
+        lo = std::min(lo, p.y);
+        hi = std::max(hi, p.y);
+    }
+    for (glm::vec3& p : lobe.mesh.positions) p.y += 0.5f * (hi - lo) - lo;
+    return lobe;
 }
 
 } // namespace lobe

@@ -31,4 +31,10 @@ BuiltTree grow_document_tree(const Document& doc, std::vector<BuiltLobe> lobes);
 /// Builds the document's lobes, then grows its tree in them.
 BuiltTree build_document_tree(const Document& doc);
 
+/// A mesh file as a lobe (meshing/model_import.h: repaired, scaled so its bounding box's
+/// largest side is `size_m`, remeshed to settings.lobes.edge_length_m), then raised so its
+/// lowest point is half its height above the ground: the default trunk has room below it.
+/// \throw FileError, InvalidInput as lobe_from_model.
+BuiltLobe model_lobe(const std::string& path, const Settings& settings, double size_m = 1.5, std::int64_t id = 1);
+
 } // namespace lobe

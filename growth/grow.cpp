@@ -15,6 +15,8 @@ namespace lobe {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
+// A subtree segment that would leave the lobe ends at this fraction of the way to the surface.
+constexpr float kClipFraction = 0.8f;
 
 // SplitMix64 (Steele et al. 2014): a counter-based stream, so each node's random choices
 // depend only on its key, never on how many numbers other nodes drew. Written here because
@@ -40,16 +42,16 @@ private:
     std::uint64_t state_;
 };
 
-// nanoflann adaptor over a range of node positions.
-struct PointRange {
+// nanoflann adaptor over some of the node positions.
+struct NodeSubset {
     const std::vector<glm::vec3>* points = nullptr;
-    std::size_t begin = 0, end = 0;
-    std::size_t kdtree_get_point_count() const { return end - begin; }
-    float kdtree_get_pt(std::size_t i, std::size_t dim) const { return (*points)[begin + i][static_cast<int>(dim)]; }
+    const std::vector<std::uint32_t>* ids = nullptr;
+    std::size_t kdtree_get_point_count() const { return ids->size(); }
+    float kdtree_get_pt(std::size_t i, std::size_t dim) const { return (*points)[(*ids)[i]][static_cast<int>(dim)]; }
     template <class Box>
     bool kdtree_get_bbox(Box&) const { return false; }
 };
-using NodeIndex = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, PointRange>, PointRange, 3,
+using NodeIndex = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, NodeSubset>, NodeSubset, 3,
                                                       std::uint32_t>;
 
 // Rotation taking +Y to `dir`, turned by `roll` about it.
@@ -217,10 +219,26 @@ std::vector<TreeNode> grow_in_lobe(const Skeleton& skeleton, int lobe_index, con
     growths.assign(start_nodes, 0);
     std::vector<std::uint8_t> stopped(start_nodes, 0);
 
+    // Once a lobe has branch nodes inside it, only nodes inside it take its attractors, so
+    // branches grow through the lobe rather than around its thin parts from outside. A lobe
+    // that the skeleton does not enter is grown into from outside (signed distance, §5.2).
+    std::vector<std::uint8_t> eligible(start_nodes, 0);
+    bool inside_only = false;
+    for (std::size_t i = 0; i < start_nodes; ++i) {
+        eligible[i] = ray.inside(pos[i]) ? 1 : 0;
+        inside_only = inside_only || eligible[i];
+    }
+    if (!inside_only) eligible.assign(start_nodes, 1);
+
     // Each attractor keeps its nearest node; only nodes added since are compared (§5.2).
+    std::vector<std::uint32_t> batch;
     auto update_nearest = [&](std::size_t begin, std::size_t end) {
-        PointRange range{&pos, begin, end};
-        NodeIndex index(3, range, nanoflann::KDTreeSingleIndexAdaptorParams(12));
+        batch.clear();
+        for (std::size_t i = begin; i < end; ++i)
+            if (eligible[i]) batch.push_back(static_cast<std::uint32_t>(i));
+        if (batch.empty()) return;
+        NodeSubset subset{&pos, &batch};
+        NodeIndex index(3, subset, nanoflann::KDTreeSingleIndexAdaptorParams(12));
         for (std::size_t a = 0; a < na; ++a) {
             if (!live[a]) continue;
             std::uint32_t idx = 0;
@@ -228,7 +246,7 @@ std::vector<TreeNode> grow_in_lobe(const Skeleton& skeleton, int lobe_index, con
             if (index.knnSearch(&attractors[a].x, 1, &idx, &d2) == 0) continue;
             if (d2 < nearest_d2[a]) {
                 nearest_d2[a] = d2;
-                nearest[a] = static_cast<std::uint32_t>(begin + idx);
+                nearest[a] = batch[idx];
             }
             if (nearest_d2[a] < kill2) {
                 live[a] = 0;
@@ -300,7 +318,16 @@ std::vector<TreeNode> grow_in_lobe(const Skeleton& skeleton, int lobe_index, con
                 glm::dvec3 va = growth_vector(vc, glm::dvec3(heading[n]), settings.alpha, settings.beta);
                 if (glm::length(va) < 1e-9) va = vc;
                 const glm::vec3 dir = glm::vec3(glm::normalize(va));
-                const float s = ray.signed_distance_along(pos[n], dir);
+                bool node_inside = false;
+                glm::vec3 dir_used = dir;
+                float s = ray.signed_distance_along(pos[n], dir, &node_inside);
+                // The stop rule is for grown tips. A sketched skeleton node is not a tip: where
+                // V_A would stop it at the surface (a trunk running close under a flat lobe's
+                // top, pointing up), it sprouts along V_cluster, towards its attractors, instead.
+                if (n < start_nodes && s >= 0.0f && s < static_cast<float>(settings.stop_distance_m)) {
+                    dir_used = glm::vec3(vc);
+                    s = ray.signed_distance_along(pos[n], dir_used, &node_inside);
+                }
                 // Outside the lobe with V_A missing it: nothing to grow towards from here.
                 // The attractors stay live, so nodes grown nearer can take them; the
                 // node's attempts are bounded by kMaxGrowthsPerNode.
@@ -314,14 +341,27 @@ std::vector<TreeNode> grow_in_lobe(const Skeleton& skeleton, int lobe_index, con
                 Stream rng(seed, lobe.id, n, growths[n], p);
                 const std::size_t sub = pick_weighted(weights, rng.uniform());
                 const Subtree& st = library.subtrees[sub];
-                const Frame f = frame_along(dir, rng.uniform() * 2 * kPi);
+                const Frame f = frame_along(dir_used, rng.uniform() * 2 * kPi);
                 const std::size_t base = pos.size();
+                const bool root_inside = node_inside;
                 for (std::size_t j = 1; j < st.nodes.size(); ++j) {
                     const int sp = st.parents[j];
                     const std::size_t parent = sp == 0 ? n : base + static_cast<std::size_t>(sp) - 1;
-                    const glm::vec3 q = pos[n] + length * f.apply(st.nodes[j]);
-                    const glm::vec3 d = q - pos[parent];
+                    // Each segment of the subtree, turned and scaled, from where its parent ended up.
+                    glm::vec3 q = pos[parent] + length * f.apply(st.nodes[j] - st.nodes[static_cast<std::size_t>(sp)]);
+                    glm::vec3 d = q - pos[parent];
+                    // A segment grown from inside the lobe stays inside: where it would leave
+                    // through a thin part of the lobe it ends short of the surface instead.
+                    const float seg = glm::length(d);
+                    if (root_inside && seg > 1e-9f) {
+                        const float hit = ray.first_hit(pos[parent], d / seg);
+                        if (hit >= 0.0f && hit < seg) {
+                            q = pos[parent] + (kClipFraction * hit / seg) * d;
+                            d = q - pos[parent];
+                        }
+                    }
                     pos.push_back(q);
+                    eligible.push_back(!inside_only || root_inside || ray.inside(q) ? 1 : 0);
                     heading.push_back(glm::length(d) > 1e-9f ? glm::normalize(d) : dir);
                     growths.push_back(0);
                     stopped.push_back(0);

@@ -149,10 +149,11 @@ bool MeshRaycaster::inside(const glm::vec3& p) const
     return hits.size() % 2 == 1;
 }
 
-float MeshRaycaster::signed_distance_along(const glm::vec3& p, const glm::vec3& dir) const
+float MeshRaycaster::signed_distance_along(const glm::vec3& p, const glm::vec3& dir, bool* inside) const
 {
     thread_local std::vector<float> hits;
     crossings(p, dir, hits);
+    if (inside) *inside = hits.size() % 2 == 1;
     if (hits.size() % 2 == 1) return hits.front(); // inside: where the ray leaves
     if (hits.size() >= 2) return hits[1];          // outside, entering: where it leaves again
     float best = std::numeric_limits<float>::max();

@@ -33,7 +33,8 @@ public:
     /// - outside, the ray entering the lobe: the distance to where it leaves it again (> 0),
     ///   so branches that enter a lobe from below keep growing through it;
     /// - outside, the ray missing the lobe: minus the distance from `p` to the nearest vertex.
-    float signed_distance_along(const glm::vec3& p, const glm::vec3& dir) const;
+    /// `inside` (when given) receives whether `p` is inside the lobe.
+    float signed_distance_along(const glm::vec3& p, const glm::vec3& dir, bool* inside = nullptr) const;
 
     const TriangleMesh& mesh() const { return mesh_; }
 

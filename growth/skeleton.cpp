@@ -224,7 +224,6 @@ Skeleton build_skeleton(const std::vector<std::vector<glm::vec3>>& trunk_strokes
         const glm::vec3 fork(centre.x, std::max(base_y + 0.5f * (lo.y - base_y), lo.y - 0.1f * height), centre.z);
         const int root = b.add(base, -1, -1);
         b.limb(root, fork, -1, false);
-        s.messages.push_back("no trunk strokes: a default trunk rises from the ground below the lobes");
     } else {
         return s;
     }

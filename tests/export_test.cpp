@@ -24,6 +24,7 @@
 #include "app/export_gltf.h"
 #include "app/export_obj.h"
 #include "core/errors.h"
+#include "tests/gltf_check.h"
 #include "tests/test_paths.h"
 
 namespace lobe {
@@ -136,13 +137,12 @@ TreeGeometry test_tree()
     return tree;
 }
 
-/// Highest y of the test tree above kBase, over every LOD.
+/// Highest y of LOD0 of the test tree above kBase.
 float tree_height(const TreeGeometry& tree)
 {
     float top = -1e30f;
-    for (const TreeLod& lod : tree.lods)
-        for (const SurfaceGeometry* g : {&lod.branches, &lod.leaves})
-            for (const glm::vec3& p : g->positions) top = std::max(top, p.y - kBase.y);
+    for (const SurfaceGeometry* g : {&tree.lods[0].branches, &tree.lods[0].leaves})
+        for (const glm::vec3& p : g->positions) top = std::max(top, p.y - kBase.y);
     return top;
 }
 
@@ -273,48 +273,6 @@ std::string read_text(const std::string& path)
 {
     std::ifstream in(path, std::ios::binary);
     return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-/// Runs tests/gltf_validate.mjs on `file`; returns the report, or fails the test with the
-/// reason (the validator missing: run scripts/setup.sh).
-::testing::AssertionResult validate(const std::string& file, nlohmann::json& report)
-{
-    const std::string node = LOBE_NODE_PATH;
-    const std::string dir = LOBE_GLTF_VALIDATOR_DIR;
-    if (node.empty() || !fs::exists(node))
-        return ::testing::AssertionFailure() << "node not found (" << node
-                                             << "): run scripts/setup.sh to install Node.js and the glTF validator";
-    if (!fs::exists(dir + "/node_modules/gltf-validator/package.json"))
-        return ::testing::AssertionFailure() << "the Khronos glTF validator is not installed in " << dir
-                                             << ": run scripts/setup.sh";
-    const std::string err_file = file + ".validator-stderr";
-    const auto q = [](const std::string& s) { return "'" + s + "'"; };
-    const std::string cmd = q(node) + " " + q(test::source_path("tests/gltf_validate.mjs")) + " --validator " +
-                            q(dir) + " " + q(file) + " 2>" + q(err_file);
-    FILE* p = ::popen(cmd.c_str(), "r");
-    if (p == nullptr) return ::testing::AssertionFailure() << "cannot run " << cmd;
-    std::string out;
-    char buf[4096];
-    while (std::size_t n = std::fread(buf, 1, sizeof buf, p)) out.append(buf, n);
-    const int status = ::pclose(p);
-    const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    if (code == 2 || code < 0)
-        return ::testing::AssertionFailure() << "validator run failed (" << code << "): " << read_text(err_file);
-    try {
-        report = nlohmann::json::parse(out);
-    } catch (const std::exception& e) {
-        return ::testing::AssertionFailure() << "validator output is not JSON: " << e.what() << "\n" << out;
-    }
-    return ::testing::AssertionSuccess();
-}
-
-std::string describe_issues(const nlohmann::json& report)
-{
-    std::ostringstream s;
-    for (const auto& m : report["issues"]["messages"])
-        s << "  [" << m.value("severity", -1) << "] " << m.value("code", "") << " " << m.value("pointer", "") << ": "
-          << m.value("message", "") << "\n";
-    return s.str();
 }
 
 // --- glTF ---------------------------------------------------------------------------------
@@ -468,7 +426,7 @@ TEST(ExportGltf, TargetHeightScalesTheTreeUniformlyToThatHeightAboveItsBase)
     const float s = 12.0f / tree_height(tree);
     double top = -1e30, bottom = 1e30;
     for (const tinygltf::Node& n : m.nodes) {
-        if (n.mesh < 0) continue;
+        if (n.mesh < 0 || n.name.find("_LOD0") == std::string::npos) continue;
         const tinygltf::Accessor& a = m.accessors[std::size_t(m.meshes[std::size_t(n.mesh)].primitives[0].attributes.at("POSITION"))];
         top = std::max(top, a.maxValues[1]);
         bottom = std::min(bottom, a.minValues[1]);
@@ -606,14 +564,14 @@ TEST(ExportGltf, KhronosValidatorReportsNoErrorsForTheTree)
     const std::string file = test::temp_dir("export-validate-tree") + "/tree.glb";
     write_glb(file, scene_of(tree));
     nlohmann::json report;
-    ASSERT_TRUE(validate(file, report));
+    ASSERT_TRUE(test::validate_gltf(file, report));
     const auto& issues = report["issues"];
     std::cout << "gltf-validator " << report.value("validatorVersion", "?") << ": " << issues["numErrors"]
               << " errors, " << issues["numWarnings"] << " warnings, " << issues["numInfos"] << " infos, "
               << issues["numHints"] << " hints\n"
-              << describe_issues(report);
-    EXPECT_EQ(issues["numErrors"].get<int>(), 0) << describe_issues(report);
-    EXPECT_EQ(issues["numWarnings"].get<int>(), 0) << describe_issues(report);
+              << test::describe_gltf_issues(report);
+    EXPECT_EQ(issues["numErrors"].get<int>(), 0) << test::describe_gltf_issues(report);
+    EXPECT_EQ(issues["numWarnings"].get<int>(), 0) << test::describe_gltf_issues(report);
     EXPECT_EQ(report["info"]["generator"], "Lobesketch");
 }
 
@@ -626,14 +584,14 @@ TEST(ExportGltf, KhronosValidatorReportsNoErrorsForTheTreeWithLobesStrokesAndHei
     const std::string file = test::temp_dir("export-validate-extras") + "/tree.glb";
     write_glb(file, scene_of(tree, true), options);
     nlohmann::json report;
-    ASSERT_TRUE(validate(file, report));
+    ASSERT_TRUE(test::validate_gltf(file, report));
     const auto& issues = report["issues"];
     std::cout << "gltf-validator " << report.value("validatorVersion", "?") << ": " << issues["numErrors"]
               << " errors, " << issues["numWarnings"] << " warnings, " << issues["numInfos"] << " infos, "
               << issues["numHints"] << " hints\n"
-              << describe_issues(report);
-    EXPECT_EQ(issues["numErrors"].get<int>(), 0) << describe_issues(report);
-    EXPECT_EQ(issues["numWarnings"].get<int>(), 0) << describe_issues(report);
+              << test::describe_gltf_issues(report);
+    EXPECT_EQ(issues["numErrors"].get<int>(), 0) << test::describe_gltf_issues(report);
+    EXPECT_EQ(issues["numWarnings"].get<int>(), 0) << test::describe_gltf_issues(report);
 }
 
 /// `fn` must throw E with a one-line message and leave `file` as it was, with no temporary
