@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The README's main command: set up, build, and replay the bundled demo recording.
-# Writes out/demo/strokes.json and out/demo/session.json.
+# Writes out/demo/strokes.json, session.json, lobes/lobe_N.ply and tree.glb.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/setup.sh release
