@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numeric>
 
@@ -57,54 +58,58 @@ struct RingRange {
     std::uint32_t count = 0;
 };
 
+/// Arc length at, and turn (cosine between the two segments) at, every point of one curve.
+struct CurveMetrics {
+    std::vector<double> arc;
+    std::vector<double> turn_cos;
+};
+
 /// Appends the rings of `curve` (see count_branch_rings) to `out`.
-void place_rings(const BranchCurve& curve, double spacing, double cos_max_turn, std::vector<RingSample>& out)
+void place_rings(const BranchCurve& curve, double spacing, double cos_max_turn, std::vector<RingSample>& out,
+                 CurveMetrics& metrics)
 {
     const std::size_t m = curve.points.size();
     if (m < 2) return;
     const auto& P = curve.points;
     const auto& R = curve.radii;
+    auto& S = metrics.arc;
+    auto& turn = metrics.turn_cos;
+    S.resize(m);
+    turn.resize(m);
+    S[0] = 0.0;
+    turn[0] = turn[m - 1] = 1.0;
+    for (std::size_t k = 1; k < m; ++k) S[k] = S[k - 1] + static_cast<double>(glm::length(P[k] - P[k - 1]));
+    for (std::size_t k = 1; k + 1 < m; ++k) {
+        const double l = (S[k] - S[k - 1]) * (S[k + 1] - S[k]);
+        turn[k] = l > 1e-20 ? static_cast<double>(glm::dot(P[k] - P[k - 1], P[k + 1] - P[k])) / l : 1.0;
+    }
     auto radius_at = [&](std::size_t k) { return std::max(R[k], kMinRingRadius); };
-    double s_last = 0.0; // arc of the last ring, always at curve point `a`
-    std::size_t a = 0;
+    std::size_t a = 0; // the last ring is at curve point a
     out.push_back({P[0], radius_at(0), 0.0f});
     // Greedy: from the last ring, the farthest curve point within the spacing that is not
     // past a sharp turn gets the next ring; a segment longer than the spacing is split evenly.
-    auto seg_len = [&](std::size_t k) { return static_cast<double>(glm::length(P[k + 1] - P[k])); };
-    auto turn_cos = [&](std::size_t k) {
-        const glm::vec3 d0 = P[k] - P[k - 1], d1 = P[k + 1] - P[k];
-        const float l = glm::length(d0) * glm::length(d1);
-        return l > 1e-20f ? static_cast<double>(glm::dot(d0, d1) / l) : 1.0;
-    };
     const double limit = spacing * (1.0 + 1e-6);
     while (a + 1 < m) {
         std::size_t best = 0;
-        double s_best = 0.0;
-        double s = s_last;
-        for (std::size_t j = a + 1; j < m; ++j) {
-            s += seg_len(j - 1);
-            if (s - s_last > limit) break;
+        for (std::size_t j = a + 1; j < m && S[j] - S[a] <= limit; ++j) {
             best = j;
-            s_best = s;
-            if (j + 1 == m || turn_cos(j) < cos_max_turn) break;
+            if (turn[j] < cos_max_turn) break;
         }
         if (best > 0) {
-            out.push_back({P[best], radius_at(best), static_cast<float>(s_best)});
+            out.push_back({P[best], radius_at(best), static_cast<float>(S[best])});
             a = best;
-            s_last = s_best;
             continue;
         }
         // The next point is farther than the spacing: split the segment evenly.
-        const double gap = seg_len(a);
+        const double gap = S[a + 1] - S[a];
         const int pieces = static_cast<int>(std::ceil(gap / spacing - 1e-9));
         for (int i = 1; i < pieces; ++i) {
             const float t = static_cast<float>(i) / static_cast<float>(pieces);
             out.push_back({P[a] + (P[a + 1] - P[a]) * t, std::max(R[a] + (R[a + 1] - R[a]) * t, kMinRingRadius),
-                           static_cast<float>(s_last + gap * static_cast<double>(t))});
+                           static_cast<float>(S[a] + gap * static_cast<double>(t))});
         }
         ++a;
-        s_last += gap;
-        out.push_back({P[a], radius_at(a), static_cast<float>(s_last)});
+        out.push_back({P[a], radius_at(a), static_cast<float>(S[a])});
     }
 }
 
@@ -128,9 +133,10 @@ void sample_all_rings(const std::vector<BranchCurve>& curves, const BranchMeshOp
     std::size_t points = 0;
     for (const BranchCurve& c : curves) points += c.points.size();
     samples.reserve(points + points / 2 + 16);
+    CurveMetrics metrics;
     for (std::size_t c = 0; c < curves.size(); ++c) {
         ranges[c].first = static_cast<std::uint32_t>(samples.size());
-        place_rings(curves[c], o.ring_spacing_m, cos_max, samples);
+        place_rings(curves[c], o.ring_spacing_m, cos_max, samples, metrics);
         ranges[c].count = static_cast<std::uint32_t>(samples.size() - ranges[c].first);
     }
 }
@@ -149,12 +155,67 @@ glm::vec3 any_perpendicular(const glm::vec3& t)
     return glm::normalize(axis - glm::dot(axis, t) * t);
 }
 
-/// The generalised-cylinder sweep over the kept curves.
-SurfaceGeometry sweep_curves(const std::vector<BranchCurve>& curves, const std::vector<RingSample>& samples,
-                             const std::vector<RingRange>& ranges, const std::vector<char>& keep, int n,
-                             std::vector<BranchRing>* rings_out)
+/// Four floats in one SIMD register (GCC/Clang vector extension: SSE on x86-64, NEON on
+/// ARM), for the ring vertex loop.
+typedef float V4 __attribute__((vector_size(16)));
+inline V4 load4(const float* p)
 {
-    SurfaceGeometry g;
+    V4 v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+}
+inline void store4(float* p, const V4& v) { std::memcpy(p, &v, sizeof v); }
+typedef std::uint32_t U4 __attribute__((vector_size(16)));
+
+/// Per-curve scratch output, small enough to stay in cache; appended to the mesh in one copy
+/// per array, so the big arrays are written once (no zero-filling resize, no per-element
+/// capacity checks).
+struct CurveScratch {
+    std::vector<glm::vec3> pos, nor;
+    std::vector<glm::vec2> uv;
+    std::vector<std::array<std::uint32_t, 3>> tri;
+    std::vector<glm::vec3> tangent;
+    std::vector<glm::vec3> normal_of_ring, tangent_of_ring; // transported frame of every ring
+    std::size_t used_v = 0, used_f = 0; // filled so far, not yet appended to the mesh
+    /// Room for `vertices` and `triangles` more after what is used.
+    void fit(std::size_t vertices, std::size_t triangles, std::size_t rings)
+    {
+        if (pos.size() < used_v + vertices) {
+            const std::size_t n = std::max(used_v + vertices, 2 * pos.size());
+            pos.resize(n);
+            nor.resize(n);
+            uv.resize(n);
+        }
+        if (tri.size() < used_f + triangles) tri.resize(std::max(used_f + triangles, 2 * tri.size()));
+        if (tangent.size() < rings) tangent.resize(rings);
+    }
+};
+
+template <class T>
+void append(std::vector<T>& out, const std::vector<T>& from, std::size_t count)
+{
+    out.insert(out.end(), from.data(), from.data() + count);
+}
+
+/// Appends what the scratch holds to the mesh.
+void flush(CurveScratch& scratch, SurfaceGeometry& g)
+{
+    append(g.positions, scratch.pos, scratch.used_v);
+    append(g.normals, scratch.nor, scratch.used_v);
+    append(g.uvs, scratch.uv, scratch.used_v);
+    append(g.triangles, scratch.tri, scratch.used_f);
+    scratch.used_v = scratch.used_f = 0;
+}
+
+/// The generalised-cylinder sweep over the kept curves, into `g` (its storage reused).
+void sweep_curves(const std::vector<BranchCurve>& curves, const std::vector<RingSample>& samples,
+                  const std::vector<RingRange>& ranges, const std::vector<char>& keep, int n, SurfaceGeometry& g,
+                  CurveScratch& scratch, std::vector<BranchRing>* rings_out)
+{
+    g.positions.clear();
+    g.normals.clear();
+    g.uvs.clear();
+    g.triangles.clear();
     const auto nn = static_cast<std::uint32_t>(n);
     std::size_t vertex_total = 0, triangle_total = 0;
     for (std::size_t c = 0; c < curves.size(); ++c) {
@@ -162,42 +223,70 @@ SurfaceGeometry sweep_curves(const std::vector<BranchCurve>& curves, const std::
         vertex_total += ranges[c].count * nn + 1 + (curves[c].parent < 0 ? 1 : 0);
         triangle_total += curve_triangles(curves[c], ranges[c].count, n);
     }
-    g.positions.resize(vertex_total);
-    g.normals.resize(vertex_total);
-    g.uvs.resize(vertex_total);
-    g.triangles.resize(triangle_total);
+    g.positions.reserve(vertex_total);
+    g.normals.reserve(vertex_total);
+    g.uvs.reserve(vertex_total);
+    g.triangles.reserve(triangle_total);
     if (rings_out) {
         rings_out->clear();
         rings_out->reserve(samples.size());
     }
 
-    // Unit circle, and the mirrored u of each column (welded seam).
-    std::vector<float> cos_j(nn), sin_j(nn), u_j(nn);
-    for (std::uint32_t j = 0; j < nn; ++j) {
+    // Ring vertices are written in blocks of four (12 position floats, 8 uv floats), so the
+    // loops below have fixed lengths the compiler vectorises. A ring of n vertices writes
+    // ⌈n/4⌉ blocks; the excess lands where the next ring (or the apex) is written after it.
+    // Tables per block: the unit circle's cos and sin and the mirrored u of each column
+    // (welded seam), spread to the float layout of the arrays.
+    const std::uint32_t blocks = (nn + 3) / 4;
+    std::vector<float> cos12(blocks * 12), sin12(blocks * 12), u8(blocks * 8);
+    for (std::uint32_t i = 0; i < blocks * 12; ++i) {
+        const std::uint32_t j = i / 3;
         const double a = 2.0 * kPi * j / n;
-        cos_j[j] = static_cast<float>(std::cos(a));
-        sin_j[j] = static_cast<float>(std::sin(a));
-        u_j[j] = static_cast<float>(1.0 - std::abs(1.0 - 2.0 * j / n));
+        cos12[i] = j < nn ? static_cast<float>(std::cos(a)) : 0.0f;
+        sin12[i] = j < nn ? static_cast<float>(std::sin(a)) : 0.0f;
+    }
+    for (std::uint32_t i = 0; i < blocks * 8; i += 2) {
+        const std::uint32_t j = i / 2;
+        u8[i] = j < nn ? static_cast<float>(1.0 - std::abs(1.0 - 2.0 * j / n)) : 0.0f;
+        u8[i + 1] = 0.0f;
+    }
+    // Tube triangles between a ring and the previous one, as offsets from the previous ring's
+    // first vertex; counter-clockwise seen from outside.
+    // Padded to whole 4-index lanes; the excess lands where the next triangles go.
+    const std::uint32_t quad_lanes = (6 * nn + 3) / 4;
+    std::vector<std::uint32_t> quad_template(4 * quad_lanes, 0);
+    for (std::uint32_t j = 0; j < nn; ++j) {
+        const std::uint32_t j1 = j + 1 == nn ? 0 : j + 1;
+        const std::uint32_t t[6] = {j, j1, nn + j1, j, nn + j1, nn + j};
+        std::copy(t, t + 6, quad_template.begin() + 6 * j);
     }
 
-    std::vector<glm::vec3> normal_of_ring(samples.size()); // transported frame normal, for child curves
-    std::vector<glm::vec3> tangent_of_ring(samples.size());
-    std::vector<glm::vec3> tangents;
-    // Raw pointers: the compiler keeps them in registers, unlike a vector's end.
-    glm::vec3* pos = g.positions.data();
-    glm::vec3* nor = g.normals.data();
-    glm::vec2* uv = g.uvs.data();
-    std::array<std::uint32_t, 3>* tri = g.triangles.data();
-    std::uint32_t v = 0; // next vertex index
+    // Transported frame of every ring, looked up by child curves at their fork.
+    if (scratch.normal_of_ring.size() < samples.size()) {
+        scratch.normal_of_ring.resize(samples.size());
+        scratch.tangent_of_ring.resize(samples.size());
+    }
+    glm::vec3* const normal_of_ring = scratch.normal_of_ring.data();
+    glm::vec3* const tangent_of_ring = scratch.tangent_of_ring.data();
 
     for (std::size_t c = 0; c < curves.size(); ++c) {
         if (!keep[c] || ranges[c].count < 2) continue;
         const BranchCurve& curve = curves[c];
         const RingSample* rs = samples.data() + ranges[c].first;
         const std::uint32_t R = ranges[c].count;
+        const bool root = curve.parent < 0;
+        const std::size_t cv = R * nn + 1 + (root ? 1 : 0);
+        const std::size_t ct = curve_triangles(curve, R, n);
+        scratch.fit(cv + 4, ct + 2, R); // the last lanes may run past the curve's share
+        glm::vec3* pos = scratch.pos.data() + scratch.used_v;
+        glm::vec3* nor = scratch.nor.data() + scratch.used_v;
+        glm::vec2* uv = scratch.uv.data() + scratch.used_v;
+        std::array<std::uint32_t, 3>* tri = scratch.tri.data() + scratch.used_f;
+        glm::vec3* tangents = scratch.tangent.data();
+        // Index of the curve's first vertex in the mesh.
+        const auto base = static_cast<std::uint32_t>(g.positions.size() + scratch.used_v);
 
         // Tangents from the neighbouring ring centres.
-        tangents.resize(R);
         for (std::uint32_t k = 0; k < R; ++k) {
             const glm::vec3 d = rs[std::min(k + 1, R - 1)].centre - rs[k == 0 ? 0 : k - 1].centre;
             const float len = glm::length(d);
@@ -213,7 +302,7 @@ SurfaceGeometry sweep_curves(const std::vector<BranchCurve>& curves, const std::
         // First frame: the parent's at the fork, projected; else any. Then the curve's phase.
         glm::vec3 N;
         const glm::vec3 t0 = tangents[0];
-        if (curve.parent >= 0 && keep[static_cast<std::size_t>(curve.parent)]) {
+        if (!root && keep[static_cast<std::size_t>(curve.parent)]) {
             const RingRange& pr = ranges[static_cast<std::size_t>(curve.parent)];
             const RingSample* ps = samples.data() + pr.first;
             const RingSample* hit = std::lower_bound(ps, ps + pr.count, curve.fork_arc_m,
@@ -234,12 +323,13 @@ SurfaceGeometry sweep_curves(const std::vector<BranchCurve>& curves, const std::
             N = static_cast<float>(std::cos(delta)) * N + static_cast<float>(std::sin(delta)) * glm::cross(t0, N);
         }
 
-        std::uint32_t base_centre = 0;
-        if (curve.parent < 0) { // flat base cap centre
-            base_centre = v++;
-            pos[base_centre] = rs[0].centre;
-            nor[base_centre] = -t0;
-            uv[base_centre] = glm::vec2(0.5f, 0.0f);
+        std::uint32_t v = 0; // local vertex index
+        std::size_t f = 0;
+        if (root) { // flat base cap centre
+            pos[0] = rs[0].centre;
+            nor[0] = -t0;
+            uv[0] = glm::vec2(0.5f, 0.0f);
+            v = 1;
         }
         float vcoord = 0.0f;
         glm::vec3 t_prev = t0;
@@ -268,43 +358,71 @@ SurfaceGeometry sweep_curves(const std::vector<BranchCurve>& curves, const std::
             tangent_of_ring[ranges[c].first + k] = t;
             const glm::vec3 centre = rs[k].centre;
             const float r = rs[k].radius;
-            if (rings_out) rings_out->push_back({centre, t, r, rs[k].arc, v, static_cast<int>(c)});
-            for (std::uint32_t j = 0; j < nn; ++j) {
-                const glm::vec3 d = cos_j[j] * N + sin_j[j] * B;
-                pos[v + j] = centre + r * d;
-                nor[v + j] = d;
-                uv[v + j] = glm::vec2(u_j[j], vcoord);
-            }
-            if (k == 0 && curve.parent < 0) {
-                for (std::uint32_t j = 0; j < nn; ++j) {
-                    const std::uint32_t j1 = j + 1 == nn ? 0 : j + 1;
-                    *tri++ = {base_centre, v + j1, v + j};
+            if (rings_out) rings_out->push_back({centre, t, r, rs[k].arc, base + v, static_cast<int>(c)});
+            {
+                // Four vertices = three 4-float lanes of positions (and of normals): the frame
+                // and centre repeat with period 3 across the lanes.
+                const V4 n0{N.x, N.y, N.z, N.x}, n1{N.y, N.z, N.x, N.y}, n2{N.z, N.x, N.y, N.z};
+                const V4 b0{B.x, B.y, B.z, B.x}, b1{B.y, B.z, B.x, B.y}, b2{B.z, B.x, B.y, B.z};
+                const V4 c0{centre.x, centre.y, centre.z, centre.x}, c1{centre.y, centre.z, centre.x, centre.y},
+                    c2{centre.z, centre.x, centre.y, centre.z};
+                const V4 rv{r, r, r, r}, vv{0.0f, vcoord, 0.0f, vcoord};
+                float* p = &pos[v].x;
+                float* q = &nor[v].x;
+                float* w = &uv[v].x;
+                for (std::uint32_t b = 0; b < blocks; ++b) {
+                    const float* cb = cos12.data() + 12 * b;
+                    const float* sb = sin12.data() + 12 * b;
+                    const V4 d0 = load4(cb) * n0 + load4(sb) * b0;
+                    const V4 d1 = load4(cb + 4) * n1 + load4(sb + 4) * b1;
+                    const V4 d2 = load4(cb + 8) * n2 + load4(sb + 8) * b2;
+                    store4(q + 12 * b, d0);
+                    store4(q + 12 * b + 4, d1);
+                    store4(q + 12 * b + 8, d2);
+                    store4(p + 12 * b, c0 + rv * d0);
+                    store4(p + 12 * b + 4, c1 + rv * d1);
+                    store4(p + 12 * b + 8, c2 + rv * d2);
+                    const float* ub = u8.data() + 8 * b;
+                    store4(w + 8 * b, load4(ub) + vv);
+                    store4(w + 8 * b + 4, load4(ub + 4) + vv);
                 }
+            }
+            const std::uint32_t gv = base + v; // this ring's first vertex in the mesh
+            if (k == 0 && root) {
+                for (std::uint32_t j = 0; j + 1 < nn; ++j) tri[f++] = {base, gv + j + 1, gv + j};
+                tri[f++] = {base, gv, gv + nn - 1};
             }
             if (k > 0) {
-                const std::uint32_t a = v - nn; // previous ring
-                for (std::uint32_t j = 0; j < nn; ++j) {
-                    const std::uint32_t j1 = j + 1 == nn ? 0 : j + 1;
-                    *tri++ = {a + j, a + j1, v + j1};
-                    *tri++ = {a + j, v + j1, v + j};
+                const std::uint32_t a = gv - nn; // previous ring
+                std::uint32_t* t2 = tri[f].data();
+                const std::uint32_t* tq = quad_template.data();
+                const U4 av{a, a, a, a};
+                for (std::uint32_t i = 0; i < quad_lanes; ++i) {
+                    U4 x;
+                    std::memcpy(&x, tq + 4 * i, sizeof x);
+                    x += av;
+                    std::memcpy(t2 + 4 * i, &x, sizeof x);
                 }
+                f += 2 * nn;
             }
             v += nn;
         }
         // Tip cone: apex one tip radius beyond the last ring.
-        const std::uint32_t last = v - nn;
+        const std::uint32_t last = base + v - nn;
         const glm::vec3 t_end = tangents[R - 1];
         const float r_end = rs[R - 1].radius;
-        const std::uint32_t apex = v++;
-        pos[apex] = rs[R - 1].centre + r_end * t_end;
-        nor[apex] = t_end;
-        uv[apex] = glm::vec2(0.5f, vcoord + 1.0f / static_cast<float>(kPi));
-        for (std::uint32_t j = 0; j < nn; ++j) {
-            const std::uint32_t j1 = j + 1 == nn ? 0 : j + 1;
-            *tri++ = {last + j, last + j1, apex};
-        }
+        pos[v] = rs[R - 1].centre + r_end * t_end;
+        nor[v] = t_end;
+        uv[v] = glm::vec2(0.5f, vcoord + 1.0f / static_cast<float>(kPi));
+        const std::uint32_t apex = base + v;
+        ++v;
+        for (std::uint32_t j = 0; j + 1 < nn; ++j) tri[f++] = {last + j, last + j + 1, apex};
+        tri[f++] = {last + nn - 1, last, apex};
+        scratch.used_v += v;
+        scratch.used_f += f;
+        if (scratch.used_v >= 8192) flush(scratch, g);
     }
-    return g;
+    flush(scratch, g);
 }
 
 std::vector<char> keep_by_min_radius(const std::vector<BranchCurve>& curves, double min_radius)
@@ -423,7 +541,8 @@ std::size_t count_branch_rings(const BranchCurve& curve, const BranchMeshOptions
 {
     check_mesh_options(options);
     std::vector<RingSample> rings;
-    place_rings(curve, options.ring_spacing_m, cos_turn_limit(options), rings);
+    CurveMetrics metrics;
+    place_rings(curve, options.ring_spacing_m, cos_turn_limit(options), rings, metrics);
     return rings.size();
 }
 
@@ -434,8 +553,11 @@ SurfaceGeometry build_branch_mesh(const std::vector<BranchCurve>& curves, const 
     std::vector<RingSample> samples;
     std::vector<RingRange> ranges;
     sample_all_rings(curves, options, samples, ranges);
-    return sweep_curves(curves, samples, ranges, keep_by_min_radius(curves, options.min_radius_m), options.radial_segments,
-                        rings);
+    SurfaceGeometry g;
+    CurveScratch scratch;
+    sweep_curves(curves, samples, ranges, keep_by_min_radius(curves, options.min_radius_m), options.radial_segments, g,
+                 scratch, rings);
+    return g;
 }
 
 TreeGraph merge_coincident_nodes(const TreeGraph& graph, float tolerance_m, std::vector<int>* old_to_new)
@@ -541,33 +663,37 @@ double lod_triangle_budget(int lod)
     return std::pow(1.0 / 3.0, std::max(0, lod));
 }
 
-TreeGeometry build_tree_geometry(const TreeGraph& graph, const BranchSettings& branches, const LeafSettings& leaves,
-                                 std::uint64_t seed, const std::string& species)
+void build_tree_geometry_into(TreeGeometry& geo, const TreeGraph& graph, const BranchSettings& branches,
+                              const LeafSettings& leaves, std::uint64_t seed, const std::string& species)
 {
     if (branches.lod_count < 1 || branches.lod_count > 6) throw InvalidInput("tree geometry: lod_count must be in [1, 6]");
-    TreeGeometry geo;
+    check_mesh_options(branch_lod_options(branches, 0));
+    RgbaImage texture = make_leaf_texture(leaves.shape);
+    const TreeGraph clean = merge_coincident_nodes(graph);
+    const std::vector<BranchChain> chains = decompose_branch_chains(clean);
+    const std::vector<BranchCurve> curves = smooth_branch_curves(clean, chains, std::max(0, branches.smoothing_iterations));
+    const LeafCloud cloud = make_leaf_cloud(graph, leaves, seed);
+
+    // Nothing can throw past this point: `geo` is only changed when the whole build succeeds.
     geo.species = species;
     for (int i = 0; i < 3; ++i) {
         geo.bark_color[static_cast<std::size_t>(i)] = static_cast<float>(branches.bark_color[i]);
         geo.leaf_color[static_cast<std::size_t>(i)] = static_cast<float>(leaves.color[i]);
     }
-    geo.leaf_texture = make_leaf_texture(leaves.shape);
-    check_mesh_options(branch_lod_options(branches, 0));
-
-    const TreeGraph clean = merge_coincident_nodes(graph);
-    const std::vector<BranchChain> chains = decompose_branch_chains(clean);
-    const std::vector<BranchCurve> curves = smooth_branch_curves(clean, chains, std::max(0, branches.smoothing_iterations));
+    geo.leaf_texture = std::move(texture);
+    geo.lods.resize(static_cast<std::size_t>(branches.lod_count));
 
     std::vector<RingSample> samples;
     std::vector<RingRange> ranges;
-    geo.lods.resize(static_cast<std::size_t>(branches.lod_count));
+    CurveScratch scratch;
 
     // LOD0: everything at full resolution.
     {
         const BranchMeshOptions o = branch_lod_options(branches, 0);
         sample_all_rings(curves, o, samples, ranges);
-        geo.lods[0].branches = sweep_curves(curves, samples, ranges, std::vector<char>(curves.size(), 1), o.radial_segments, nullptr);
-        geo.lods[0].leaves = build_leaf_quads(graph, leaves, seed);
+        sweep_curves(curves, samples, ranges, std::vector<char>(curves.size(), 1), o.radial_segments, geo.lods[0].branches,
+                     scratch, nullptr);
+        emit_leaf_quads(cloud, leaves, LeafLodOptions{}, geo.lods[0].leaves);
     }
     const double total0 = static_cast<double>(geo.lods[0].branches.triangle_count() + geo.lods[0].leaves.triangle_count());
     const double leaves0 = static_cast<double>(geo.lods[0].leaves.triangle_count());
@@ -575,13 +701,14 @@ TreeGeometry build_tree_geometry(const TreeGraph& graph, const BranchSettings& b
     std::vector<double> eff(curves.size());
     std::vector<float> length(curves.size());
     std::vector<std::uint32_t> order(curves.size());
+    std::vector<char> keep_curve(curves.size());
     for (int lod = 1; lod < branches.lod_count; ++lod) {
         TreeLod& out = geo.lods[static_cast<std::size_t>(lod)];
         const double budget = lod_triangle_budget(lod) * total0;
         // Leaves: fewer and larger; never more than 80 % of the budget.
         double keep = leaf_lod_keep_fraction(lod);
         if (leaves0 > 0.0 && leaves0 * keep > 0.8 * budget) keep = std::max(1e-4, 0.8 * budget / leaves0);
-        out.leaves = build_leaf_quads(graph, leaves, seed, LeafLodOptions{keep});
+        emit_leaf_quads(cloud, leaves, LeafLodOptions{keep}, out.leaves);
 
         // Branches: coarser rings, then the thickest chains that fit the rest of the budget.
         const BranchMeshOptions o = branch_lod_options(branches, lod);
@@ -591,18 +718,18 @@ TreeGeometry build_tree_geometry(const TreeGraph& graph, const BranchSettings& b
             const int p = curves[c].parent;
             eff[c] = p < 0 ? std::numeric_limits<double>::infinity()
                            : std::min(static_cast<double>(curves[c].radii[0]), eff[static_cast<std::size_t>(p)]);
+            length[c] = ranges[c].count ? samples[ranges[c].first + ranges[c].count - 1].arc : 0.0f;
         }
         // Thickest first; among equally thick chains (all single-tip twigs have the tip
         // radius) the longer first, so pruning thins the crown evenly instead of clearing one
         // side of it.
-        for (std::size_t c = 0; c < curves.size(); ++c) length[c] = ranges[c].count ? samples[ranges[c].first + ranges[c].count - 1].arc : 0.0f;
         std::iota(order.begin(), order.end(), 0u);
         std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
             if (eff[a] != eff[b]) return eff[a] > eff[b];
             if (length[a] != length[b]) return length[a] > length[b];
             return a < b;
         });
-        std::vector<char> keep_curve(curves.size(), 0);
+        std::fill(keep_curve.begin(), keep_curve.end(), 0);
         double used = 0.0;
         for (std::size_t i = 0; i < order.size(); ++i) {
             const std::uint32_t c = order[i];
@@ -613,8 +740,15 @@ TreeGeometry build_tree_geometry(const TreeGraph& graph, const BranchSettings& b
             used += t;
             keep_curve[c] = 1;
         }
-        out.branches = sweep_curves(curves, samples, ranges, keep_curve, o.radial_segments, nullptr);
+        sweep_curves(curves, samples, ranges, keep_curve, o.radial_segments, out.branches, scratch, nullptr);
     }
+}
+
+TreeGeometry build_tree_geometry(const TreeGraph& graph, const BranchSettings& branches, const LeafSettings& leaves,
+                                 std::uint64_t seed, const std::string& species)
+{
+    TreeGeometry geo;
+    build_tree_geometry_into(geo, graph, branches, leaves, seed, species);
     return geo;
 }
 

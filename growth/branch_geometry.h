@@ -129,11 +129,20 @@ double lod_triangle_budget(int lod);
 /// LODs come from the same smoothed skeleton with the coarser resolution of
 /// branch_lod_options, the thinnest twigs pruned (the largest set of chains, thickest first,
 /// that fits the budget lod_triangle_budget × LOD0's triangles), and fewer, larger leaves
-/// (leaf_lod_keep_fraction) at the same tips, so the foliage keeps its area and silhouette.
+/// (leaf_lod_keep_fraction, lowered when the leaves alone would take more than 80 % of a
+/// LOD's budget) at the same tips, so the foliage keeps its area and silhouette.
 /// Deterministic: the same inputs give the same bytes.
 /// \throw InvalidInput on an invalid graph (see merge_coincident_nodes), lod_count outside
 /// [1, 6], radial_segments < 3, ring_spacing_m ≤ 0 or an unknown leaf shape.
 TreeGeometry build_tree_geometry(const TreeGraph& graph, const BranchSettings& branches, const LeafSettings& leaves,
                                  std::uint64_t seed, const std::string& species = {});
+
+/// build_tree_geometry into an existing TreeGeometry, reusing the storage of its meshes: a
+/// caller that regrows the tree often (the editor, while the person sketches) keeps two
+/// TreeGeometry values, draws one and rebuilds into the other, and after the first build no
+/// memory is allocated for the meshes. `out` is left unchanged when this throws.
+/// \throw InvalidInput as build_tree_geometry.
+void build_tree_geometry_into(TreeGeometry& out, const TreeGraph& graph, const BranchSettings& branches,
+                              const LeafSettings& leaves, std::uint64_t seed, const std::string& species = {});
 
 } // namespace lobe
