@@ -510,3 +510,23 @@ TEST(BranchGeometry, PruneTwigsRemovesThinChainsWithTheirSubtreesAndKeepsTheMain
     // Nothing pruned below the tip radius.
     EXPECT_EQ(prune_twigs(tree, 0.0f).size(), tree.size());
 }
+
+TEST(BranchGeometry, RebuildingIntoKeptStorageGivesTheSameBytesAndLeavesItUnchangedOnError)
+{
+    const TreeGraph big = binary_test_tree(1), small = binary_test_tree(2);
+    TreeGeometry kept;
+    build_tree_geometry_into(kept, big, default_branches(), default_leaves(), 4);
+    build_tree_geometry_into(kept, small, default_branches(), default_leaves(), 4, "willow");
+    const TreeGeometry fresh = build_tree_geometry(small, default_branches(), default_leaves(), 4, "willow");
+    ASSERT_EQ(kept.lods.size(), fresh.lods.size());
+    for (std::size_t k = 0; k < kept.lods.size(); ++k) {
+        EXPECT_TRUE(same_bytes(kept.lods[k].branches, fresh.lods[k].branches));
+        EXPECT_TRUE(same_bytes(kept.lods[k].leaves, fresh.lods[k].leaves));
+    }
+    EXPECT_EQ(kept.species, "willow");
+    TreeGraph bad = small;
+    bad.nodes[5].parent = 900;
+    EXPECT_THROW(build_tree_geometry_into(kept, bad, default_branches(), default_leaves(), 4, "birch"), InvalidInput);
+    EXPECT_EQ(kept.species, "willow");
+    EXPECT_TRUE(same_bytes(kept.lods[0].branches, fresh.lods[0].branches));
+}
