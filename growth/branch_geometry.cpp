@@ -167,19 +167,20 @@ inline V4 load4(const float* p)
 inline void store4(float* p, const V4& v) { std::memcpy(p, &v, sizeof v); }
 typedef std::uint32_t U4 __attribute__((vector_size(16)));
 
-/// Per-curve scratch output, small enough to stay in cache; appended to the mesh in one copy
-/// per array, so the big arrays are written once (no zero-filling resize, no per-element
-/// capacity checks).
+/// Working arrays of the sweep, kept across curves and LODs: the current curve's ring
+/// tangents, the transported frame of every ring, and the batch of curves not yet appended to
+/// the mesh (when it is not written in place).
 struct CurveScratch {
+    std::vector<glm::vec3> tangent;
+    std::vector<glm::vec3> normal_of_ring, tangent_of_ring;
     std::vector<glm::vec3> pos, nor;
     std::vector<glm::vec2> uv;
     std::vector<std::array<std::uint32_t, 3>> tri;
-    std::vector<glm::vec3> tangent;
-    std::vector<glm::vec3> normal_of_ring, tangent_of_ring; // transported frame of every ring
-    std::size_t used_v = 0, used_f = 0; // filled so far, not yet appended to the mesh
-    /// Room for `vertices` and `triangles` more after what is used.
-    void fit(std::size_t vertices, std::size_t triangles, std::size_t rings)
+    std::size_t used_v = 0, used_f = 0;
+    /// Room for `rings` tangents, and for `vertices` and `triangles` after what is used.
+    void fit(std::size_t rings, std::size_t vertices, std::size_t triangles)
     {
+        if (tangent.size() < rings) tangent.resize(rings);
         if (pos.size() < used_v + vertices) {
             const std::size_t n = std::max(used_v + vertices, 2 * pos.size());
             pos.resize(n);
@@ -187,7 +188,6 @@ struct CurveScratch {
             uv.resize(n);
         }
         if (tri.size() < used_f + triangles) tri.resize(std::max(used_f + triangles, 2 * tri.size()));
-        if (tangent.size() < rings) tangent.resize(rings);
     }
 };
 
@@ -197,7 +197,7 @@ void append(std::vector<T>& out, const std::vector<T>& from, std::size_t count)
     out.insert(out.end(), from.data(), from.data() + count);
 }
 
-/// Appends what the scratch holds to the mesh.
+/// Appends the scratch's batch to the mesh.
 void flush(CurveScratch& scratch, SurfaceGeometry& g)
 {
     append(g.positions, scratch.pos, scratch.used_v);
@@ -212,10 +212,6 @@ void sweep_curves(const std::vector<BranchCurve>& curves, const std::vector<Ring
                   const std::vector<RingRange>& ranges, const std::vector<char>& keep, int n, SurfaceGeometry& g,
                   CurveScratch& scratch, std::vector<BranchRing>* rings_out)
 {
-    g.positions.clear();
-    g.normals.clear();
-    g.uvs.clear();
-    g.triangles.clear();
     const auto nn = static_cast<std::uint32_t>(n);
     std::size_t vertex_total = 0, triangle_total = 0;
     for (std::size_t c = 0; c < curves.size(); ++c) {
@@ -223,10 +219,23 @@ void sweep_curves(const std::vector<BranchCurve>& curves, const std::vector<Ring
         vertex_total += ranges[c].count * nn + 1 + (curves[c].parent < 0 ? 1 : 0);
         triangle_total += curve_triangles(curves[c], ranges[c].count, n);
     }
-    g.positions.reserve(vertex_total);
-    g.normals.reserve(vertex_total);
-    g.uvs.reserve(vertex_total);
-    g.triangles.reserve(triangle_total);
+    // Each array is written once. When `g` already holds at least as many elements (storage
+    // kept from an earlier build), the curves are written in place; otherwise they go to a
+    // small cached scratch that is appended in batches (a resize would first fill fresh
+    // memory with zeros). Both leave room (cut off at the end) for the last SIMD lanes'
+    // overrun.
+    const bool in_place = g.positions.size() >= vertex_total + 4 && g.normals.size() >= vertex_total + 4 &&
+                          g.uvs.size() >= vertex_total + 4 && g.triangles.size() >= triangle_total + 2;
+    if (!in_place) {
+        g.positions.clear();
+        g.normals.clear();
+        g.uvs.clear();
+        g.triangles.clear();
+        g.positions.reserve(vertex_total);
+        g.normals.reserve(vertex_total);
+        g.uvs.reserve(vertex_total);
+        g.triangles.reserve(triangle_total);
+    }
     if (rings_out) {
         rings_out->clear();
         rings_out->reserve(samples.size());
@@ -268,6 +277,7 @@ void sweep_curves(const std::vector<BranchCurve>& curves, const std::vector<Ring
     }
     glm::vec3* const normal_of_ring = scratch.normal_of_ring.data();
     glm::vec3* const tangent_of_ring = scratch.tangent_of_ring.data();
+    std::size_t written_v = 0, written_f = 0;
 
     for (std::size_t c = 0; c < curves.size(); ++c) {
         if (!keep[c] || ranges[c].count < 2) continue;
@@ -275,16 +285,14 @@ void sweep_curves(const std::vector<BranchCurve>& curves, const std::vector<Ring
         const RingSample* rs = samples.data() + ranges[c].first;
         const std::uint32_t R = ranges[c].count;
         const bool root = curve.parent < 0;
-        const std::size_t cv = R * nn + 1 + (root ? 1 : 0);
-        const std::size_t ct = curve_triangles(curve, R, n);
-        scratch.fit(cv + 4, ct + 2, R); // the last lanes may run past the curve's share
-        glm::vec3* pos = scratch.pos.data() + scratch.used_v;
-        glm::vec3* nor = scratch.nor.data() + scratch.used_v;
-        glm::vec2* uv = scratch.uv.data() + scratch.used_v;
-        std::array<std::uint32_t, 3>* tri = scratch.tri.data() + scratch.used_f;
+        const std::size_t curve_vertices = R * nn + 1 + (root ? 1 : 0);
+        scratch.fit(R, in_place ? 0 : curve_vertices + 4, in_place ? 0 : curve_triangles(curve, R, n) + 2);
+        glm::vec3* pos = in_place ? g.positions.data() + written_v : scratch.pos.data() + scratch.used_v;
+        glm::vec3* nor = in_place ? g.normals.data() + written_v : scratch.nor.data() + scratch.used_v;
+        glm::vec2* uv = in_place ? g.uvs.data() + written_v : scratch.uv.data() + scratch.used_v;
+        std::array<std::uint32_t, 3>* tri = in_place ? g.triangles.data() + written_f : scratch.tri.data() + scratch.used_f;
         glm::vec3* tangents = scratch.tangent.data();
-        // Index of the curve's first vertex in the mesh.
-        const auto base = static_cast<std::uint32_t>(g.positions.size() + scratch.used_v);
+        const auto base = static_cast<std::uint32_t>(written_v); // the curve's first vertex in the mesh
 
         // Tangents from the neighbouring ring centres.
         for (std::uint32_t k = 0; k < R; ++k) {
@@ -418,11 +426,22 @@ void sweep_curves(const std::vector<BranchCurve>& curves, const std::vector<Ring
         ++v;
         for (std::uint32_t j = 0; j + 1 < nn; ++j) tri[f++] = {last + j, last + j + 1, apex};
         tri[f++] = {last + nn - 1, last, apex};
-        scratch.used_v += v;
-        scratch.used_f += f;
-        if (scratch.used_v >= 8192) flush(scratch, g);
+        written_v += v;
+        written_f += f;
+        if (!in_place) {
+            scratch.used_v += v;
+            scratch.used_f += f;
+            if (scratch.used_v >= 8192) flush(scratch, g);
+        }
     }
-    flush(scratch, g);
+    if (in_place) {
+        g.positions.resize(written_v);
+        g.normals.resize(written_v);
+        g.uvs.resize(written_v);
+        g.triangles.resize(written_f);
+    } else {
+        flush(scratch, g);
+    }
 }
 
 std::vector<char> keep_by_min_radius(const std::vector<BranchCurve>& curves, double min_radius)

@@ -513,9 +513,15 @@ TEST(BranchGeometry, PruneTwigsRemovesThinChainsWithTheirSubtreesAndKeepsTheMain
 
 TEST(BranchGeometry, RebuildingIntoKeptStorageGivesTheSameBytesAndLeavesItUnchangedOnError)
 {
-    const TreeGraph big = binary_test_tree(1), small = binary_test_tree(2);
+    TreeShape deeper;
+    deeper.depth = 9;
+    const TreeGraph big = make_fixture_tree(deeper), small = binary_test_tree(2);
     TreeGeometry kept;
+    // Small into empty storage (appended), big into small (grows), small into big (in place).
+    build_tree_geometry_into(kept, small, default_branches(), default_leaves(), 4);
     build_tree_geometry_into(kept, big, default_branches(), default_leaves(), 4);
+    const TreeGeometry fresh_big = build_tree_geometry(big, default_branches(), default_leaves(), 4);
+    for (std::size_t k = 0; k < kept.lods.size(); ++k) EXPECT_TRUE(same_bytes(kept.lods[k].branches, fresh_big.lods[k].branches));
     build_tree_geometry_into(kept, small, default_branches(), default_leaves(), 4, "willow");
     const TreeGeometry fresh = build_tree_geometry(small, default_branches(), default_leaves(), 4, "willow");
     ASSERT_EQ(kept.lods.size(), fresh.lods.size());
