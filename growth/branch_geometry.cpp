@@ -679,7 +679,9 @@ BranchMeshOptions branch_lod_options(const BranchSettings& branches, int lod)
 
 double lod_triangle_budget(int lod)
 {
-    return std::pow(1.0 / 3.0, std::max(0, lod));
+    if (lod <= 0) return 1.0;
+    if (lod == 1) return 0.45;
+    return 0.135 * std::pow(0.3, lod - 2);
 }
 
 void build_tree_geometry_into(TreeGeometry& geo, const TreeGraph& graph, const BranchSettings& branches,

@@ -115,13 +115,14 @@ TreeGraph merge_coincident_nodes(const TreeGraph& graph, float tolerance_m = 1e-
 TreeGraph prune_twigs(const TreeGraph& graph, float min_radius_m, std::vector<int>* old_to_new = nullptr);
 
 /// Resolution of level of detail `lod` for `branches`: LOD0 is the settings themselves; each
-/// further level halves the radial segments (at least 3), multiplies the ring spacing by 2.5
-/// and allows 1.75 × the turn angle between rings. Twig pruning is chosen by
+/// further level multiplies the radial segments by 0.7 (rounded, at least 3: 8, 6, 4, 3, …),
+/// doubles the ring spacing and allows 1.75 × the turn angle between rings (10°, 17.5°, …,
+/// at most 60°). Twig pruning is chosen by
 /// build_tree_geometry to meet the triangle budgets.
 BranchMeshOptions branch_lod_options(const BranchSettings& branches, int lod);
 
-/// Share of LOD0's triangles (branches + leaves) that LOD `lod` may use: 1, 0.5, 0.15, then
-/// × 0.3 per further level.
+/// Share of LOD0's triangles (branches + leaves) that LOD `lod` may use: 1, 0.45, 0.135, then
+/// × 0.3 per further level (10 % below the 50 % and 15 % the LODs must stay under).
 double lod_triangle_budget(int lod);
 
 /// Builds the tree's branch and leaf geometry at branches.lod_count levels of detail, the
