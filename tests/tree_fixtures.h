@@ -116,7 +116,7 @@ inline TreeGraph make_fixture_tree(const TreeShape& shape)
     return g;
 }
 
-/// The depth-8 binary test tree (256 tips, 1,597 nodes).
+/// The depth-8 binary test tree (256 tips, 1,591 nodes).
 inline TreeGraph binary_test_tree(std::uint64_t seed = 1)
 {
     TreeShape s;
