@@ -151,7 +151,7 @@ RgbaImage make_leaf_texture(const std::string& shape_name, int size)
                 if (shape != LeafShape::Needle && hw > 1e-6) {
                     const double q = (t - 0.22 * ax / hw) * vein_pairs;
                     const double dist_px = std::abs(q - std::round(q)) / vein_pairs * blade_len * size;
-                    const double fade = std::clamp(1.0 - ax / (0.85 * hw), 0.0, 1.0);
+                    const double fade = std::clamp(1.0 - ax / (0.85 * hw), 0.0, 1.0) * std::clamp((0.9 - t) * 8.0, 0.0, 1.0);
                     shade += 0.08 * fade * std::clamp(1.2 - dist_px, 0.0, 1.0);
                 }
                 // Darker towards the edge, soft mottling.
