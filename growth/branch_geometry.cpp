@@ -224,17 +224,26 @@ void sweep_curves(const std::vector<BranchCurve>& curves, const std::vector<Ring
     // small cached scratch that is appended in batches (a resize would first fill fresh
     // memory with zeros). Both leave room (cut off at the end) for the last SIMD lanes'
     // overrun.
-    const bool in_place = g.positions.size() >= vertex_total + 4 && g.normals.size() >= vertex_total + 4 &&
-                          g.uvs.size() >= vertex_total + 4 && g.triangles.size() >= triangle_total + 2;
-    if (!in_place) {
+    auto holds = [](const auto& v, std::size_t count, std::size_t pad) {
+        return v.size() >= count && v.capacity() >= count + pad; // only the padding gets initialised
+    };
+    const bool in_place = holds(g.positions, vertex_total, 4) && holds(g.normals, vertex_total, 4) &&
+                          holds(g.uvs, vertex_total, 4) && holds(g.triangles, triangle_total, 2);
+    if (in_place) {
+        g.positions.resize(vertex_total + 4);
+        g.normals.resize(vertex_total + 4);
+        g.uvs.resize(vertex_total + 4);
+        g.triangles.resize(triangle_total + 2);
+    } else {
         g.positions.clear();
         g.normals.clear();
         g.uvs.clear();
         g.triangles.clear();
-        g.positions.reserve(vertex_total);
-        g.normals.reserve(vertex_total);
-        g.uvs.reserve(vertex_total);
-        g.triangles.reserve(triangle_total);
+        // Room for the padding too, so the next build into this storage can go in place.
+        g.positions.reserve(vertex_total + 4);
+        g.normals.reserve(vertex_total + 4);
+        g.uvs.reserve(vertex_total + 4);
+        g.triangles.reserve(triangle_total + 2);
     }
     if (rings_out) {
         rings_out->clear();
