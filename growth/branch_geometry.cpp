@@ -58,31 +58,49 @@ struct RingRange {
     std::uint32_t count = 0;
 };
 
-/// Arc length at, and turn (cosine between the two segments) at, every point of one curve.
+/// Arc length at, and turn (cosine between the two segments) at, every point of every curve,
+/// in one flat array each: curve c's points start at first[c]. Computed once, used by every LOD.
 struct CurveMetrics {
     std::vector<double> arc;
     std::vector<double> turn_cos;
+    std::vector<std::size_t> first;
 };
 
-/// Appends the rings of `curve` (see count_branch_rings) to `out`.
-void place_rings(const BranchCurve& curve, double spacing, double cos_max_turn, std::vector<RingSample>& out,
-                 CurveMetrics& metrics)
+CurveMetrics curve_metrics(const std::vector<BranchCurve>& curves)
 {
+    CurveMetrics m;
+    m.first.resize(curves.size() + 1, 0);
+    for (std::size_t c = 0; c < curves.size(); ++c) m.first[c + 1] = m.first[c] + curves[c].points.size();
+    m.arc.resize(m.first.back());
+    m.turn_cos.resize(m.first.back());
+    for (std::size_t c = 0; c < curves.size(); ++c) {
+        const auto& P = curves[c].points;
+        const std::size_t n = P.size();
+        if (n == 0) continue;
+        double* S = m.arc.data() + m.first[c];
+        double* turn = m.turn_cos.data() + m.first[c];
+        S[0] = 0.0;
+        turn[0] = turn[n - 1] = 1.0;
+        for (std::size_t k = 1; k < n; ++k) S[k] = S[k - 1] + static_cast<double>(glm::length(P[k] - P[k - 1]));
+        for (std::size_t k = 1; k + 1 < n; ++k) {
+            const double l = (S[k] - S[k - 1]) * (S[k + 1] - S[k]);
+            turn[k] = l > 1e-20 ? static_cast<double>(glm::dot(P[k] - P[k - 1], P[k + 1] - P[k])) / l : 1.0;
+        }
+    }
+    return m;
+}
+
+/// Appends the rings of curve `c` (see count_branch_rings) to `out`.
+void place_rings(const std::vector<BranchCurve>& curves, const CurveMetrics& metrics, std::size_t c, double spacing,
+                 double cos_max_turn, std::vector<RingSample>& out)
+{
+    const BranchCurve& curve = curves[c];
     const std::size_t m = curve.points.size();
     if (m < 2) return;
     const auto& P = curve.points;
     const auto& R = curve.radii;
-    auto& S = metrics.arc;
-    auto& turn = metrics.turn_cos;
-    S.resize(m);
-    turn.resize(m);
-    S[0] = 0.0;
-    turn[0] = turn[m - 1] = 1.0;
-    for (std::size_t k = 1; k < m; ++k) S[k] = S[k - 1] + static_cast<double>(glm::length(P[k] - P[k - 1]));
-    for (std::size_t k = 1; k + 1 < m; ++k) {
-        const double l = (S[k] - S[k - 1]) * (S[k + 1] - S[k]);
-        turn[k] = l > 1e-20 ? static_cast<double>(glm::dot(P[k] - P[k - 1], P[k + 1] - P[k])) / l : 1.0;
-    }
+    const double* S = metrics.arc.data() + metrics.first[c];
+    const double* turn = metrics.turn_cos.data() + metrics.first[c];
     auto radius_at = [&](std::size_t k) { return std::max(R[k], kMinRingRadius); };
     std::size_t a = 0; // the last ring is at curve point a
     out.push_back({P[0], radius_at(0), 0.0f});
@@ -124,7 +142,7 @@ void check_mesh_options(const BranchMeshOptions& o)
 double cos_turn_limit(const BranchMeshOptions& o) { return std::cos(std::clamp(o.max_turn_deg, 0.0, 180.0) * kPi / 180.0); }
 
 /// Rings of every curve, one flat array.
-void sample_all_rings(const std::vector<BranchCurve>& curves, const BranchMeshOptions& o,
+void sample_all_rings(const std::vector<BranchCurve>& curves, const CurveMetrics& metrics, const BranchMeshOptions& o,
                       std::vector<RingSample>& samples, std::vector<RingRange>& ranges)
 {
     const double cos_max = cos_turn_limit(o);
@@ -133,10 +151,9 @@ void sample_all_rings(const std::vector<BranchCurve>& curves, const BranchMeshOp
     std::size_t points = 0;
     for (const BranchCurve& c : curves) points += c.points.size();
     samples.reserve(points + points / 2 + 16);
-    CurveMetrics metrics;
     for (std::size_t c = 0; c < curves.size(); ++c) {
         ranges[c].first = static_cast<std::uint32_t>(samples.size());
-        place_rings(curves[c], o.ring_spacing_m, cos_max, samples, metrics);
+        place_rings(curves, metrics, c, o.ring_spacing_m, cos_max, samples);
         ranges[c].count = static_cast<std::uint32_t>(samples.size() - ranges[c].first);
     }
 }
@@ -569,8 +586,8 @@ std::size_t count_branch_rings(const BranchCurve& curve, const BranchMeshOptions
 {
     check_mesh_options(options);
     std::vector<RingSample> rings;
-    CurveMetrics metrics;
-    place_rings(curve, options.ring_spacing_m, cos_turn_limit(options), rings, metrics);
+    const std::vector<BranchCurve> one{curve};
+    place_rings(one, curve_metrics(one), 0, options.ring_spacing_m, cos_turn_limit(options), rings);
     return rings.size();
 }
 
@@ -580,7 +597,7 @@ SurfaceGeometry build_branch_mesh(const std::vector<BranchCurve>& curves, const 
     check_mesh_options(options);
     std::vector<RingSample> samples;
     std::vector<RingRange> ranges;
-    sample_all_rings(curves, options, samples, ranges);
+    sample_all_rings(curves, curve_metrics(curves), options, samples, ranges);
     SurfaceGeometry g;
     CurveScratch scratch;
     sweep_curves(curves, samples, ranges, keep_by_min_radius(curves, options.min_radius_m), options.radial_segments, g,
@@ -703,6 +720,7 @@ void build_tree_geometry_into(TreeGeometry& geo, const TreeGraph& graph, const B
     const std::vector<BranchChain> chains = decompose_branch_chains(clean);
     const std::vector<BranchCurve> curves = smooth_branch_curves(clean, chains, std::max(0, branches.smoothing_iterations));
     const LeafCloud cloud = make_leaf_cloud(graph, leaves, seed);
+    const CurveMetrics metrics = curve_metrics(curves);
 
     // Nothing can throw past this point: `geo` is only changed when the whole build succeeds.
     geo.species = species;
@@ -720,7 +738,7 @@ void build_tree_geometry_into(TreeGeometry& geo, const TreeGraph& graph, const B
     // LOD0: everything at full resolution.
     {
         const BranchMeshOptions o = branch_lod_options(branches, 0);
-        sample_all_rings(curves, o, samples, ranges);
+        sample_all_rings(curves, metrics, o, samples, ranges);
         sweep_curves(curves, samples, ranges, std::vector<char>(curves.size(), 1), o.radial_segments, geo.lods[0].branches,
                      scratch, nullptr);
         emit_leaf_quads(cloud, leaves, LeafLodOptions{}, geo.lods[0].leaves);
@@ -742,13 +760,21 @@ void build_tree_geometry_into(TreeGeometry& geo, const TreeGraph& graph, const B
 
         // Branches: coarser rings, then the thickest chains that fit the rest of the budget.
         const BranchMeshOptions o = branch_lod_options(branches, lod);
-        sample_all_rings(curves, o, samples, ranges);
+        sample_all_rings(curves, metrics, o, samples, ranges);
         const double branch_budget = budget - static_cast<double>(out.leaves.triangle_count());
         for (std::size_t c = 0; c < curves.size(); ++c) {
             const int p = curves[c].parent;
             eff[c] = p < 0 ? std::numeric_limits<double>::infinity()
                            : std::min(static_cast<double>(curves[c].radii[0]), eff[static_cast<std::size_t>(p)]);
             length[c] = ranges[c].count ? samples[ranges[c].first + ranges[c].count - 1].arc : 0.0f;
+        }
+        double all = 0.0;
+        for (std::size_t c = 0; c < curves.size(); ++c)
+            all += static_cast<double>(curve_triangles(curves[c], ranges[c].count, o.radial_segments));
+        if (all <= branch_budget) { // the coarser rings alone meet the budget: no pruning
+            std::fill(keep_curve.begin(), keep_curve.end(), 1);
+            sweep_curves(curves, samples, ranges, keep_curve, o.radial_segments, out.branches, scratch, nullptr);
+            continue;
         }
         // Thickest first; among equally thick chains (all single-tip twigs have the tip
         // radius) the longer first, so pruning thins the crown evenly instead of clearing one
