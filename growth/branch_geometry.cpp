@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numeric>
 
@@ -57,54 +58,76 @@ struct RingRange {
     std::uint32_t count = 0;
 };
 
-/// Appends the rings of `curve` (see count_branch_rings) to `out`.
-void place_rings(const BranchCurve& curve, double spacing, double cos_max_turn, std::vector<RingSample>& out)
+/// Arc length at, and turn (cosine between the two segments) at, every point of every curve,
+/// in one flat array each: curve c's points start at first[c]. Computed once, used by every LOD.
+struct CurveMetrics {
+    std::vector<double> arc;
+    std::vector<double> turn_cos;
+    std::vector<std::size_t> first;
+};
+
+CurveMetrics curve_metrics(const std::vector<BranchCurve>& curves)
 {
+    CurveMetrics m;
+    m.first.resize(curves.size() + 1, 0);
+    for (std::size_t c = 0; c < curves.size(); ++c) m.first[c + 1] = m.first[c] + curves[c].points.size();
+    m.arc.resize(m.first.back());
+    m.turn_cos.resize(m.first.back());
+    for (std::size_t c = 0; c < curves.size(); ++c) {
+        const auto& P = curves[c].points;
+        const std::size_t n = P.size();
+        if (n == 0) continue;
+        double* S = m.arc.data() + m.first[c];
+        double* turn = m.turn_cos.data() + m.first[c];
+        S[0] = 0.0;
+        turn[0] = turn[n - 1] = 1.0;
+        for (std::size_t k = 1; k < n; ++k) S[k] = S[k - 1] + static_cast<double>(glm::length(P[k] - P[k - 1]));
+        for (std::size_t k = 1; k + 1 < n; ++k) {
+            const double l = (S[k] - S[k - 1]) * (S[k + 1] - S[k]);
+            turn[k] = l > 1e-20 ? static_cast<double>(glm::dot(P[k] - P[k - 1], P[k + 1] - P[k])) / l : 1.0;
+        }
+    }
+    return m;
+}
+
+/// Appends the rings of curve `c` (see count_branch_rings) to `out`.
+void place_rings(const std::vector<BranchCurve>& curves, const CurveMetrics& metrics, std::size_t c, double spacing,
+                 double cos_max_turn, std::vector<RingSample>& out)
+{
+    const BranchCurve& curve = curves[c];
     const std::size_t m = curve.points.size();
     if (m < 2) return;
     const auto& P = curve.points;
     const auto& R = curve.radii;
+    const double* S = metrics.arc.data() + metrics.first[c];
+    const double* turn = metrics.turn_cos.data() + metrics.first[c];
     auto radius_at = [&](std::size_t k) { return std::max(R[k], kMinRingRadius); };
-    double s_last = 0.0; // arc of the last ring, always at curve point `a`
-    std::size_t a = 0;
+    std::size_t a = 0; // the last ring is at curve point a
     out.push_back({P[0], radius_at(0), 0.0f});
     // Greedy: from the last ring, the farthest curve point within the spacing that is not
     // past a sharp turn gets the next ring; a segment longer than the spacing is split evenly.
-    auto seg_len = [&](std::size_t k) { return static_cast<double>(glm::length(P[k + 1] - P[k])); };
-    auto turn_cos = [&](std::size_t k) {
-        const glm::vec3 d0 = P[k] - P[k - 1], d1 = P[k + 1] - P[k];
-        const float l = glm::length(d0) * glm::length(d1);
-        return l > 1e-20f ? static_cast<double>(glm::dot(d0, d1) / l) : 1.0;
-    };
     const double limit = spacing * (1.0 + 1e-6);
     while (a + 1 < m) {
         std::size_t best = 0;
-        double s_best = 0.0;
-        double s = s_last;
-        for (std::size_t j = a + 1; j < m; ++j) {
-            s += seg_len(j - 1);
-            if (s - s_last > limit) break;
+        for (std::size_t j = a + 1; j < m && S[j] - S[a] <= limit; ++j) {
             best = j;
-            s_best = s;
-            if (j + 1 == m || turn_cos(j) < cos_max_turn) break;
+            if (turn[j] < cos_max_turn) break;
         }
         if (best > 0) {
-            out.push_back({P[best], radius_at(best), static_cast<float>(s_best)});
+            out.push_back({P[best], radius_at(best), static_cast<float>(S[best])});
             a = best;
-            s_last = s_best;
             continue;
         }
         // The next point is farther than the spacing: split the segment evenly.
-        const double gap = seg_len(a);
+        const double gap = S[a + 1] - S[a];
         const int pieces = static_cast<int>(std::ceil(gap / spacing - 1e-9));
         for (int i = 1; i < pieces; ++i) {
             const float t = static_cast<float>(i) / static_cast<float>(pieces);
             out.push_back({P[a] + (P[a + 1] - P[a]) * t, std::max(R[a] + (R[a + 1] - R[a]) * t, kMinRingRadius),
-                           static_cast<float>(s_last + gap * static_cast<double>(t))});
+                           static_cast<float>(S[a] + gap * static_cast<double>(t))});
         }
         ++a;
-        s_last += gap;
-        out.push_back({P[a], radius_at(a), static_cast<float>(s_last)});
+        out.push_back({P[a], radius_at(a), static_cast<float>(S[a])});
     }
 }
 
@@ -119,7 +142,7 @@ void check_mesh_options(const BranchMeshOptions& o)
 double cos_turn_limit(const BranchMeshOptions& o) { return std::cos(std::clamp(o.max_turn_deg, 0.0, 180.0) * kPi / 180.0); }
 
 /// Rings of every curve, one flat array.
-void sample_all_rings(const std::vector<BranchCurve>& curves, const BranchMeshOptions& o,
+void sample_all_rings(const std::vector<BranchCurve>& curves, const CurveMetrics& metrics, const BranchMeshOptions& o,
                       std::vector<RingSample>& samples, std::vector<RingRange>& ranges)
 {
     const double cos_max = cos_turn_limit(o);
@@ -130,7 +153,7 @@ void sample_all_rings(const std::vector<BranchCurve>& curves, const BranchMeshOp
     samples.reserve(points + points / 2 + 16);
     for (std::size_t c = 0; c < curves.size(); ++c) {
         ranges[c].first = static_cast<std::uint32_t>(samples.size());
-        place_rings(curves[c], o.ring_spacing_m, cos_max, samples);
+        place_rings(curves, metrics, c, o.ring_spacing_m, cos_max, samples);
         ranges[c].count = static_cast<std::uint32_t>(samples.size() - ranges[c].first);
     }
 }
@@ -149,12 +172,63 @@ glm::vec3 any_perpendicular(const glm::vec3& t)
     return glm::normalize(axis - glm::dot(axis, t) * t);
 }
 
-/// The generalised-cylinder sweep over the kept curves.
-SurfaceGeometry sweep_curves(const std::vector<BranchCurve>& curves, const std::vector<RingSample>& samples,
-                             const std::vector<RingRange>& ranges, const std::vector<char>& keep, int n,
-                             std::vector<BranchRing>* rings_out)
+/// Four floats in one SIMD register (GCC/Clang vector extension: SSE on x86-64, NEON on
+/// ARM), for the ring vertex loop.
+typedef float V4 __attribute__((vector_size(16)));
+inline V4 load4(const float* p)
 {
-    SurfaceGeometry g;
+    V4 v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+}
+inline void store4(float* p, const V4& v) { std::memcpy(p, &v, sizeof v); }
+typedef std::uint32_t U4 __attribute__((vector_size(16)));
+
+/// Working arrays of the sweep, kept across curves and LODs: the current curve's ring
+/// tangents, the transported frame of every ring, and the batch of curves not yet appended to
+/// the mesh (when it is not written in place).
+struct CurveScratch {
+    std::vector<glm::vec3> tangent;
+    std::vector<glm::vec3> normal_of_ring, tangent_of_ring;
+    std::vector<glm::vec3> pos, nor;
+    std::vector<glm::vec2> uv;
+    std::vector<std::array<std::uint32_t, 3>> tri;
+    std::size_t used_v = 0, used_f = 0;
+    /// Room for `rings` tangents, and for `vertices` and `triangles` after what is used.
+    void fit(std::size_t rings, std::size_t vertices, std::size_t triangles)
+    {
+        if (tangent.size() < rings) tangent.resize(rings);
+        if (pos.size() < used_v + vertices) {
+            const std::size_t n = std::max(used_v + vertices, 2 * pos.size());
+            pos.resize(n);
+            nor.resize(n);
+            uv.resize(n);
+        }
+        if (tri.size() < used_f + triangles) tri.resize(std::max(used_f + triangles, 2 * tri.size()));
+    }
+};
+
+template <class T>
+void append(std::vector<T>& out, const std::vector<T>& from, std::size_t count)
+{
+    out.insert(out.end(), from.data(), from.data() + count);
+}
+
+/// Appends the scratch's batch to the mesh.
+void flush(CurveScratch& scratch, SurfaceGeometry& g)
+{
+    append(g.positions, scratch.pos, scratch.used_v);
+    append(g.normals, scratch.nor, scratch.used_v);
+    append(g.uvs, scratch.uv, scratch.used_v);
+    append(g.triangles, scratch.tri, scratch.used_f);
+    scratch.used_v = scratch.used_f = 0;
+}
+
+/// The generalised-cylinder sweep over the kept curves, into `g` (its storage reused).
+void sweep_curves(const std::vector<BranchCurve>& curves, const std::vector<RingSample>& samples,
+                  const std::vector<RingRange>& ranges, const std::vector<char>& keep, int n, SurfaceGeometry& g,
+                  CurveScratch& scratch, std::vector<BranchRing>* rings_out)
+{
     const auto nn = static_cast<std::uint32_t>(n);
     std::size_t vertex_total = 0, triangle_total = 0;
     for (std::size_t c = 0; c < curves.size(); ++c) {
@@ -162,42 +236,91 @@ SurfaceGeometry sweep_curves(const std::vector<BranchCurve>& curves, const std::
         vertex_total += ranges[c].count * nn + 1 + (curves[c].parent < 0 ? 1 : 0);
         triangle_total += curve_triangles(curves[c], ranges[c].count, n);
     }
-    g.positions.resize(vertex_total);
-    g.normals.resize(vertex_total);
-    g.uvs.resize(vertex_total);
-    g.triangles.resize(triangle_total);
+    // Each array is written once. When `g` already holds at least as many elements (storage
+    // kept from an earlier build), the curves are written in place; otherwise they go to a
+    // small cached scratch that is appended in batches (a resize would first fill fresh
+    // memory with zeros). Both leave room (cut off at the end) for the last SIMD lanes'
+    // overrun.
+    auto holds = [](const auto& v, std::size_t count, std::size_t pad) {
+        return v.size() >= count && v.capacity() >= count + pad; // only the padding gets initialised
+    };
+    const bool in_place = holds(g.positions, vertex_total, 4) && holds(g.normals, vertex_total, 4) &&
+                          holds(g.uvs, vertex_total, 4) && holds(g.triangles, triangle_total, 2);
+    if (in_place) {
+        g.positions.resize(vertex_total + 4);
+        g.normals.resize(vertex_total + 4);
+        g.uvs.resize(vertex_total + 4);
+        g.triangles.resize(triangle_total + 2);
+    } else {
+        g.positions.clear();
+        g.normals.clear();
+        g.uvs.clear();
+        g.triangles.clear();
+        // Room for the padding too, so the next build into this storage can go in place.
+        g.positions.reserve(vertex_total + 4);
+        g.normals.reserve(vertex_total + 4);
+        g.uvs.reserve(vertex_total + 4);
+        g.triangles.reserve(triangle_total + 2);
+    }
     if (rings_out) {
         rings_out->clear();
         rings_out->reserve(samples.size());
     }
 
-    // Unit circle, and the mirrored u of each column (welded seam).
-    std::vector<float> cos_j(nn), sin_j(nn), u_j(nn);
-    for (std::uint32_t j = 0; j < nn; ++j) {
+    // Ring vertices are written in blocks of four (12 position floats, 8 uv floats), so the
+    // loops below have fixed lengths the compiler vectorises. A ring of n vertices writes
+    // ⌈n/4⌉ blocks; the excess lands where the next ring (or the apex) is written after it.
+    // Tables per block: the unit circle's cos and sin and the mirrored u of each column
+    // (welded seam), spread to the float layout of the arrays.
+    const std::uint32_t blocks = (nn + 3) / 4;
+    std::vector<float> cos12(blocks * 12), sin12(blocks * 12), u8(blocks * 8);
+    for (std::uint32_t i = 0; i < blocks * 12; ++i) {
+        const std::uint32_t j = i / 3;
         const double a = 2.0 * kPi * j / n;
-        cos_j[j] = static_cast<float>(std::cos(a));
-        sin_j[j] = static_cast<float>(std::sin(a));
-        u_j[j] = static_cast<float>(1.0 - std::abs(1.0 - 2.0 * j / n));
+        cos12[i] = j < nn ? static_cast<float>(std::cos(a)) : 0.0f;
+        sin12[i] = j < nn ? static_cast<float>(std::sin(a)) : 0.0f;
+    }
+    for (std::uint32_t i = 0; i < blocks * 8; i += 2) {
+        const std::uint32_t j = i / 2;
+        u8[i] = j < nn ? static_cast<float>(1.0 - std::abs(1.0 - 2.0 * j / n)) : 0.0f;
+        u8[i + 1] = 0.0f;
+    }
+    // Tube triangles between a ring and the previous one, as offsets from the previous ring's
+    // first vertex; counter-clockwise seen from outside.
+    // Padded to whole 4-index lanes; the excess lands where the next triangles go.
+    const std::uint32_t quad_lanes = (6 * nn + 3) / 4;
+    std::vector<std::uint32_t> quad_template(4 * quad_lanes, 0);
+    for (std::uint32_t j = 0; j < nn; ++j) {
+        const std::uint32_t j1 = j + 1 == nn ? 0 : j + 1;
+        const std::uint32_t t[6] = {j, j1, nn + j1, j, nn + j1, nn + j};
+        std::copy(t, t + 6, quad_template.begin() + 6 * j);
     }
 
-    std::vector<glm::vec3> normal_of_ring(samples.size()); // transported frame normal, for child curves
-    std::vector<glm::vec3> tangent_of_ring(samples.size());
-    std::vector<glm::vec3> tangents;
-    // Raw pointers: the compiler keeps them in registers, unlike a vector's end.
-    glm::vec3* pos = g.positions.data();
-    glm::vec3* nor = g.normals.data();
-    glm::vec2* uv = g.uvs.data();
-    std::array<std::uint32_t, 3>* tri = g.triangles.data();
-    std::uint32_t v = 0; // next vertex index
+    // Transported frame of every ring, looked up by child curves at their fork.
+    if (scratch.normal_of_ring.size() < samples.size()) {
+        scratch.normal_of_ring.resize(samples.size());
+        scratch.tangent_of_ring.resize(samples.size());
+    }
+    glm::vec3* const normal_of_ring = scratch.normal_of_ring.data();
+    glm::vec3* const tangent_of_ring = scratch.tangent_of_ring.data();
+    std::size_t written_v = 0, written_f = 0;
 
     for (std::size_t c = 0; c < curves.size(); ++c) {
         if (!keep[c] || ranges[c].count < 2) continue;
         const BranchCurve& curve = curves[c];
         const RingSample* rs = samples.data() + ranges[c].first;
         const std::uint32_t R = ranges[c].count;
+        const bool root = curve.parent < 0;
+        const std::size_t curve_vertices = R * nn + 1 + (root ? 1 : 0);
+        scratch.fit(R, in_place ? 0 : curve_vertices + 4, in_place ? 0 : curve_triangles(curve, R, n) + 2);
+        glm::vec3* pos = in_place ? g.positions.data() + written_v : scratch.pos.data() + scratch.used_v;
+        glm::vec3* nor = in_place ? g.normals.data() + written_v : scratch.nor.data() + scratch.used_v;
+        glm::vec2* uv = in_place ? g.uvs.data() + written_v : scratch.uv.data() + scratch.used_v;
+        std::array<std::uint32_t, 3>* tri = in_place ? g.triangles.data() + written_f : scratch.tri.data() + scratch.used_f;
+        glm::vec3* tangents = scratch.tangent.data();
+        const auto base = static_cast<std::uint32_t>(written_v); // the curve's first vertex in the mesh
 
         // Tangents from the neighbouring ring centres.
-        tangents.resize(R);
         for (std::uint32_t k = 0; k < R; ++k) {
             const glm::vec3 d = rs[std::min(k + 1, R - 1)].centre - rs[k == 0 ? 0 : k - 1].centre;
             const float len = glm::length(d);
@@ -213,7 +336,7 @@ SurfaceGeometry sweep_curves(const std::vector<BranchCurve>& curves, const std::
         // First frame: the parent's at the fork, projected; else any. Then the curve's phase.
         glm::vec3 N;
         const glm::vec3 t0 = tangents[0];
-        if (curve.parent >= 0 && keep[static_cast<std::size_t>(curve.parent)]) {
+        if (!root && keep[static_cast<std::size_t>(curve.parent)]) {
             const RingRange& pr = ranges[static_cast<std::size_t>(curve.parent)];
             const RingSample* ps = samples.data() + pr.first;
             const RingSample* hit = std::lower_bound(ps, ps + pr.count, curve.fork_arc_m,
@@ -234,12 +357,13 @@ SurfaceGeometry sweep_curves(const std::vector<BranchCurve>& curves, const std::
             N = static_cast<float>(std::cos(delta)) * N + static_cast<float>(std::sin(delta)) * glm::cross(t0, N);
         }
 
-        std::uint32_t base_centre = 0;
-        if (curve.parent < 0) { // flat base cap centre
-            base_centre = v++;
-            pos[base_centre] = rs[0].centre;
-            nor[base_centre] = -t0;
-            uv[base_centre] = glm::vec2(0.5f, 0.0f);
+        std::uint32_t v = 0; // local vertex index
+        std::size_t f = 0;
+        if (root) { // flat base cap centre
+            pos[0] = rs[0].centre;
+            nor[0] = -t0;
+            uv[0] = glm::vec2(0.5f, 0.0f);
+            v = 1;
         }
         float vcoord = 0.0f;
         glm::vec3 t_prev = t0;
@@ -268,43 +392,82 @@ SurfaceGeometry sweep_curves(const std::vector<BranchCurve>& curves, const std::
             tangent_of_ring[ranges[c].first + k] = t;
             const glm::vec3 centre = rs[k].centre;
             const float r = rs[k].radius;
-            if (rings_out) rings_out->push_back({centre, t, r, rs[k].arc, v, static_cast<int>(c)});
-            for (std::uint32_t j = 0; j < nn; ++j) {
-                const glm::vec3 d = cos_j[j] * N + sin_j[j] * B;
-                pos[v + j] = centre + r * d;
-                nor[v + j] = d;
-                uv[v + j] = glm::vec2(u_j[j], vcoord);
-            }
-            if (k == 0 && curve.parent < 0) {
-                for (std::uint32_t j = 0; j < nn; ++j) {
-                    const std::uint32_t j1 = j + 1 == nn ? 0 : j + 1;
-                    *tri++ = {base_centre, v + j1, v + j};
+            if (rings_out) rings_out->push_back({centre, t, r, rs[k].arc, base + v, static_cast<int>(c)});
+            {
+                // Four vertices = three 4-float lanes of positions (and of normals): the frame
+                // and centre repeat with period 3 across the lanes.
+                const V4 n0{N.x, N.y, N.z, N.x}, n1{N.y, N.z, N.x, N.y}, n2{N.z, N.x, N.y, N.z};
+                const V4 b0{B.x, B.y, B.z, B.x}, b1{B.y, B.z, B.x, B.y}, b2{B.z, B.x, B.y, B.z};
+                const V4 c0{centre.x, centre.y, centre.z, centre.x}, c1{centre.y, centre.z, centre.x, centre.y},
+                    c2{centre.z, centre.x, centre.y, centre.z};
+                const V4 rv{r, r, r, r}, vv{0.0f, vcoord, 0.0f, vcoord};
+                float* p = &pos[v].x;
+                float* q = &nor[v].x;
+                float* w = &uv[v].x;
+                for (std::uint32_t b = 0; b < blocks; ++b) {
+                    const float* cb = cos12.data() + 12 * b;
+                    const float* sb = sin12.data() + 12 * b;
+                    const V4 d0 = load4(cb) * n0 + load4(sb) * b0;
+                    const V4 d1 = load4(cb + 4) * n1 + load4(sb + 4) * b1;
+                    const V4 d2 = load4(cb + 8) * n2 + load4(sb + 8) * b2;
+                    store4(q + 12 * b, d0);
+                    store4(q + 12 * b + 4, d1);
+                    store4(q + 12 * b + 8, d2);
+                    store4(p + 12 * b, c0 + rv * d0);
+                    store4(p + 12 * b + 4, c1 + rv * d1);
+                    store4(p + 12 * b + 8, c2 + rv * d2);
+                    const float* ub = u8.data() + 8 * b;
+                    store4(w + 8 * b, load4(ub) + vv);
+                    store4(w + 8 * b + 4, load4(ub + 4) + vv);
                 }
+            }
+            const std::uint32_t gv = base + v; // this ring's first vertex in the mesh
+            if (k == 0 && root) {
+                for (std::uint32_t j = 0; j + 1 < nn; ++j) tri[f++] = {base, gv + j + 1, gv + j};
+                tri[f++] = {base, gv, gv + nn - 1};
             }
             if (k > 0) {
-                const std::uint32_t a = v - nn; // previous ring
-                for (std::uint32_t j = 0; j < nn; ++j) {
-                    const std::uint32_t j1 = j + 1 == nn ? 0 : j + 1;
-                    *tri++ = {a + j, a + j1, v + j1};
-                    *tri++ = {a + j, v + j1, v + j};
+                const std::uint32_t a = gv - nn; // previous ring
+                std::uint32_t* t2 = tri[f].data();
+                const std::uint32_t* tq = quad_template.data();
+                const U4 av{a, a, a, a};
+                for (std::uint32_t i = 0; i < quad_lanes; ++i) {
+                    U4 x;
+                    std::memcpy(&x, tq + 4 * i, sizeof x);
+                    x += av;
+                    std::memcpy(t2 + 4 * i, &x, sizeof x);
                 }
+                f += 2 * nn;
             }
             v += nn;
         }
         // Tip cone: apex one tip radius beyond the last ring.
-        const std::uint32_t last = v - nn;
+        const std::uint32_t last = base + v - nn;
         const glm::vec3 t_end = tangents[R - 1];
         const float r_end = rs[R - 1].radius;
-        const std::uint32_t apex = v++;
-        pos[apex] = rs[R - 1].centre + r_end * t_end;
-        nor[apex] = t_end;
-        uv[apex] = glm::vec2(0.5f, vcoord + 1.0f / static_cast<float>(kPi));
-        for (std::uint32_t j = 0; j < nn; ++j) {
-            const std::uint32_t j1 = j + 1 == nn ? 0 : j + 1;
-            *tri++ = {last + j, last + j1, apex};
+        pos[v] = rs[R - 1].centre + r_end * t_end;
+        nor[v] = t_end;
+        uv[v] = glm::vec2(0.5f, vcoord + 1.0f / static_cast<float>(kPi));
+        const std::uint32_t apex = base + v;
+        ++v;
+        for (std::uint32_t j = 0; j + 1 < nn; ++j) tri[f++] = {last + j, last + j + 1, apex};
+        tri[f++] = {last + nn - 1, last, apex};
+        written_v += v;
+        written_f += f;
+        if (!in_place) {
+            scratch.used_v += v;
+            scratch.used_f += f;
+            if (scratch.used_v >= 8192) flush(scratch, g);
         }
     }
-    return g;
+    if (in_place) {
+        g.positions.resize(written_v);
+        g.normals.resize(written_v);
+        g.uvs.resize(written_v);
+        g.triangles.resize(written_f);
+    } else {
+        flush(scratch, g);
+    }
 }
 
 std::vector<char> keep_by_min_radius(const std::vector<BranchCurve>& curves, double min_radius)
@@ -423,7 +586,8 @@ std::size_t count_branch_rings(const BranchCurve& curve, const BranchMeshOptions
 {
     check_mesh_options(options);
     std::vector<RingSample> rings;
-    place_rings(curve, options.ring_spacing_m, cos_turn_limit(options), rings);
+    const std::vector<BranchCurve> one{curve};
+    place_rings(one, curve_metrics(one), 0, options.ring_spacing_m, cos_turn_limit(options), rings);
     return rings.size();
 }
 
@@ -433,9 +597,12 @@ SurfaceGeometry build_branch_mesh(const std::vector<BranchCurve>& curves, const 
     check_mesh_options(options);
     std::vector<RingSample> samples;
     std::vector<RingRange> ranges;
-    sample_all_rings(curves, options, samples, ranges);
-    return sweep_curves(curves, samples, ranges, keep_by_min_radius(curves, options.min_radius_m), options.radial_segments,
-                        rings);
+    sample_all_rings(curves, curve_metrics(curves), options, samples, ranges);
+    SurfaceGeometry g;
+    CurveScratch scratch;
+    sweep_curves(curves, samples, ranges, keep_by_min_radius(curves, options.min_radius_m), options.radial_segments, g,
+                 scratch, rings);
+    return g;
 }
 
 TreeGraph merge_coincident_nodes(const TreeGraph& graph, float tolerance_m, std::vector<int>* old_to_new)
@@ -538,36 +705,43 @@ BranchMeshOptions branch_lod_options(const BranchSettings& branches, int lod)
 
 double lod_triangle_budget(int lod)
 {
-    return std::pow(1.0 / 3.0, std::max(0, lod));
+    if (lod <= 0) return 1.0;
+    if (lod == 1) return 0.45;
+    return 0.135 * std::pow(0.3, lod - 2);
 }
 
-TreeGeometry build_tree_geometry(const TreeGraph& graph, const BranchSettings& branches, const LeafSettings& leaves,
-                                 std::uint64_t seed, const std::string& species)
+void build_tree_geometry_into(TreeGeometry& geo, const TreeGraph& graph, const BranchSettings& branches,
+                              const LeafSettings& leaves, std::uint64_t seed, const std::string& species)
 {
     if (branches.lod_count < 1 || branches.lod_count > 6) throw InvalidInput("tree geometry: lod_count must be in [1, 6]");
-    TreeGeometry geo;
+    check_mesh_options(branch_lod_options(branches, 0));
+    RgbaImage texture = make_leaf_texture(leaves.shape);
+    const TreeGraph clean = merge_coincident_nodes(graph);
+    const std::vector<BranchChain> chains = decompose_branch_chains(clean);
+    const std::vector<BranchCurve> curves = smooth_branch_curves(clean, chains, std::max(0, branches.smoothing_iterations));
+    const LeafCloud cloud = make_leaf_cloud(graph, leaves, seed);
+    const CurveMetrics metrics = curve_metrics(curves);
+
+    // Nothing can throw past this point: `geo` is only changed when the whole build succeeds.
     geo.species = species;
     for (int i = 0; i < 3; ++i) {
         geo.bark_color[static_cast<std::size_t>(i)] = static_cast<float>(branches.bark_color[i]);
         geo.leaf_color[static_cast<std::size_t>(i)] = static_cast<float>(leaves.color[i]);
     }
-    geo.leaf_texture = make_leaf_texture(leaves.shape);
-    check_mesh_options(branch_lod_options(branches, 0));
-
-    const TreeGraph clean = merge_coincident_nodes(graph);
-    const std::vector<BranchChain> chains = decompose_branch_chains(clean);
-    const std::vector<BranchCurve> curves = smooth_branch_curves(clean, chains, std::max(0, branches.smoothing_iterations));
+    geo.leaf_texture = std::move(texture);
+    geo.lods.resize(static_cast<std::size_t>(branches.lod_count));
 
     std::vector<RingSample> samples;
     std::vector<RingRange> ranges;
-    geo.lods.resize(static_cast<std::size_t>(branches.lod_count));
+    CurveScratch scratch;
 
     // LOD0: everything at full resolution.
     {
         const BranchMeshOptions o = branch_lod_options(branches, 0);
-        sample_all_rings(curves, o, samples, ranges);
-        geo.lods[0].branches = sweep_curves(curves, samples, ranges, std::vector<char>(curves.size(), 1), o.radial_segments, nullptr);
-        geo.lods[0].leaves = build_leaf_quads(graph, leaves, seed);
+        sample_all_rings(curves, metrics, o, samples, ranges);
+        sweep_curves(curves, samples, ranges, std::vector<char>(curves.size(), 1), o.radial_segments, geo.lods[0].branches,
+                     scratch, nullptr);
+        emit_leaf_quads(cloud, leaves, LeafLodOptions{}, geo.lods[0].leaves);
     }
     const double total0 = static_cast<double>(geo.lods[0].branches.triangle_count() + geo.lods[0].leaves.triangle_count());
     const double leaves0 = static_cast<double>(geo.lods[0].leaves.triangle_count());
@@ -575,34 +749,43 @@ TreeGeometry build_tree_geometry(const TreeGraph& graph, const BranchSettings& b
     std::vector<double> eff(curves.size());
     std::vector<float> length(curves.size());
     std::vector<std::uint32_t> order(curves.size());
+    std::vector<char> keep_curve(curves.size());
     for (int lod = 1; lod < branches.lod_count; ++lod) {
         TreeLod& out = geo.lods[static_cast<std::size_t>(lod)];
         const double budget = lod_triangle_budget(lod) * total0;
         // Leaves: fewer and larger; never more than 80 % of the budget.
         double keep = leaf_lod_keep_fraction(lod);
         if (leaves0 > 0.0 && leaves0 * keep > 0.8 * budget) keep = std::max(1e-4, 0.8 * budget / leaves0);
-        out.leaves = build_leaf_quads(graph, leaves, seed, LeafLodOptions{keep});
+        emit_leaf_quads(cloud, leaves, LeafLodOptions{keep}, out.leaves);
 
         // Branches: coarser rings, then the thickest chains that fit the rest of the budget.
         const BranchMeshOptions o = branch_lod_options(branches, lod);
-        sample_all_rings(curves, o, samples, ranges);
+        sample_all_rings(curves, metrics, o, samples, ranges);
         const double branch_budget = budget - static_cast<double>(out.leaves.triangle_count());
         for (std::size_t c = 0; c < curves.size(); ++c) {
             const int p = curves[c].parent;
             eff[c] = p < 0 ? std::numeric_limits<double>::infinity()
                            : std::min(static_cast<double>(curves[c].radii[0]), eff[static_cast<std::size_t>(p)]);
+            length[c] = ranges[c].count ? samples[ranges[c].first + ranges[c].count - 1].arc : 0.0f;
+        }
+        double all = 0.0;
+        for (std::size_t c = 0; c < curves.size(); ++c)
+            all += static_cast<double>(curve_triangles(curves[c], ranges[c].count, o.radial_segments));
+        if (all <= branch_budget) { // the coarser rings alone meet the budget: no pruning
+            std::fill(keep_curve.begin(), keep_curve.end(), 1);
+            sweep_curves(curves, samples, ranges, keep_curve, o.radial_segments, out.branches, scratch, nullptr);
+            continue;
         }
         // Thickest first; among equally thick chains (all single-tip twigs have the tip
         // radius) the longer first, so pruning thins the crown evenly instead of clearing one
         // side of it.
-        for (std::size_t c = 0; c < curves.size(); ++c) length[c] = ranges[c].count ? samples[ranges[c].first + ranges[c].count - 1].arc : 0.0f;
         std::iota(order.begin(), order.end(), 0u);
         std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
             if (eff[a] != eff[b]) return eff[a] > eff[b];
             if (length[a] != length[b]) return length[a] > length[b];
             return a < b;
         });
-        std::vector<char> keep_curve(curves.size(), 0);
+        std::fill(keep_curve.begin(), keep_curve.end(), 0);
         double used = 0.0;
         for (std::size_t i = 0; i < order.size(); ++i) {
             const std::uint32_t c = order[i];
@@ -613,8 +796,15 @@ TreeGeometry build_tree_geometry(const TreeGraph& graph, const BranchSettings& b
             used += t;
             keep_curve[c] = 1;
         }
-        out.branches = sweep_curves(curves, samples, ranges, keep_curve, o.radial_segments, nullptr);
+        sweep_curves(curves, samples, ranges, keep_curve, o.radial_segments, out.branches, scratch, nullptr);
     }
+}
+
+TreeGeometry build_tree_geometry(const TreeGraph& graph, const BranchSettings& branches, const LeafSettings& leaves,
+                                 std::uint64_t seed, const std::string& species)
+{
+    TreeGeometry geo;
+    build_tree_geometry_into(geo, graph, branches, leaves, seed, species);
     return geo;
 }
 

@@ -115,13 +115,14 @@ TreeGraph merge_coincident_nodes(const TreeGraph& graph, float tolerance_m = 1e-
 TreeGraph prune_twigs(const TreeGraph& graph, float min_radius_m, std::vector<int>* old_to_new = nullptr);
 
 /// Resolution of level of detail `lod` for `branches`: LOD0 is the settings themselves; each
-/// further level halves the radial segments (at least 3), multiplies the ring spacing by 2.5
-/// and allows 1.75 × the turn angle between rings. Twig pruning is chosen by
+/// further level multiplies the radial segments by 0.7 (rounded, at least 3: 8, 6, 4, 3, …),
+/// doubles the ring spacing and allows 1.75 × the turn angle between rings (10°, 17.5°, …,
+/// at most 60°). Twig pruning is chosen by
 /// build_tree_geometry to meet the triangle budgets.
 BranchMeshOptions branch_lod_options(const BranchSettings& branches, int lod);
 
-/// Share of LOD0's triangles (branches + leaves) that LOD `lod` may use: 1, 0.5, 0.15, then
-/// × 0.3 per further level.
+/// Share of LOD0's triangles (branches + leaves) that LOD `lod` may use: 1, 0.45, 0.135, then
+/// × 0.3 per further level (10 % below the 50 % and 15 % the LODs must stay under).
 double lod_triangle_budget(int lod);
 
 /// Builds the tree's branch and leaf geometry at branches.lod_count levels of detail, the
@@ -129,11 +130,20 @@ double lod_triangle_budget(int lod);
 /// LODs come from the same smoothed skeleton with the coarser resolution of
 /// branch_lod_options, the thinnest twigs pruned (the largest set of chains, thickest first,
 /// that fits the budget lod_triangle_budget × LOD0's triangles), and fewer, larger leaves
-/// (leaf_lod_keep_fraction) at the same tips, so the foliage keeps its area and silhouette.
+/// (leaf_lod_keep_fraction, lowered when the leaves alone would take more than 80 % of a
+/// LOD's budget) at the same tips, so the foliage keeps its area and silhouette.
 /// Deterministic: the same inputs give the same bytes.
 /// \throw InvalidInput on an invalid graph (see merge_coincident_nodes), lod_count outside
 /// [1, 6], radial_segments < 3, ring_spacing_m ≤ 0 or an unknown leaf shape.
 TreeGeometry build_tree_geometry(const TreeGraph& graph, const BranchSettings& branches, const LeafSettings& leaves,
                                  std::uint64_t seed, const std::string& species = {});
+
+/// build_tree_geometry into an existing TreeGeometry, reusing the storage of its meshes: a
+/// caller that regrows the tree often (the editor, while the person sketches) keeps two
+/// TreeGeometry values, draws one and rebuilds into the other, and after the first build no
+/// memory is allocated for the meshes. `out` is left unchanged when this throws.
+/// \throw InvalidInput as build_tree_geometry.
+void build_tree_geometry_into(TreeGeometry& out, const TreeGraph& graph, const BranchSettings& branches,
+                              const LeafSettings& leaves, std::uint64_t seed, const std::string& species = {});
 
 } // namespace lobe

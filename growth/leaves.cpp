@@ -111,7 +111,7 @@ double value_noise(double x, double y, int cells, std::uint64_t salt)
     return (a + (b - a) * sx) + ((c + (d - c) * sx) - (a + (b - a) * sx)) * sy;
 }
 
-std::uint8_t to_byte(double v) { return static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0)); }
+std::uint8_t to_byte(double v) { return static_cast<std::uint8_t>(std::clamp(v, 0.0, 1.0) * 255.0 + 0.5); }
 
 } // namespace
 
@@ -151,7 +151,7 @@ RgbaImage make_leaf_texture(const std::string& shape_name, int size)
                 if (shape != LeafShape::Needle && hw > 1e-6) {
                     const double q = (t - 0.22 * ax / hw) * vein_pairs;
                     const double dist_px = std::abs(q - std::round(q)) / vein_pairs * blade_len * size;
-                    const double fade = std::clamp(1.0 - ax / (0.85 * hw), 0.0, 1.0);
+                    const double fade = std::clamp(1.0 - ax / (0.85 * hw), 0.0, 1.0) * std::clamp((0.9 - t) * 8.0, 0.0, 1.0);
                     shade += 0.08 * fade * std::clamp(1.2 - dist_px, 0.0, 1.0);
                 }
                 // Darker towards the edge, soft mottling.
@@ -198,31 +198,25 @@ std::vector<int> leaf_tip_nodes(const TreeGraph& graph)
 
 double leaf_lod_keep_fraction(int lod) { return std::pow(0.5, std::max(0, lod)); }
 
-SurfaceGeometry build_leaf_quads(const TreeGraph& graph, const LeafSettings& leaves, std::uint64_t seed,
-                                 const LeafLodOptions& lod, std::vector<int>* quad_nodes)
+LeafCloud make_leaf_cloud(const TreeGraph& graph, const LeafSettings& leaves, std::uint64_t seed)
 {
-    if (!(lod.keep_fraction > 0.0 && lod.keep_fraction <= 1.0))
-        throw InvalidInput("leaves: keep_fraction must be in (0, 1]");
-    SurfaceGeometry out;
-    if (quad_nodes) quad_nodes->clear();
+    LeafCloud cloud;
     const int per_node = std::max(0, leaves.per_node);
-    if (per_node == 0 || graph.nodes.size() < 2) return out;
-
+    cloud.per_node = per_node;
+    if (per_node == 0 || graph.nodes.size() < 2) return cloud;
     const std::vector<int> tips = leaf_tip_nodes(graph);
     const std::vector<std::uint32_t> ordinal = ordinals_within_lobes(graph);
-    const double keep = lod.keep_fraction;
-    const double scale = std::sqrt(1.0 / keep); // area × 1/keep
-    const double length = leaves.length_m * scale;
-    const double half_width = 0.5 * leaves.width_m * scale;
     const double cos_dev = std::cos(std::clamp(leaves.deviation_deg, 0.0, 180.0) * kPi / 180.0);
-
-    const std::size_t max_quads = tips.size() * static_cast<std::size_t>(per_node);
-    out.positions.reserve(max_quads * 4);
-    out.normals.reserve(max_quads * 4);
-    out.uvs.reserve(max_quads * 4);
-    out.triangles.reserve(max_quads * 2);
-    if (quad_nodes) quad_nodes->reserve(max_quads);
-
+    cloud.leaves.reserve(tips.size() * static_cast<std::size_t>(per_node));
+    // A uniform direction in the plane of (a, b), by rejection: no trigonometry, so the draws
+    // give the same bits wherever the math library differs.
+    auto unit_in_plane = [](SplitMix64& rng, const glm::dvec3& a, const glm::dvec3& b) {
+        for (;;) {
+            const double x = 2.0 * rng.uniform() - 1.0, y = 2.0 * rng.uniform() - 1.0;
+            const double s2 = x * x + y * y;
+            if (s2 <= 1.0 && s2 > 1e-8) return (x * a + y * b) / std::sqrt(s2);
+        }
+    };
     for (const int tip : tips) {
         const TreeNode& node = graph.nodes[static_cast<std::size_t>(tip)];
         const glm::dvec3 base(node.position);
@@ -238,40 +232,91 @@ SurfaceGeometry build_leaf_quads(const TreeGraph& graph, const LeafSettings& lea
         }
         SplitMix64 rng = leaf_stream(seed, node.lobe, ordinal[static_cast<std::size_t>(tip)]);
         // Always drawn first, so every LOD sees the same leaf draws after it.
-        const double r = rng.uniform();
-        const int count = keep >= 1.0 ? per_node
-                                      : std::min(per_node, static_cast<int>(std::floor(per_node * keep + r)));
+        const auto keep_offset = static_cast<float>(rng.uniform());
         glm::dvec3 e1, e2;
         perpendicular_basis(dir, e1, e2);
-        for (int j = 0; j < count; ++j) {
+        for (int j = 0; j < per_node; ++j) {
             // Axis: uniform over the spherical cap of half-angle deviation_deg around dir.
             const double cos_t = 1.0 - rng.uniform() * (1.0 - cos_dev);
             const double sin_t = std::sqrt(std::max(0.0, 1.0 - cos_t * cos_t));
-            const double phi = 2.0 * kPi * rng.uniform();
-            const glm::dvec3 axis = glm::normalize(cos_t * dir + sin_t * (std::cos(phi) * e1 + std::sin(phi) * e2));
+            const glm::dvec3 axis = glm::normalize(cos_t * dir + sin_t * unit_in_plane(rng, e1, e2));
             // Roll about the axis.
             glm::dvec3 a1, a2;
             perpendicular_basis(axis, a1, a2);
-            const double roll = 2.0 * kPi * rng.uniform();
-            const glm::dvec3 across = std::cos(roll) * a1 + std::sin(roll) * a2;
-            const glm::vec3 normal(glm::normalize(glm::cross(across, axis)));
-
-            const auto first = static_cast<std::uint32_t>(out.positions.size());
-            const glm::dvec3 side = half_width * across, up = length * axis;
-            out.positions.emplace_back(base - side);
-            out.positions.emplace_back(base + side);
-            out.positions.emplace_back(base + up + side);
-            out.positions.emplace_back(base + up - side);
-            out.uvs.emplace_back(0.0f, 1.0f);
-            out.uvs.emplace_back(1.0f, 1.0f);
-            out.uvs.emplace_back(1.0f, 0.0f);
-            out.uvs.emplace_back(0.0f, 0.0f);
-            for (int k = 0; k < 4; ++k) out.normals.push_back(normal);
-            out.triangles.push_back({first, first + 1, first + 2});
-            out.triangles.push_back({first, first + 2, first + 3});
-            if (quad_nodes) quad_nodes->push_back(tip);
+            const glm::dvec3 across = unit_in_plane(rng, a1, a2);
+            cloud.leaves.push_back({glm::vec3(base), glm::vec3(axis), glm::vec3(across), tip, j, keep_offset});
         }
     }
+    return cloud;
+}
+
+namespace {
+void check_keep(double keep)
+{
+    if (!(keep > 0.0 && keep <= 1.0)) throw InvalidInput("leaves: keep_fraction must be in (0, 1]");
+}
+int kept_per_tip(int per_node, double keep, float offset)
+{
+    return keep >= 1.0 ? per_node : std::min(per_node, static_cast<int>(std::floor(per_node * keep + static_cast<double>(offset))));
+}
+} // namespace
+
+std::size_t count_leaf_quads(const LeafCloud& cloud, double keep_fraction)
+{
+    check_keep(keep_fraction);
+    std::size_t n = 0;
+    for (const LeafCloud::Leaf& leaf : cloud.leaves)
+        n += leaf.rank < kept_per_tip(cloud.per_node, keep_fraction, leaf.keep_offset);
+    return n;
+}
+
+void emit_leaf_quads(const LeafCloud& cloud, const LeafSettings& leaves, const LeafLodOptions& lod, SurfaceGeometry& out,
+                     std::vector<int>* quad_nodes)
+{
+    check_keep(lod.keep_fraction);
+    const double keep = lod.keep_fraction;
+    const std::size_t quads = count_leaf_quads(cloud, keep);
+    out.positions.clear();
+    out.normals.clear();
+    out.uvs.clear();
+    out.triangles.clear();
+    out.positions.reserve(quads * 4);
+    out.normals.reserve(quads * 4);
+    out.uvs.reserve(quads * 4);
+    out.triangles.reserve(quads * 2);
+    if (quad_nodes) {
+        quad_nodes->clear();
+        quad_nodes->reserve(quads);
+    }
+    const double scale = std::sqrt(1.0 / keep); // area × 1/keep
+    const auto length = static_cast<float>(leaves.length_m * scale);
+    const auto half_width = static_cast<float>(0.5 * leaves.width_m * scale);
+    for (const LeafCloud::Leaf& leaf : cloud.leaves) {
+        if (leaf.rank >= kept_per_tip(cloud.per_node, keep, leaf.keep_offset)) continue;
+        const glm::vec3 normal = glm::normalize(glm::cross(leaf.across, leaf.axis));
+        const auto first = static_cast<std::uint32_t>(out.positions.size());
+        const glm::vec3 side = half_width * leaf.across, up = length * leaf.axis;
+        out.positions.push_back(leaf.base - side);
+        out.positions.push_back(leaf.base + side);
+        out.positions.push_back(leaf.base + up + side);
+        out.positions.push_back(leaf.base + up - side);
+        out.uvs.emplace_back(0.0f, 1.0f);
+        out.uvs.emplace_back(1.0f, 1.0f);
+        out.uvs.emplace_back(1.0f, 0.0f);
+        out.uvs.emplace_back(0.0f, 0.0f);
+        for (int k = 0; k < 4; ++k) out.normals.push_back(normal);
+        out.triangles.push_back({first, first + 1, first + 2});
+        out.triangles.push_back({first, first + 2, first + 3});
+        if (quad_nodes) quad_nodes->push_back(leaf.node);
+    }
+}
+
+SurfaceGeometry build_leaf_quads(const TreeGraph& graph, const LeafSettings& leaves, std::uint64_t seed,
+                                 const LeafLodOptions& lod, std::vector<int>* quad_nodes)
+{
+    check_keep(lod.keep_fraction);
+    SurfaceGeometry out;
+    emit_leaf_quads(make_leaf_cloud(graph, leaves, seed), leaves, lod, out, quad_nodes);
     return out;
 }
 

@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include <glm/vec3.hpp>
+
 #include "core/settings.h"
 #include "core/tree.h"
 #include "growth/tree_geometry.h"
@@ -47,10 +49,37 @@ std::vector<int> leaf_tip_nodes(const TreeGraph& graph);
 /// length_m × width_m. Four vertices per quad (no vertex shared between quads), normals the
 /// quad's face normal (render two-sided). A tip whose parent is at the same position takes
 /// the direction of the nearest ancestor that is not; if none, +Y.
+/// Same as emit_leaf_quads(make_leaf_cloud(graph, leaves, seed), leaves, lod, out, quad_nodes).
 /// \param quad_nodes when not null, receives the tip node of each quad.
 /// \throw InvalidInput when keep_fraction is not in (0, 1].
 SurfaceGeometry build_leaf_quads(const TreeGraph& graph, const LeafSettings& leaves, std::uint64_t seed,
                                  const LeafLodOptions& lod = {}, std::vector<int>* quad_nodes = nullptr);
+
+/// The random placement of every LOD0 leaf, drawn once and shared by all levels of detail.
+struct LeafCloud {
+    struct Leaf {
+        glm::vec3 base{0.0f};   ///< the tip node's position: the middle of the quad's base edge
+        glm::vec3 axis{0.0f};   ///< unit, from the base to the leaf's tip
+        glm::vec3 across{0.0f}; ///< unit, normal to axis: the base edge's direction
+        int node = 0;           ///< the tip node
+        int rank = 0;           ///< 0 … per_node − 1 among the leaves of its tip
+        float keep_offset = 0;  ///< the tip's r in ⌊per_node · keep + r⌋, in [0, 1)
+    };
+    std::vector<Leaf> leaves; ///< tips in node order, each tip's leaves by rank
+    int per_node = 0;
+};
+
+/// Draws the LOD0 leaves of `graph` (see build_leaf_quads).
+LeafCloud make_leaf_cloud(const TreeGraph& graph, const LeafSettings& leaves, std::uint64_t seed);
+
+/// Number of quads emit_leaf_quads writes for `keep_fraction`.
+std::size_t count_leaf_quads(const LeafCloud& cloud, double keep_fraction);
+
+/// Writes the quads of `cloud` at `lod` into `out`, replacing its content but reusing its
+/// storage. Sizes from `leaves` (length_m, width_m), scaled by √(1 / keep_fraction).
+/// \throw InvalidInput when keep_fraction is not in (0, 1].
+void emit_leaf_quads(const LeafCloud& cloud, const LeafSettings& leaves, const LeafLodOptions& lod, SurfaceGeometry& out,
+                     std::vector<int>* quad_nodes = nullptr);
 
 /// Share of the LOD0 leaves kept at level `lod`: 0.5^lod.
 double leaf_lod_keep_fraction(int lod);

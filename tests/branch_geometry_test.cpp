@@ -510,3 +510,29 @@ TEST(BranchGeometry, PruneTwigsRemovesThinChainsWithTheirSubtreesAndKeepsTheMain
     // Nothing pruned below the tip radius.
     EXPECT_EQ(prune_twigs(tree, 0.0f).size(), tree.size());
 }
+
+TEST(BranchGeometry, RebuildingIntoKeptStorageGivesTheSameBytesAndLeavesItUnchangedOnError)
+{
+    TreeShape deeper;
+    deeper.depth = 9;
+    const TreeGraph big = make_fixture_tree(deeper), small = binary_test_tree(2);
+    TreeGeometry kept;
+    // Small into empty storage (appended), big into small (grows), small into big (in place).
+    build_tree_geometry_into(kept, small, default_branches(), default_leaves(), 4);
+    build_tree_geometry_into(kept, big, default_branches(), default_leaves(), 4);
+    const TreeGeometry fresh_big = build_tree_geometry(big, default_branches(), default_leaves(), 4);
+    for (std::size_t k = 0; k < kept.lods.size(); ++k) EXPECT_TRUE(same_bytes(kept.lods[k].branches, fresh_big.lods[k].branches));
+    build_tree_geometry_into(kept, small, default_branches(), default_leaves(), 4, "willow");
+    const TreeGeometry fresh = build_tree_geometry(small, default_branches(), default_leaves(), 4, "willow");
+    ASSERT_EQ(kept.lods.size(), fresh.lods.size());
+    for (std::size_t k = 0; k < kept.lods.size(); ++k) {
+        EXPECT_TRUE(same_bytes(kept.lods[k].branches, fresh.lods[k].branches));
+        EXPECT_TRUE(same_bytes(kept.lods[k].leaves, fresh.lods[k].leaves));
+    }
+    EXPECT_EQ(kept.species, "willow");
+    TreeGraph bad = small;
+    bad.nodes[5].parent = 900;
+    EXPECT_THROW(build_tree_geometry_into(kept, bad, default_branches(), default_leaves(), 4, "birch"), InvalidInput);
+    EXPECT_EQ(kept.species, "willow");
+    EXPECT_TRUE(same_bytes(kept.lods[0].branches, fresh.lods[0].branches));
+}

@@ -338,3 +338,25 @@ TEST(Leaves, UnknownShapesAndSizesThrowInvalidInput)
     EXPECT_THROW(make_leaf_texture("ovate", 4), InvalidInput);
     EXPECT_THROW(make_leaf_texture("ovate", 100000), InvalidInput);
 }
+
+TEST(Leaves, CloudCountsAndEmitsTheSameQuadsAsBuildLeafQuads)
+{
+    const TreeGraph g = binary_test_tree();
+    LeafSettings l;
+    l.per_node = 3;
+    const LeafCloud cloud = make_leaf_cloud(g, l, 21);
+    EXPECT_EQ(cloud.leaves.size(), 256u * 3u);
+    SurfaceGeometry out;
+    for (double keep : {1.0, 0.5, 0.3, 0.1}) {
+        emit_leaf_quads(cloud, l, {keep}, out);
+        EXPECT_EQ(out.triangle_count(), 2 * count_leaf_quads(cloud, keep)) << keep;
+        EXPECT_TRUE(same_bytes(out, build_leaf_quads(g, l, 21, {keep}))) << keep;
+    }
+    for (const LeafCloud::Leaf& leaf : cloud.leaves) {
+        EXPECT_NEAR(glm::length(leaf.axis), 1.0f, 1e-5f);
+        EXPECT_NEAR(glm::length(leaf.across), 1.0f, 1e-5f);
+        EXPECT_NEAR(glm::dot(leaf.axis, leaf.across), 0.0f, 1e-5f);
+        EXPECT_GE(leaf.keep_offset, 0.0f);
+        EXPECT_LT(leaf.keep_offset, 1.0f);
+    }
+}

@@ -20,7 +20,8 @@ namespace lobe::test {
 struct TreeShape {
     int depth = 8;                   ///< fork levels above the trunk
     double triple_fork_share = 0.0;  ///< share of forks with three children instead of two
-    int nodes_per_branch = 3;        ///< nodes along each branch
+    int nodes_per_branch = 3;        ///< nodes along each branch (at least)
+    double max_node_spacing_m = 0.0; ///< when > 0, long branches get more nodes, at most this far apart
     double trunk_height_m = 1.2;
     double trunk_node_spacing_m = 0.02;
     double first_branch_m = 0.6;     ///< length of a first-level branch
@@ -93,8 +94,10 @@ inline TreeGraph make_fixture_tree(const TreeShape& shape)
         int parent = b.parent;
         glm::dvec3 pos(g.nodes[static_cast<std::size_t>(parent)].position);
         glm::dvec3 dir = b.dir;
-        const double step = b.length / shape.nodes_per_branch;
-        for (int k = 0; k < shape.nodes_per_branch; ++k) {
+        int nodes = shape.nodes_per_branch;
+        if (shape.max_node_spacing_m > 0.0) nodes = std::max(nodes, static_cast<int>(std::ceil(b.length / shape.max_node_spacing_m)));
+        const double step = b.length / nodes;
+        for (int k = 0; k < nodes; ++k) {
             // A little bend along the branch.
             dir = glm::normalize(dir + glm::dvec3(rng.next() - 0.5, rng.next() - 0.5, rng.next() - 0.5) * 0.15);
             pos += dir * step;
@@ -113,7 +116,7 @@ inline TreeGraph make_fixture_tree(const TreeShape& shape)
     return g;
 }
 
-/// The depth-8 binary test tree (256 tips, 1,597 nodes).
+/// The depth-8 binary test tree (256 tips, 1,591 nodes).
 inline TreeGraph binary_test_tree(std::uint64_t seed = 1)
 {
     TreeShape s;
@@ -121,13 +124,14 @@ inline TreeGraph binary_test_tree(std::uint64_t seed = 1)
     return make_fixture_tree(s);
 }
 
-/// A tree the size of the largest scene's: about 30,000 nodes and 5,000 tips.
+/// A tree the size of the largest scene's: 29,737 nodes and 5,264 tips.
 inline TreeGraph large_test_tree()
 {
     TreeShape s;
     s.depth = 11;
-    s.triple_fork_share = 0.17;
+    s.triple_fork_share = 0.22;
     s.nodes_per_branch = 3;
+    s.max_node_spacing_m = 0.05;
     s.first_branch_m = 0.9;
     s.length_ratio = 0.76;
     s.seed = 7;
