@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 
 #include <glm/geometric.hpp>
 #include <nanoflann.hpp>
@@ -176,7 +177,7 @@ glm::dvec3 cluster_direction(const glm::vec3& node, const std::vector<glm::vec3>
 
 std::vector<TreeNode> grow_in_lobe(const Skeleton& skeleton, int lobe_index, const GrowthLobe& lobe,
                                    const GrowthSettings& settings, const SubtreeLibrary& library,
-                                   std::uint64_t seed, LobeGrowthStats& stats)
+                                   std::uint64_t seed, LobeGrowthStats& stats, const MeshRaycaster* shared_ray)
 {
     stats = {};
     if (library.subtrees.empty()) throw InvalidInput("growth: the subtree library is empty");
@@ -209,7 +210,9 @@ std::vector<TreeNode> grow_in_lobe(const Skeleton& skeleton, int lobe_index, con
     const std::vector<glm::vec3>& attractors = lobe.mesh.positions;
     const std::size_t na = attractors.size();
     stats.attractors = na;
-    const MeshRaycaster ray(lobe.mesh);
+    std::optional<MeshRaycaster> own_ray;
+    if (!shared_ray) own_ray.emplace(lobe.mesh);
+    const MeshRaycaster& ray = shared_ray ? *shared_ray : *own_ray;
     const float kill2 = static_cast<float>(settings.kill_distance_m * settings.kill_distance_m);
 
     std::vector<std::uint8_t> live(na, 1);
@@ -354,7 +357,7 @@ std::vector<TreeNode> grow_in_lobe(const Skeleton& skeleton, int lobe_index, con
                     // through a thin part of the lobe it ends short of the surface instead.
                     const float seg = glm::length(d);
                     if (root_inside && seg > 1e-9f) {
-                        const float hit = ray.first_hit(pos[parent], d / seg);
+                        const float hit = ray.first_hit(pos[parent], d / seg, seg);
                         if (hit >= 0.0f && hit < seg) {
                             q = pos[parent] + (kClipFraction * hit / seg) * d;
                             d = q - pos[parent];
@@ -407,9 +410,12 @@ GrowthResult grow_tree(const std::vector<std::vector<glm::vec3>>& trunk_strokes,
     GrowthResult result;
     std::vector<TriangleMesh> meshes;
     for (const GrowthLobe& l : lobes) meshes.push_back(l.mesh);
+    std::vector<MeshRaycaster> rays;
+    rays.reserve(lobes.size());
+    for (const GrowthLobe& l : lobes) rays.emplace_back(l.mesh);
     SkeletonOptions so;
     so.spacing_m = settings.skeleton_spacing_m;
-    Skeleton skeleton = build_skeleton(trunk_strokes, meshes, so);
+    Skeleton skeleton = build_skeleton(trunk_strokes, meshes, so, &rays);
     result.messages = skeleton.messages;
     result.tree = skeleton.graph;
     result.skeleton_nodes = skeleton.graph.nodes.size();
@@ -421,7 +427,7 @@ GrowthResult grow_tree(const std::vector<std::vector<glm::vec3>>& trunk_strokes,
     for (std::size_t l = 0; l < lobes.size(); ++l) {
         LobeGrowthStats stats;
         std::vector<TreeNode> nodes =
-            grow_in_lobe(skeleton, static_cast<int>(l), lobes[l], settings, library, seed, stats);
+            grow_in_lobe(skeleton, static_cast<int>(l), lobes[l], settings, library, seed, stats, &rays[l]);
         const int offset = static_cast<int>(result.tree.nodes.size());
         for (TreeNode& n : nodes) {
             if (n.parent >= static_cast<int>(s)) n.parent = offset + (n.parent - static_cast<int>(s));

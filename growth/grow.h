@@ -26,6 +26,8 @@
 
 namespace lobe {
 
+class MeshRaycaster;
+
 /// One lobe to grow in.
 struct GrowthLobe {
     std::int64_t id = 0;    ///< the lobe's id: keys its random streams
@@ -82,9 +84,10 @@ glm::dvec3 cluster_direction(const glm::vec3& node, const std::vector<glm::vec3>
 /// Grows one lobe from `skeleton` (its shared nodes and the limbs made for lobe
 /// `lobe_index`). The returned nodes' parents index `skeleton.graph.nodes` when below
 /// skeleton.graph.size() and the returned nodes (offset by that size) otherwise.
+/// `ray` (optional) is the lobe's ray caster when the caller has one.
 std::vector<TreeNode> grow_in_lobe(const Skeleton& skeleton, int lobe_index, const GrowthLobe& lobe,
                                    const GrowthSettings& settings, const SubtreeLibrary& library,
-                                   std::uint64_t seed, LobeGrowthStats& stats);
+                                   std::uint64_t seed, LobeGrowthStats& stats, const MeshRaycaster* ray = nullptr);
 
 /// The whole tree: skeleton from the trunk strokes (or the default trunk), then every lobe's
 /// growth, merged into one graph rooted at the trunk base. Radii are left to

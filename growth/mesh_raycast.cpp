@@ -29,9 +29,9 @@ float intersect(const glm::vec3& o, const glm::vec3& d, const glm::vec3& a, cons
     return glm::dot(e2, q) * inv;
 }
 
-bool hits_box(const glm::vec3& o, const glm::vec3& inv_d, const glm::vec3& lo, const glm::vec3& hi)
+bool hits_box(const glm::vec3& o, const glm::vec3& inv_d, const glm::vec3& lo, const glm::vec3& hi, float t_max)
 {
-    float t0 = 0.0f, t1 = std::numeric_limits<float>::max();
+    float t0 = 0.0f, t1 = t_max;
     for (int k = 0; k < 3; ++k) {
         float a = (lo[k] - o[k]) * inv_d[k], b = (hi[k] - o[k]) * inv_d[k];
         if (a > b) std::swap(a, b);
@@ -95,7 +95,7 @@ int MeshRaycaster::build(int begin, int end, std::vector<glm::vec3>& centroids)
 }
 
 template <typename Visit>
-void MeshRaycaster::traverse(const glm::vec3& origin, const glm::vec3& dir, Visit&& visit) const
+void MeshRaycaster::traverse(const glm::vec3& origin, const glm::vec3& dir, float t_max, Visit&& visit) const
 {
     if (nodes_.empty()) return;
     const glm::vec3 inv_d(1.0f / (dir.x != 0.0f ? dir.x : 1e-30f), 1.0f / (dir.y != 0.0f ? dir.y : 1e-30f),
@@ -106,7 +106,7 @@ void MeshRaycaster::traverse(const glm::vec3& origin, const glm::vec3& dir, Visi
     while (top > 0) {
         const int at = stack[--top];
         const Node& node = nodes_[static_cast<std::size_t>(at)];
-        if (!hits_box(origin, inv_d, node.lo, node.hi)) continue;
+        if (!hits_box(origin, inv_d, node.lo, node.hi, t_max)) continue;
         if (node.count > 0) {
             for (int i = node.first; i < node.first + node.count; ++i) {
                 const auto& t = mesh_.triangles[static_cast<std::size_t>(order_[static_cast<std::size_t>(i)])];
@@ -125,17 +125,17 @@ void MeshRaycaster::traverse(const glm::vec3& origin, const glm::vec3& dir, Visi
 void MeshRaycaster::crossings(const glm::vec3& origin, const glm::vec3& dir, std::vector<float>& out) const
 {
     out.clear();
-    traverse(origin, dir, [&](float t) { out.push_back(t); });
+    traverse(origin, dir, std::numeric_limits<float>::max(), [&](float t) { out.push_back(t); });
     std::sort(out.begin(), out.end());
     // A ray through a shared edge or vertex hits each triangle there: count the crossing once.
     out.erase(std::unique(out.begin(), out.end(), [](float a, float b) { return b - a < 1e-6f; }), out.end());
 }
 
-float MeshRaycaster::first_hit(const glm::vec3& origin, const glm::vec3& dir) const
+float MeshRaycaster::first_hit(const glm::vec3& origin, const glm::vec3& dir, float t_max) const
 {
     float best = -1.0f;
-    traverse(origin, dir, [&](float t) {
-        if (best < 0.0f || t < best) best = t;
+    traverse(origin, dir, t_max, [&](float t) {
+        if (t < t_max && (best < 0.0f || t < best)) best = t;
     });
     return best;
 }

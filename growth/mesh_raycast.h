@@ -6,6 +6,7 @@
 /// to keep CGAL out of growth/ (compile time) and because growth casts thousands of short
 /// queries per tree: a flat, cache-friendly BVH of floats answers one in well under a microsecond.
 
+#include <limits>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -23,8 +24,10 @@ public:
     /// Distances t > 0 of every crossing of the ray origin + t·dir with the mesh, ascending.
     /// \pre dir is unit length.
     void crossings(const glm::vec3& origin, const glm::vec3& dir, std::vector<float>& out) const;
-    /// Nearest crossing (t > 0), or a negative number when the ray hits nothing.
-    float first_hit(const glm::vec3& origin, const glm::vec3& dir) const;
+    /// Nearest crossing with 0 < t < t_max, or a negative number when there is none. A short
+    /// t_max (a branch segment) only visits the boxes the segment touches.
+    float first_hit(const glm::vec3& origin, const glm::vec3& dir,
+                    float t_max = std::numeric_limits<float>::max()) const;
     /// True when `p` is inside the closed mesh (parity of the crossings of a fixed ray).
     bool inside(const glm::vec3& p) const;
 
@@ -46,7 +49,7 @@ private:
     };
     int build(int begin, int end, std::vector<glm::vec3>& centroids);
     template <typename Visit>
-    void traverse(const glm::vec3& origin, const glm::vec3& dir, Visit&& visit) const;
+    void traverse(const glm::vec3& origin, const glm::vec3& dir, float t_max, Visit&& visit) const;
 
     TriangleMesh mesh_;
     std::vector<Node> nodes_;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include <glm/geometric.hpp>
 
@@ -131,7 +132,8 @@ private:
 } // namespace
 
 Skeleton build_skeleton(const std::vector<std::vector<glm::vec3>>& trunk_strokes,
-                        const std::vector<TriangleMesh>& lobes, const SkeletonOptions& options)
+                        const std::vector<TriangleMesh>& lobes, const SkeletonOptions& options,
+                        const std::vector<MeshRaycaster>* rays)
 {
     Skeleton s;
     double spacing = std::max(options.spacing_m, 1e-3);
@@ -231,7 +233,9 @@ Skeleton build_skeleton(const std::vector<std::vector<glm::vec3>>& trunk_strokes
     // Every lobe must be reached: a lobe that no skeleton node enters gets a limb to its centre.
     for (std::size_t l = 0; l < lobes.size(); ++l) {
         if (lobes[l].positions.empty()) continue;
-        const MeshRaycaster ray(lobes[l]);
+        std::optional<MeshRaycaster> own;
+        if (!rays || rays->size() != lobes.size()) own.emplace(lobes[l]);
+        const MeshRaycaster& ray = own ? *own : (*rays)[l];
         bool reached = false;
         for (const TreeNode& n : s.graph.nodes)
             if (ray.inside(n.position)) {

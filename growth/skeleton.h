@@ -18,6 +18,8 @@
 
 namespace lobe {
 
+class MeshRaycaster;
+
 struct SkeletonOptions {
     double spacing_m = 0.02; ///< distance between skeleton nodes along a stroke
     /// The default trunk's base lies this fraction of the lobes' total height below the
@@ -40,7 +42,9 @@ struct Skeleton {
 ///        finite points, shorter than the spacing) are left out with a message.
 /// \param lobes the lobes the tree grows in (closed meshes), for the default trunk and limbs.
 /// Returns an empty graph only when there are neither usable strokes nor lobes.
+/// \param rays (optional) ray casters of `lobes`, same order, when the caller has them.
 Skeleton build_skeleton(const std::vector<std::vector<glm::vec3>>& trunk_strokes,
-                        const std::vector<TriangleMesh>& lobes, const SkeletonOptions& options = {});
+                        const std::vector<TriangleMesh>& lobes, const SkeletonOptions& options = {},
+                        const std::vector<MeshRaycaster>* rays = nullptr);
 
 } // namespace lobe
