@@ -1,5 +1,8 @@
 #include "app/cli_common.h"
 
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 
@@ -68,6 +71,13 @@ Settings load_settings_file(const std::string& path)
     } catch (const InvalidInput& e) {
         throw FileError(path, e.what());
     }
+}
+
+std::string lower_extension(const std::string& path)
+{
+    std::string ext = std::filesystem::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return ext;
 }
 
 } // namespace lobe::cli

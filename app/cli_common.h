@@ -24,6 +24,9 @@ void print_report(const std::string& path, const ReadReport& report);
 /// Reads a recording and prints what had to be dropped. \throw FileError
 Recording load_recording_verbose(const std::string& path);
 
+/// The file name's extension, lower case, with its dot (".obj"); empty when it has none.
+std::string lower_extension(const std::string& path);
+
 /// Loads a settings JSON file (the "settings" object of a session document).
 /// \throw FileError naming the file and the bad key.
 Settings load_settings_file(const std::string& path);

@@ -23,13 +23,6 @@ namespace lobe::cli {
 
 namespace {
 
-std::string lower_extension(const std::string& path)
-{
-    std::string ext = std::filesystem::path(path).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    return ext;
-}
-
 bool is_mesh_file(const std::string& path)
 {
     const std::string ext = lower_extension(path);

@@ -25,10 +25,11 @@ void put(std::string& out, std::size_t v)
     out.append(buf, r.ptr);
 }
 
-void put_vertices(std::string& out, const std::vector<glm::vec3>& positions)
+// One "v x y z" (or "vn …") line per vector.
+void put_vec3_lines(std::string& out, const char* key, const std::vector<glm::vec3>& vectors)
 {
-    for (const glm::vec3& p : positions) {
-        out += "v ";
+    for (const glm::vec3& p : vectors) {
+        out += key;
         put(out, p.x);
         out += ' ';
         put(out, p.y);
@@ -91,7 +92,7 @@ std::string build_obj(const PreparedExport& e, const std::string& mtl_name)
     for (const ExportPart& part : e.parts) {
         const SurfaceGeometry& g = part.geometry;
         o += "\no " + part.name + "\n";
-        put_vertices(o, g.positions);
+        put_vec3_lines(o, "v ", g.positions);
         for (const glm::vec2& uv : g.uvs) {
             o += "vt ";
             put(o, uv.x);
@@ -99,15 +100,7 @@ std::string build_obj(const PreparedExport& e, const std::string& mtl_name)
             put(o, 1.0f - uv.y); // glTF/image rows run top-down, OBJ's v bottom-up
             o += '\n';
         }
-        for (const glm::vec3& n : g.normals) {
-            o += "vn ";
-            put(o, n.x);
-            o += ' ';
-            put(o, n.y);
-            o += ' ';
-            put(o, n.z);
-            o += '\n';
-        }
+        put_vec3_lines(o, "vn ", g.normals);
         o += part.kind == ExportPart::Kind::Leaves ? "usemtl leaf\n" : "usemtl bark\n";
         for (const auto& t : g.triangles) {
             o += 'f';
@@ -126,7 +119,7 @@ std::string build_obj(const PreparedExport& e, const std::string& mtl_name)
     }
     for (const ExportLobe& lobe : e.lobes) {
         o += "\no " + lobe.name + "\n";
-        put_vertices(o, lobe.positions);
+        put_vec3_lines(o, "v ", lobe.positions);
         o += "usemtl lobe\n";
         for (const auto& t : lobe.triangles) {
             o += 'f';
@@ -140,7 +133,7 @@ std::string build_obj(const PreparedExport& e, const std::string& mtl_name)
     }
     for (const ExportPolyline& line : e.strokes) {
         o += "\no " + line.name + "\n";
-        put_vertices(o, line.points);
+        put_vec3_lines(o, "v ", line.points);
         o += "usemtl stroke\nl";
         for (std::size_t i = 0; i < line.points.size(); ++i) {
             o += ' ';

@@ -17,15 +17,12 @@
 #include <tiny_gltf.h>
 #pragma GCC diagnostic pop
 
-#include "app/edit_hooks.h"
 #include "app/tree_output.h"
 #include "app/tree_pipeline.h"
 #include "app/regrow_worker.h"
 #include "growth/mesh_raycast.h"
-#include "input/pipeline.h"
-#include "input/recording.h"
-#include "input/session_builder.h"
 #include "tests/gltf_check.h"
+#include "tests/replay_fixture.h"
 #include "tests/test_paths.h"
 
 namespace lobe {
@@ -176,19 +173,10 @@ TEST(TreeCli, BadGrowOptionsGiveOneLineAndExitCodes)
     EXPECT_FALSE(fs::exists(out + "/x.fbx"));
 }
 
-Document replay_document(const std::string& name)
-{
-    const Recording recording = read_recording(rec(name));
-    const InputResult r = run_input_pipeline(recording);
-    SessionBuilder b(Document{}, EditPickOptions{}, meshing_edit_hooks());
-    b.apply(r.actions);
-    return b.take_document();
-}
-
 TEST(TreeGeometryOfRecordings, LodsStayWithinTheirTriangleBudgetsOnEveryTable1Tree)
 {
     for (const char* name : {"table1-1lobe-5strokes", "table1-4lobes-22strokes", "table1-3lobes-16strokes"}) {
-        const Document doc = replay_document(name);
+        const Document doc = test::replay_document(name);
         const BuiltTree tree = build_document_tree(doc);
         const TreeGeometry g = document_tree_geometry(doc, tree);
         ASSERT_EQ(g.lods.size(), 3u);
@@ -234,7 +222,7 @@ INSTANTIATE_TEST_SUITE_P(Fig14, TreeInModel, ::testing::Values("stanford-bunny",
 
 TEST(RegrowWorker, LatestSubmissionWinsAndMatchesAGrowthOnTheCallingThread)
 {
-    const Document doc = replay_document("table1-1lobe-5strokes");
+    const Document doc = test::replay_document("table1-1lobe-5strokes");
     RegrowWorker worker;
     EXPECT_FALSE(worker.take().has_value());
     Document a = doc, b = doc, c = doc;

@@ -2,44 +2,21 @@
 // frames: one connected tree rooted at the trunk base, attractors reached, branches inside
 // the lobes, radii from the pipe model, determinism, and lobes independent of each other.
 #include <cmath>
-#include <map>
 
 #include <gtest/gtest.h>
 #include <glm/geometric.hpp>
 
-#include "app/edit_hooks.h"
 #include "app/tree_pipeline.h"
 #include "growth/mesh_raycast.h"
-#include "input/pipeline.h"
-#include "input/recording.h"
-#include "input/session_builder.h"
-#include "tests/test_paths.h"
+#include "tests/replay_fixture.h"
 
 namespace lobe {
 namespace {
 
 const char* const kTable1[] = {"table1-1lobe-5strokes", "table1-4lobes-22strokes", "table1-3lobes-16strokes"};
 
-struct Scene {
-    Document doc;
-    std::vector<BuiltLobe> lobes;
-};
-
-// Replaying and meshing take a while: each recording once per test binary.
-const Scene& scene(const std::string& name)
-{
-    static std::map<std::string, Scene> cache;
-    auto it = cache.find(name);
-    if (it != cache.end()) return it->second;
-    const Recording rec = read_recording(test::source_path("recordings/" + name + ".lrec"));
-    const InputResult r = run_input_pipeline(rec);
-    SessionBuilder b(Document{}, EditPickOptions{}, meshing_edit_hooks());
-    b.apply(r.actions);
-    Scene s;
-    s.doc = b.take_document();
-    s.lobes = build_document_lobes(s.doc);
-    return cache.emplace(name, std::move(s)).first->second;
-}
+using Scene = test::ReplayedScene;
+const Scene& scene(const std::string& name) { return test::replayed_scene(name); }
 
 double outside_fraction(const BuiltTree& t)
 {

@@ -5,44 +5,22 @@
 #include <benchmark/benchmark.h>
 
 #include <cmath>
-#include <map>
 #include <string>
 
 #include <glm/geometric.hpp>
 #include <nanoflann.hpp>
 
-#include "app/edit_hooks.h"
 #include "app/tree_output.h"
 #include "app/tree_pipeline.h"
 #include "growth/branch_geometry.h"
-#include "input/pipeline.h"
-#include "input/recording.h"
-#include "input/session_builder.h"
-#include "tests/test_paths.h"
+#include "tests/replay_fixture.h"
 
 using namespace lobe;
 
 namespace {
 
-struct Scene {
-    Document doc;
-    std::vector<BuiltLobe> lobes;
-};
-
-const Scene& scene(const std::string& name)
-{
-    static std::map<std::string, Scene> cache;
-    auto it = cache.find(name);
-    if (it != cache.end()) return it->second;
-    const Recording rec = read_recording(test::source_path("recordings/" + name + ".lrec"));
-    const InputResult r = run_input_pipeline(rec);
-    SessionBuilder b(Document{}, EditPickOptions{}, meshing_edit_hooks());
-    b.apply(r.actions);
-    Scene s;
-    s.doc = b.take_document();
-    s.lobes = build_document_lobes(s.doc);
-    return cache.emplace(name, std::move(s)).first->second;
-}
+using Scene = test::ReplayedScene;
+const Scene& scene(const std::string& name) { return test::replayed_scene(name); }
 
 const char* const kScenes[] = {"table1-1lobe-5strokes", "table1-4lobes-22strokes", "table1-3lobes-16strokes"};
 
