@@ -8,7 +8,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/edit_hooks.h"
 #include "core/atomic_file.h"
+#include "input/pipeline.h"
+#include "input/session_builder.h"
 #include "core/document.h"
 #include "core/errors.h"
 
@@ -78,6 +81,22 @@ std::string lower_extension(const std::string& path)
     std::string ext = std::filesystem::path(path).extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
     return ext;
+}
+
+Document replay_into_document(const std::string& path, Document doc, std::size_t* drags)
+{
+    const Recording rec = load_recording_verbose(path);
+    const double duration = rec.frames.empty() ? 0.0 : rec.frames.back().time - rec.frames.front().time;
+    progress("replaying " + std::to_string(rec.frames.size()) + " frames (" + std::to_string(duration).substr(0, 6) +
+             " s) of " + path);
+    const InputResult result = run_input_pipeline(rec, doc.settings.input);
+    for (const std::string& m : result.messages) warn(path + ": " + m);
+    if (drags) *drags = result.drags.size();
+    doc.source_recording = std::filesystem::absolute(path).lexically_normal().string();
+    SessionBuilder builder(std::move(doc), EditPickOptions{}, meshing_edit_hooks());
+    builder.apply(result.actions);
+    for (const std::string& m : builder.messages()) warn(path + ": " + m);
+    return builder.take_document();
 }
 
 } // namespace lobe::cli

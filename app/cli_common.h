@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "core/document.h"
 #include "core/settings.h"
 #include "input/recording.h"
 
@@ -23,6 +24,12 @@ void print_report(const std::string& path, const ReadReport& report);
 
 /// Reads a recording and prints what had to be dropped. \throw FileError
 Recording load_recording_verbose(const std::string& path);
+
+/// Replays the recording at `path` into `doc` (its settings and seed are used): the input
+/// pipeline, then the session builder with the meshing edit hooks, as `replay` does. Warnings
+/// of both go to stderr naming the file; `drags` (when given) receives the number of drags.
+/// \throw FileError for an unreadable recording.
+Document replay_into_document(const std::string& path, Document doc, std::size_t* drags = nullptr);
 
 /// The file name's extension, lower case, with its dot (".obj"); empty when it has none.
 std::string lower_extension(const std::string& path);

@@ -11,13 +11,10 @@
 
 #include "app/cli.h"
 #include "app/cli_common.h"
-#include "app/edit_hooks.h"
 #include "app/tree_output.h"
 #include "app/tree_pipeline.h"
 #include "core/errors.h"
 #include "growth/species.h"
-#include "input/pipeline.h"
-#include "input/session_builder.h"
 
 namespace lobe::cli {
 
@@ -127,16 +124,7 @@ void add_grow_command(CLI::App& app, int& exit_code)
             doc.lobes.push_back({1, {}, "", std::nullopt, {}});
             tree = grow_document_tree(doc, {lobe});
         } else {
-            if (ext != ".json") {
-                const Recording rec = load_recording_verbose(a->input);
-                const InputResult result = run_input_pipeline(rec, doc.settings.input);
-                for (const std::string& m : result.messages) warn(a->input + ": " + m);
-                doc.source_recording = std::filesystem::absolute(a->input).lexically_normal().string();
-                SessionBuilder builder(std::move(doc), EditPickOptions{}, meshing_edit_hooks());
-                builder.apply(result.actions);
-                for (const std::string& m : builder.messages()) warn(a->input + ": " + m);
-                doc = builder.take_document();
-            }
+            if (ext != ".json") doc = replay_into_document(a->input, std::move(doc));
             tree = build_document_tree(doc);
         }
         report_and_write(*a, doc, tree, a->input, exit_code);

@@ -10,8 +10,6 @@
 #include "app/cli_common.h"
 #include "app/outputs.h"
 #include "core/errors.h"
-#include "input/pipeline.h"
-#include "input/session_builder.h"
 #include "meshing/mesh_io.h"
 #include "meshing/mesh_quality.h"
 #include "meshing/model_import.h"
@@ -65,13 +63,7 @@ void add_lobes_command(CLI::App& app, int& exit_code)
             if (!a->settings.empty()) doc.settings = load_settings_file(a->settings);
         } else {
             if (!a->settings.empty()) doc.settings = load_settings_file(a->settings);
-            const Recording rec = load_recording_verbose(a->input);
-            const InputResult result = run_input_pipeline(rec, doc.settings.input);
-            for (const std::string& m : result.messages) warn(a->input + ": " + m);
-            doc.source_recording = std::filesystem::absolute(a->input).lexically_normal().string();
-            SessionBuilder builder(std::move(doc));
-            builder.apply(result.actions);
-            doc = builder.take_document();
+            doc = replay_into_document(a->input, std::move(doc));
         }
         std::vector<std::string> warnings;
         const std::size_t written = write_document_lobes(doc, a->out, warnings);

@@ -7,12 +7,9 @@
 
 #include "app/cli.h"
 #include "app/cli_common.h"
-#include "app/edit_hooks.h"
 #include "app/outputs.h"
 #include "app/tree_output.h"
 #include "core/errors.h"
-#include "input/pipeline.h"
-#include "input/session_builder.h"
 
 namespace lobe::cli {
 
@@ -30,23 +27,11 @@ void add_replay_command(CLI::App& app, int& exit_code)
     cmd->add_option("--settings", a->settings, "Settings JSON (a settings object or a session document)");
     cmd->add_option("--seed", a->seed, "Seed of every random choice downstream")->capture_default_str();
     cmd->callback([a, &exit_code] {
-        Settings settings;
-        if (!a->settings.empty()) settings = load_settings_file(a->settings);
-        Recording rec = load_recording_verbose(a->rec);
-        const double duration = rec.frames.empty() ? 0.0 : rec.frames.back().time - rec.frames.front().time;
-        progress("replaying " + std::to_string(rec.frames.size()) + " frames (" + std::to_string(duration).substr(0, 6) +
-                 " s) of " + a->rec);
-        InputResult result = run_input_pipeline(rec, settings.input);
-        for (const std::string& m : result.messages) warn(a->rec + ": " + m);
-
         Document doc;
         doc.seed = a->seed;
-        doc.settings = settings;
-        doc.source_recording = std::filesystem::absolute(a->rec).lexically_normal().string();
-        SessionBuilder builder(std::move(doc), EditPickOptions{}, meshing_edit_hooks());
-        builder.apply(result.actions);
-        for (const std::string& m : builder.messages()) warn(a->rec + ": " + m);
-        Document out_doc = builder.take_document();
+        if (!a->settings.empty()) doc.settings = load_settings_file(a->settings);
+        std::size_t drags = 0;
+        Document out_doc = replay_into_document(a->rec, std::move(doc), &drags);
 
         std::error_code ec;
         std::filesystem::create_directories(a->out, ec);
@@ -79,10 +64,10 @@ void add_replay_command(CLI::App& app, int& exit_code)
         progress("derived " + std::to_string(out_doc.strokes.size()) + " strokes (" + std::to_string(lobe_strokes) +
                  " lobe, " + std::to_string(trunk_strokes) + " trunk) in " + std::to_string(out_doc.lobes.size()) +
                  " lobe group(s), " + std::to_string(out_doc.edits.size()) + " edit(s) from " +
-                 std::to_string(result.drags.size()) + " drag(s)");
+                 std::to_string(drags) + " drag(s)");
         progress("wrote " + a->out + "/strokes.json, " + a->out + "/session.json, " + std::to_string(lobe_files) +
                  " lobe mesh(es) in " + a->out + "/lobes" + (tree_written ? " and " + a->out + "/tree.glb" : ""));
-        if (out_doc.strokes.empty() && result.drags.empty()) {
+        if (out_doc.strokes.empty() && drags == 0) {
             error(a->rec + ": no strokes in this recording");
             exit_code = kExitFailure;
             return;
