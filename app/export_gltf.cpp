@@ -151,13 +151,42 @@ std::vector<double> rgba(const std::array<float, 3>& rgb, double alpha)
     return {double(rgb[0]), double(rgb[1]), double(rgb[2]), alpha};
 }
 
-tinygltf::Material bark_material(const PreparedExport& e)
+/// Embeds `image` as a PNG in the binary chunk with its own sampler; returns the texture index.
+int embed_texture(GlbBuilder& b, const RgbaImage& image, const std::string& name, int wrap)
+{
+    const std::vector<std::uint8_t> png = encode_png(image);
+    tinygltf::Model& model = b.model();
+    tinygltf::Image img;
+    img.name = name;
+    img.mimeType = "image/png";
+    img.bufferView = b.add_view(png.data(), png.size(), 0);
+    model.images.push_back(std::move(img));
+    tinygltf::Sampler sampler;
+    sampler.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
+    sampler.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
+    sampler.wrapS = wrap;
+    sampler.wrapT = wrap;
+    model.samplers.push_back(sampler);
+    tinygltf::Texture texture;
+    texture.source = static_cast<int>(model.images.size() - 1);
+    texture.sampler = static_cast<int>(model.samplers.size() - 1);
+    model.textures.push_back(texture);
+    return static_cast<int>(model.textures.size() - 1);
+}
+
+/// The bark material; embeds the tiling bark texture (PNG, REPEAT) when the tree has one.
+tinygltf::Material bark_material(const PreparedExport& e, GlbBuilder& b)
 {
     tinygltf::Material m;
     m.name = "bark";
     m.pbrMetallicRoughness.baseColorFactor = rgba(e.bark_color, 1.0);
     m.pbrMetallicRoughness.metallicFactor = 0.0;
     m.pbrMetallicRoughness.roughnessFactor = 0.9;
+    if (e.bark_texture != nullptr) {
+        m.pbrMetallicRoughness.baseColorTexture.index =
+            embed_texture(b, *e.bark_texture, e.name + "_bark", TINYGLTF_TEXTURE_WRAP_REPEAT);
+        m.pbrMetallicRoughness.baseColorTexture.texCoord = 0;
+    }
     return m;
 }
 
@@ -173,22 +202,9 @@ tinygltf::Material leaf_material(const PreparedExport& e, GlbBuilder& b)
     m.alphaCutoff = 0.5;
     m.doubleSided = true;
     if (e.leaf_texture != nullptr) {
-        const std::vector<std::uint8_t> png = encode_png(*e.leaf_texture);
-        tinygltf::Model& model = b.model();
-        tinygltf::Image image;
-        image.name = e.name + "_leaf";
-        image.mimeType = "image/png";
-        image.bufferView = b.add_view(png.data(), png.size(), 0);
-        model.images.push_back(std::move(image));
-        tinygltf::Sampler sampler;
-        sampler.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
-        sampler.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
-        model.samplers.push_back(sampler);
-        tinygltf::Texture texture;
-        texture.source = static_cast<int>(model.images.size() - 1);
-        texture.sampler = static_cast<int>(model.samplers.size() - 1);
-        model.textures.push_back(texture);
-        m.pbrMetallicRoughness.baseColorTexture.index = static_cast<int>(model.textures.size() - 1);
+        // Clamped: the leaf is one picture, and its transparent border must not wrap round.
+        m.pbrMetallicRoughness.baseColorTexture.index =
+            embed_texture(b, *e.leaf_texture, e.name + "_leaf", TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE);
         m.pbrMetallicRoughness.baseColorTexture.texCoord = 0;
     }
     return m;
@@ -232,7 +248,7 @@ tinygltf::Model build_model(const PreparedExport& e)
     for (const ExportPart& part : e.parts) {
         const bool is_leaves = part.kind == ExportPart::Kind::Leaves;
         int& material = is_leaves ? leaf : bark;
-        if (material < 0) material = b.add_material(is_leaves ? leaf_material(e, b) : bark_material(e));
+        if (material < 0) material = b.add_material(is_leaves ? leaf_material(e, b) : bark_material(e, b));
         const SurfaceGeometry& g = part.geometry;
         tinygltf::Primitive prim;
         prim.mode = TINYGLTF_MODE_TRIANGLES;

@@ -49,17 +49,16 @@ void put_rgb(std::string& out, const char* key, const std::array<float, 3>& c)
     out += '\n';
 }
 
-std::string build_mtl(const PreparedExport& e, const std::string& png_name)
+std::string build_mtl(const PreparedExport& e, const std::string& png_name, const std::string& bark_png_name)
 {
     std::string m = "# Lobesketch: materials of " + e.name + "\n";
-    bool any_branches = false;
-    for (const ExportPart& p : e.parts) any_branches = any_branches || p.kind == ExportPart::Kind::Branches;
-    if (any_branches) {
+    if (e.has_branches()) {
         m += "\nnewmtl bark\n";
         put_rgb(m, "Ka", {0.0f, 0.0f, 0.0f});
         put_rgb(m, "Kd", e.bark_color);
         put_rgb(m, "Ks", {0.0f, 0.0f, 0.0f});
         m += "d 1\nillum 1\n";
+        if (e.bark_texture != nullptr) m += "map_Kd " + bark_png_name + "\n";
     }
     if (e.has_leaves()) {
         m += "\nnewmtl leaf\n";
@@ -153,13 +152,14 @@ std::string_view bytes_view(const std::vector<std::uint8_t>& b)
 } // namespace
 
 ObjFiles encode_obj(const ExportScene& scene, const ExportOptions& options, const std::string& mtl_name,
-                    const std::string& png_name)
+                    const std::string& png_name, const std::string& bark_png_name)
 {
     const PreparedExport e = prepare_export(scene, options);
     ObjFiles files;
     files.obj = build_obj(e, mtl_name);
-    files.mtl = build_mtl(e, png_name);
+    files.mtl = build_mtl(e, png_name, bark_png_name);
     if (e.has_leaves() && e.leaf_texture != nullptr) files.leaf_png = encode_png(*e.leaf_texture);
+    if (e.has_branches() && e.bark_texture != nullptr) files.bark_png = encode_png(*e.bark_texture);
     return files;
 }
 
@@ -168,9 +168,11 @@ void write_obj(const std::string& path, const ExportScene& scene, const ExportOp
     const std::filesystem::path obj_path(path);
     const std::filesystem::path mtl_path = std::filesystem::path(obj_path).replace_extension(".mtl");
     const std::filesystem::path png_path = obj_path.parent_path() / (obj_path.stem().string() + "_leaf.png");
-    const ObjFiles files =
-        encode_obj(scene, options, mtl_path.filename().string(), png_path.filename().string());
+    const std::filesystem::path bark_path = obj_path.parent_path() / (obj_path.stem().string() + "_bark.png");
+    const ObjFiles files = encode_obj(scene, options, mtl_path.filename().string(), png_path.filename().string(),
+                                      bark_path.filename().string());
     if (!files.leaf_png.empty()) write_file_atomic(png_path.string(), bytes_view(files.leaf_png));
+    if (!files.bark_png.empty()) write_file_atomic(bark_path.string(), bytes_view(files.bark_png));
     write_file_atomic(mtl_path.string(), files.mtl);
     write_file_atomic(path, files.obj);
 }

@@ -21,13 +21,14 @@ struct ObjFiles {
     std::string obj;
     std::string mtl;
     std::vector<std::uint8_t> leaf_png; ///< empty when the tree has no leaf texture
+    std::vector<std::uint8_t> bark_png; ///< empty when the tree has no bark texture (or no branches are written)
 };
 
-/// Builds the OBJ/MTL/PNG contents; `mtl_name` and `png_name` are the file names the OBJ and
-/// MTL refer to (`mtllib`, `map_Kd`).
+/// Builds the OBJ/MTL/PNG contents; `mtl_name`, `png_name` and `bark_png_name` are the file
+/// names the OBJ and MTL refer to (`mtllib`, `map_Kd`).
 /// \throw InvalidInput as prepare_export.
 ObjFiles encode_obj(const ExportScene& scene, const ExportOptions& options, const std::string& mtl_name,
-                    const std::string& png_name);
+                    const std::string& png_name, const std::string& bark_png_name = "bark.png");
 
 /// Writes `path` (X.obj), X.mtl and X_leaf.png beside it, each atomically; the PNG and MTL
 /// are written first so the OBJ never refers to a missing file. X_leaf.png is written only

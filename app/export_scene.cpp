@@ -101,6 +101,11 @@ bool PreparedExport::has_leaves() const
     return std::any_of(parts.begin(), parts.end(), [](const ExportPart& p) { return p.kind == ExportPart::Kind::Leaves; });
 }
 
+bool PreparedExport::has_branches() const
+{
+    return std::any_of(parts.begin(), parts.end(), [](const ExportPart& p) { return p.kind == ExportPart::Kind::Branches; });
+}
+
 PreparedExport prepare_export(const ExportScene& scene, const ExportOptions& options)
 {
     if (scene.tree == nullptr) fail("no tree given");
@@ -117,10 +122,12 @@ PreparedExport prepare_export(const ExportScene& scene, const ExportOptions& opt
         check_surface(tree.lods[i].leaves, "LOD " + std::to_string(i) + " leaves");
     }
     const RgbaImage& tex = tree.leaf_texture;
-    if (tex.width < 0 || tex.height < 0 ||
-        tex.pixels.size() != std::size_t(tex.width) * std::size_t(tex.height) * 4u)
-        fail("leaf texture of " + std::to_string(tex.width) + "x" + std::to_string(tex.height) + " has " +
-             std::to_string(tex.pixels.size()) + " bytes");
+    const RgbaImage& bark = tree.bark_texture;
+    for (const auto& [image, what] : {std::pair{&tex, "leaf"}, std::pair{&bark, "bark"}})
+        if (image->width < 0 || image->height < 0 ||
+            image->pixels.size() != std::size_t(image->width) * std::size_t(image->height) * 4u)
+            fail(std::string(what) + " texture of " + std::to_string(image->width) + "x" +
+                 std::to_string(image->height) + " has " + std::to_string(image->pixels.size()) + " bytes");
 
     float scale = 1.0f;
     if (options.target_height_m > 0.0) {
@@ -136,6 +143,7 @@ PreparedExport prepare_export(const ExportScene& scene, const ExportOptions& opt
     out.leaf_color = tree.leaf_color;
     out.species = tree.species;
     out.leaf_texture = (tex.width > 0 && tex.height > 0) ? &tex : nullptr;
+    out.bark_texture = (bark.width > 0 && bark.height > 0) ? &bark : nullptr;
     for (int lod : lods) {
         const TreeLod& l = tree.lods[std::size_t(lod)];
         if (!l.branches.empty())

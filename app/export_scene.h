@@ -67,11 +67,13 @@ struct PreparedExport {
     std::vector<ExportLobe> lobes;      ///< empty unless include_lobes
     std::vector<ExportPolyline> strokes; ///< empty unless include_strokes
     const RgbaImage* leaf_texture = nullptr; ///< null when the tree has no texture (width or height 0)
+    const RgbaImage* bark_texture = nullptr; ///< null when the tree has no bark texture
     std::array<float, 3> bark_color{};
     std::array<float, 3> leaf_color{};
     std::string species;
     float scale = 1.0f; ///< the uniform scale applied after subtracting the base
     bool has_leaves() const;
+    bool has_branches() const;
 };
 
 /// Checks `scene` and `options` and transforms the geometry: x' = (x − base) · scale.

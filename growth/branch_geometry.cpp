@@ -10,6 +10,7 @@
 #include <glm/geometric.hpp>
 
 #include "core/errors.h"
+#include "growth/bark_texture.h"
 #include "growth/leaves.h"
 
 namespace lobe {
@@ -716,6 +717,7 @@ void build_tree_geometry_into(TreeGeometry& geo, const TreeGraph& graph, const B
     if (branches.lod_count < 1 || branches.lod_count > 6) throw InvalidInput("tree geometry: lod_count must be in [1, 6]");
     check_mesh_options(branch_lod_options(branches, 0));
     RgbaImage texture = make_leaf_texture(leaves.shape);
+    static const RgbaImage bark = make_bark_texture(); // the same for every tree
     const TreeGraph clean = merge_coincident_nodes(graph);
     const std::vector<BranchChain> chains = decompose_branch_chains(clean);
     const std::vector<BranchCurve> curves = smooth_branch_curves(clean, chains, std::max(0, branches.smoothing_iterations));
@@ -729,6 +731,7 @@ void build_tree_geometry_into(TreeGeometry& geo, const TreeGraph& graph, const B
         geo.leaf_color[static_cast<std::size_t>(i)] = static_cast<float>(leaves.color[i]);
     }
     geo.leaf_texture = std::move(texture);
+    geo.bark_texture = bark;
     geo.lods.resize(static_cast<std::size_t>(branches.lod_count));
 
     std::vector<RingSample> samples;

@@ -35,13 +35,14 @@ struct RgbaImage {
 
 /// One level of detail.
 struct TreeLod {
-    SurfaceGeometry branches; ///< bark: u around the branch, v along it (metres / circumference)
+    SurfaceGeometry branches; ///< bark: u around the branch (mirrored 0 → 1 → 0), v along it in half circumferences
     SurfaceGeometry leaves;   ///< quads (two triangles each), uv over the leaf texture; render two-sided
 };
 
 struct TreeGeometry {
     std::vector<TreeLod> lods; ///< LOD0 (finest) first
     RgbaImage leaf_texture;    ///< alpha-tested (alpha 0 outside the leaf)
+    RgbaImage bark_texture;    ///< tiles (REPEAT) over the bark UVs; multiplied by bark_color; may be empty
     std::array<float, 3> bark_color{0.36f, 0.25f, 0.17f}; ///< linear RGB
     std::array<float, 3> leaf_color{0.20f, 0.42f, 0.12f}; ///< linear RGB (multiplies the texture)
     std::string species;       ///< preset name, for material names

@@ -24,6 +24,7 @@
 #include "app/export_gltf.h"
 #include "app/export_obj.h"
 #include "core/errors.h"
+#include "growth/bark_texture.h"
 #include "tests/gltf_check.h"
 #include "tests/test_paths.h"
 
@@ -371,6 +372,34 @@ TEST(ExportGltf, BarkMaterialIsOpaqueRoughDielectricWithBarkColorAndBarkUvs)
               (std::vector<double>{tree.bark_color[0], tree.bark_color[1], tree.bark_color[2], 1.0}));
     EXPECT_EQ(read_vec2(m, p.attributes.at("TEXCOORD_0")), tree.lods[1].branches.uvs);
     EXPECT_EQ(m.materials.size(), 2u) << "bark and leaf only, shared by all LODs";
+}
+
+TEST(ExportGltf, BarkTextureIsEmbeddedRepeatingAndTheLeafTextureClamped)
+{
+    TreeGeometry tree = test_tree();
+    tree.bark_texture = make_bark_texture(16);
+    const tinygltf::Model m = load_glb(encode_glb(scene_of(tree)));
+    const tinygltf::Material& bark = m.materials.at(std::size_t(primitive_of(m, "tree_branches_LOD0").material));
+    const tinygltf::Material& leaf = m.materials.at(std::size_t(primitive_of(m, "tree_leaves_LOD0").material));
+    ASSERT_GE(bark.pbrMetallicRoughness.baseColorTexture.index, 0);
+    ASSERT_GE(leaf.pbrMetallicRoughness.baseColorTexture.index, 0);
+    const tinygltf::Texture& bt = m.textures.at(std::size_t(bark.pbrMetallicRoughness.baseColorTexture.index));
+    const tinygltf::Texture& lt = m.textures.at(std::size_t(leaf.pbrMetallicRoughness.baseColorTexture.index));
+    EXPECT_EQ(m.samplers.at(std::size_t(bt.sampler)).wrapS, TINYGLTF_TEXTURE_WRAP_REPEAT);
+    EXPECT_EQ(m.samplers.at(std::size_t(bt.sampler)).wrapT, TINYGLTF_TEXTURE_WRAP_REPEAT);
+    EXPECT_EQ(m.samplers.at(std::size_t(lt.sampler)).wrapS, TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE);
+    const tinygltf::Image& image = m.images.at(std::size_t(bt.source));
+    EXPECT_EQ(image.width, 16);
+    EXPECT_EQ(image.height, 16);
+    EXPECT_EQ(image.image, tree.bark_texture.pixels);
+    // With a bark texture the bark UVs are used: the validator has nothing to say about them.
+    const std::string file = test::temp_dir("export-bark") + "/tree.glb";
+    write_glb(file, scene_of(tree));
+    nlohmann::json report;
+    ASSERT_TRUE(test::validate_gltf(file, report));
+    EXPECT_EQ(report["issues"]["numErrors"], 0) << test::describe_gltf_issues(report);
+    EXPECT_EQ(report["issues"]["numWarnings"], 0) << test::describe_gltf_issues(report);
+    EXPECT_EQ(report["issues"]["numInfos"], 0) << test::describe_gltf_issues(report);
 }
 
 TEST(ExportGltf, PositionBoundsMatchTheDataWhichIsTheInputMinusTheBase)

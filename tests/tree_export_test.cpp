@@ -96,6 +96,7 @@ TEST(TreeCli, ReplayWritesAValidatedGlbOfTheTreeWithThreeLodsAndItsOriginAtTheTr
     ASSERT_TRUE(test::validate_gltf(glb, report));
     EXPECT_EQ(report["issues"]["numErrors"], 0) << test::describe_gltf_issues(report);
     EXPECT_EQ(report["issues"]["numWarnings"], 0) << test::describe_gltf_issues(report);
+    EXPECT_EQ(report["issues"]["numInfos"], 0) << test::describe_gltf_issues(report); // bark UVs used by the bark texture
     const tinygltf::Model m = load_glb(glb);
     const auto names = node_names(m);
     for (int lod = 0; lod < 3; ++lod) {
@@ -146,6 +147,7 @@ TEST(TreeCli, GrowTakesSeedSplitAngleSpeciesLodAndHeightAndExportRewritesASessio
     EXPECT_TRUE(fs::exists(out + "/t.obj"));
     EXPECT_TRUE(fs::exists(out + "/t.mtl"));
     EXPECT_TRUE(fs::exists(out + "/t_leaf.png"));
+    EXPECT_TRUE(fs::exists(out + "/t_bark.png"));
 }
 
 TEST(TreeCli, BadGrowOptionsGiveOneLineAndExitCodes)
