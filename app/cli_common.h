@@ -2,8 +2,12 @@
 /// \file cli_common.h
 /// Shared helpers of the CLI subcommands: messages, settings files, recording input.
 
+#include <cstdint>
+#include <optional>
 #include <string>
 
+#include "app/tree_pipeline.h"
+#include "core/document.h"
 #include "core/settings.h"
 #include "input/recording.h"
 
@@ -28,6 +32,39 @@ Recording load_recording_verbose(const std::string& path);
 /// \throw FileError naming the file and the bad key.
 Settings load_settings_file(const std::string& path);
 
+/// The options that say how a tree is grown from an input (`grow`, `export`, `render`).
+struct TreeInputOptions {
+    std::string settings; ///< settings JSON file (empty: none)
+    std::string species;  ///< preset name or .json file (empty: the settings')
+    std::optional<std::uint64_t> seed;
+    std::optional<double> split_angle, spacing;
+    double mesh_size = 1.5; ///< a mesh input's largest side (metres)
+};
+
+/// Registers --settings, --species, --seed, --split-angle and --attractor-spacing.
+void add_tree_input_options(CLI::App* cmd, TreeInputOptions& o);
+
+/// Applies, in the order a person expects, the species and then the single options to `s`,
+/// and validates the result. \throw InvalidInput
+void apply_tree_input_options(Settings& s, const TreeInputOptions& o);
+
+/// Lower-case extension of `path` (".json").
+std::string lower_extension(const std::string& path);
+/// An .obj, .ply or .off file.
+bool is_mesh_file(const std::string& path);
+
+/// A document and its grown tree.
+struct GrownInput {
+    Document doc;
+    BuiltTree tree;
+};
+
+/// Grows the tree of `input`: a session document (.json), a mesh (.obj/.ply/.off, one lobe
+/// of `mesh_size`) or a recording (run through the input pipeline and the session builder,
+/// warnings printed naming the file), with the options applied.
+/// \throw FileError, InvalidInput
+GrownInput grow_input_tree(const std::string& input, const TreeInputOptions& o);
+
 // Subcommand registration; each sets `exit_code` when it runs.
 void add_info_command(CLI::App& app, int& exit_code);
 void add_replay_command(CLI::App& app, int& exit_code);
@@ -36,5 +73,6 @@ void add_synth_command(CLI::App& app, int& exit_code);
 void add_lobes_command(CLI::App& app, int& exit_code);
 void add_grow_command(CLI::App& app, int& exit_code);
 void add_export_command(CLI::App& app, int& exit_code);
+void add_render_command(CLI::App& app, int& exit_code);
 
 } // namespace lobe::cli

@@ -18,17 +18,6 @@
 
 namespace lobe::cli {
 
-namespace {
-
-std::string lower_extension(const std::string& path)
-{
-    std::string ext = std::filesystem::path(path).extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    return ext;
-}
-
-} // namespace
-
 void add_lobes_command(CLI::App& app, int& exit_code)
 {
     auto* cmd = app.add_subcommand(
