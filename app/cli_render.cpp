@@ -77,7 +77,9 @@ void add_render_command(CLI::App& app, int& exit_code)
                     parse_show_list(s);
                     return std::string();
                 } catch (const InvalidInput& e) {
-                    return std::string(e.what());
+                    std::string why = e.what();
+                    if (why.rfind("--show: ", 0) == 0) why.erase(0, 8); // CLI11 names the option itself
+                    return why;
                 }
             },
             "LIST"));
