@@ -308,7 +308,11 @@ RgbaImage material_texture(const tinygltf::Model& m, int material)
 
 RenderScene glb_render_scene(const std::string& path, const RenderContent& content)
 {
-    if (!std::filesystem::is_regular_file(path)) throw FileError(path, "no such file");
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) throw FileError(path, "no such file");
+    // The exporter refuses to write more than 4 GiB; a bigger file is not one of ours.
+    if (std::filesystem::file_size(path, ec) > (std::uintmax_t(4) << 30))
+        throw FileError(path, "larger than 4 GiB: not a tree exported by Lobesketch");
     tinygltf::TinyGLTF loader;
     tinygltf::Model m;
     std::string err, warning;

@@ -188,6 +188,26 @@ TEST(RenderPicture, TwoIdenticalRunsGiveByteIdenticalPictures)
     EXPECT_EQ(png_bytes(other.render(camera, kW, kH)), a);
 }
 
+TEST(RenderPicture, WithoutMultisamplingTheSameTreeCoversTheSameShareOfThePicture)
+{
+    const RenderScene scene = tree_scene();
+    const Camera camera = camera_for(scene, front_view());
+    RendererOptions options;
+    options.samples = 1;
+    Renderer single(options);
+    EXPECT_EQ(single.samples(), 1);
+    EXPECT_EQ(shared().renderer->samples(), 4);
+    single.set_scene(scene);
+    const RgbaImage aliased = single.render(camera, kW, kH);
+    RenderScene empty;
+    empty.ground_y = scene.ground_y;
+    empty.ground_area = scene_bounds(scene);
+    single.set_scene(empty);
+    const double share1 = coverage(aliased, single.render(camera, kW, kH));
+    const double share4 = coverage(draw(scene, camera), background_of(scene, camera));
+    EXPECT_NEAR(share1, share4, 0.03);
+}
+
 struct LodSilhouette {
     std::size_t both = 0, only_lod0 = 0, only_lod = 0;
     double iou() const { return double(both) / double(std::max<std::size_t>(1, both + only_lod0 + only_lod)); }
