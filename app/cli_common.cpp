@@ -6,14 +6,16 @@
 #include <fstream>
 #include <iostream>
 
+#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
 #include "app/edit_hooks.h"
 #include "core/atomic_file.h"
-#include "input/pipeline.h"
-#include "input/session_builder.h"
 #include "core/document.h"
 #include "core/errors.h"
+#include "growth/species.h"
+#include "input/pipeline.h"
+#include "input/session_builder.h"
 
 namespace lobe::cli {
 
@@ -76,6 +78,26 @@ Settings load_settings_file(const std::string& path)
     }
 }
 
+void add_tree_input_options(CLI::App* cmd, TreeInputOptions& o)
+{
+    cmd->add_option("--settings", o.settings, "Settings JSON (a settings object or a session document)");
+    cmd->add_option("--species", o.species,
+                    "Species preset: broadleaf, conifer, willow, birch, or a preset .json file");
+    cmd->add_option("--seed", o.seed, "Seed of every random choice of growth (default: the session's)");
+    cmd->add_option("--split-angle", o.split_angle, "Split angle t in degrees (smaller: denser branching)")
+        ->check(CLI::Range(5.0, 180.0));
+    cmd->add_option("--attractor-spacing", o.spacing, "Attractor spacing in metres: lobes are remeshed to it")
+        ->check(CLI::Range(0.005, 0.5));
+}
+
+void apply_tree_input_options(Settings& s, const TreeInputOptions& o)
+{
+    if (!o.species.empty()) apply_species(s, load_species(o.species));
+    if (o.split_angle) s.growth.split_angle_deg = *o.split_angle;
+    if (o.spacing) s.lobes.edge_length_m = *o.spacing;
+    validate_settings(s);
+}
+
 std::string lower_extension(const std::string& path)
 {
     std::string ext = std::filesystem::path(path).extension().string();
@@ -97,6 +119,35 @@ Document replay_into_document(const std::string& path, Document doc, std::size_t
     builder.apply(result.actions);
     for (const std::string& m : builder.messages()) warn(path + ": " + m);
     return builder.take_document();
+}
+
+bool is_mesh_file(const std::string& path)
+{
+    const std::string ext = lower_extension(path);
+    return ext == ".obj" || ext == ".ply" || ext == ".off";
+}
+
+GrownInput grow_input_tree(const std::string& input, const TreeInputOptions& o)
+{
+    GrownInput out;
+    Document& doc = out.doc;
+    if (!o.settings.empty()) doc.settings = load_settings_file(o.settings);
+    const std::string ext = lower_extension(input);
+    if (ext == ".json") {
+        doc = load_document(input);
+        if (!o.settings.empty()) doc.settings = load_settings_file(o.settings);
+    }
+    apply_tree_input_options(doc.settings, o);
+    if (o.seed) doc.seed = *o.seed;
+    if (is_mesh_file(input)) {
+        const BuiltLobe lobe = model_lobe(input, doc.settings, o.mesh_size);
+        doc.lobes.push_back({1, {}, "", std::nullopt, {}});
+        out.tree = grow_document_tree(doc, {lobe});
+        return out;
+    }
+    if (ext != ".json") doc = replay_into_document(input, std::move(doc));
+    out.tree = build_document_tree(doc);
+    return out;
 }
 
 } // namespace lobe::cli

@@ -1,11 +1,7 @@
 // `lobesketch grow INPUT --out tree.glb` and `lobesketch export SESSION --out FILE`: a tree
 // from a recording, a session or a mesh, written as glTF binary or OBJ.
-#include <algorithm>
-#include <cctype>
 #include <chrono>
-#include <filesystem>
 #include <memory>
-#include <optional>
 
 #include <CLI/CLI.hpp>
 
@@ -14,50 +10,26 @@
 #include "app/tree_output.h"
 #include "app/tree_pipeline.h"
 #include "core/errors.h"
-#include "growth/species.h"
 
 namespace lobe::cli {
 
 namespace {
 
-bool is_mesh_file(const std::string& path)
-{
-    const std::string ext = lower_extension(path);
-    return ext == ".obj" || ext == ".ply" || ext == ".off";
-}
-
 struct TreeArgs {
-    std::string input, out, settings, species, lod = "all";
-    std::optional<std::uint64_t> seed;
-    std::optional<double> split_angle, spacing;
-    double height = 0.0, size = 1.5;
+    TreeInputOptions in;
+    std::string input, out, lod = "all";
+    double height = 0.0;
     bool lobes = false, strokes = false;
 };
 
 void add_tree_options(CLI::App* cmd, TreeArgs& a)
 {
-    cmd->add_option("--settings", a.settings, "Settings JSON (a settings object or a session document)");
-    cmd->add_option("--species", a.species,
-                    "Species preset: broadleaf, conifer, willow, birch, or a preset .json file");
-    cmd->add_option("--seed", a.seed, "Seed of every random choice of growth (default: the session's)");
-    cmd->add_option("--split-angle", a.split_angle, "Split angle t in degrees (smaller: denser branching)")
-        ->check(CLI::Range(5.0, 180.0));
-    cmd->add_option("--attractor-spacing", a.spacing, "Attractor spacing in metres: lobes are remeshed to it")
-        ->check(CLI::Range(0.005, 0.5));
+    add_tree_input_options(cmd, a.in);
     cmd->add_option("--lod", a.lod, "LODs to write: all, or indices such as 0 or 0,2")->capture_default_str();
     cmd->add_option("--height", a.height, "Scale the exported tree to this height in metres (0 keeps the sketch's)")
         ->check(CLI::Range(0.0, 1000.0));
     cmd->add_flag("--lobes", a.lobes, "Also write the lobes as extra nodes");
     cmd->add_flag("--strokes", a.strokes, "Also write the strokes as extra nodes");
-}
-
-// Settings in the order a person expects: the file, then the species, then single options.
-void apply_tree_options(Settings& s, const TreeArgs& a)
-{
-    if (!a.species.empty()) apply_species(s, load_species(a.species));
-    if (a.split_angle) s.growth.split_angle_deg = *a.split_angle;
-    if (a.spacing) s.lobes.edge_length_m = *a.spacing;
-    validate_settings(s);
 }
 
 void report_and_write(const TreeArgs& a, const Document& doc, const BuiltTree& tree, const std::string& input,
@@ -105,29 +77,12 @@ void add_grow_command(CLI::App& app, int& exit_code)
     cmd->add_option("-o,--out", a->out, "Output file: tree.glb (glTF binary) or tree.obj (with .mtl and PNG)")
         ->required();
     add_tree_options(cmd, *a);
-    cmd->add_option("--size", a->size, "A mesh input is scaled so its bounding box's largest side is this (metres)")
+    cmd->add_option("--size", a->in.mesh_size, "A mesh input is scaled so its bounding box's largest side is this (metres)")
         ->capture_default_str()
         ->check(CLI::Range(0.01, 100.0));
     cmd->callback([a, &exit_code] {
-        Document doc;
-        if (!a->settings.empty()) doc.settings = load_settings_file(a->settings);
-        const std::string ext = lower_extension(a->input);
-        if (ext == ".json") {
-            doc = load_document(a->input);
-            if (!a->settings.empty()) doc.settings = load_settings_file(a->settings);
-        }
-        apply_tree_options(doc.settings, *a);
-        if (a->seed) doc.seed = *a->seed;
-        BuiltTree tree;
-        if (is_mesh_file(a->input)) {
-            const BuiltLobe lobe = model_lobe(a->input, doc.settings, a->size);
-            doc.lobes.push_back({1, {}, "", std::nullopt, {}});
-            tree = grow_document_tree(doc, {lobe});
-        } else {
-            if (ext != ".json") doc = replay_into_document(a->input, std::move(doc));
-            tree = build_document_tree(doc);
-        }
-        report_and_write(*a, doc, tree, a->input, exit_code);
+        const GrownInput grown = grow_input_tree(a->input, a->in);
+        report_and_write(*a, grown.doc, grown.tree, a->input, exit_code);
     });
 }
 
@@ -141,9 +96,9 @@ void add_export_command(CLI::App& app, int& exit_code)
     add_tree_options(cmd, *a);
     cmd->callback([a, &exit_code] {
         Document doc = load_document(a->input);
-        if (!a->settings.empty()) doc.settings = load_settings_file(a->settings);
-        apply_tree_options(doc.settings, *a);
-        if (a->seed) doc.seed = *a->seed;
+        if (!a->in.settings.empty()) doc.settings = load_settings_file(a->in.settings);
+        apply_tree_input_options(doc.settings, a->in);
+        if (a->in.seed) doc.seed = *a->in.seed;
         report_and_write(*a, doc, build_document_tree(doc), a->input, exit_code);
     });
 }

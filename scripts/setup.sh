@@ -13,6 +13,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libcgal-dev libopenmesh-dev libgmp-dev libmpfr-dev
   libnanoflann-dev libtinygltf-dev libstb-dev
+  libvulkan-dev mesa-vulkan-drivers glslc
 )
 
 missing=()

@@ -1,0 +1,152 @@
+#pragma once
+/// \file renderer.h
+/// Pictures of a tree and its sketch: a Vulkan renderer behind a plain C++ interface (no
+/// Vulkan type here; the Vulkan code is in app/renderer.cpp). What it draws, the camera
+/// framing and device selection are described in docs/rendering.md.
+///
+/// ```cpp
+/// Renderer renderer;                       // instance + device (GPU, else lavapipe)
+/// renderer.set_scene(scene);               // uploads only the meshes whose version changed
+/// RgbaImage png_pixels = renderer.render(frame_view(scene_bounds(scene), front_view(), 16.0f / 9.0f), 1280, 720);
+/// ```
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "core/errors.h"
+#include "growth/tree_geometry.h"
+
+namespace lobe {
+
+/// A Vulkan call failed; the message names the call, its result and file:line.
+class RenderError : public Error {
+public:
+    using Error::Error;
+};
+
+/// No Vulkan instance or no usable device: the message (one line) names what to install.
+class RenderUnavailable : public RenderError {
+public:
+    using RenderError::RenderError;
+};
+
+/// How a mesh is shaded (app/shaders/mesh.frag).
+enum class RenderMaterial : std::uint8_t {
+    Bark,   ///< opaque, lit, back faces culled
+    Leaf,   ///< alpha-tested from the leaf texture, two-sided
+    Lobe,   ///< translucent (alpha blend, after the opaque meshes, no depth write), two-sided
+    Stroke, ///< opaque, nearly unlit (stroke tubes)
+};
+
+/// One mesh of a scene.
+struct RenderItem {
+    std::uint64_t key = 0;     ///< names the mesh across set_scene calls (unique in a scene)
+    std::uint64_t version = 0; ///< changes whenever `geometry` changes: equal key and version are not re-uploaded
+    RenderMaterial material = RenderMaterial::Bark;
+    std::array<float, 4> color{1.0f, 1.0f, 1.0f, 1.0f}; ///< linear RGBA (alpha used by lobes)
+    SurfaceGeometry geometry; ///< world space (metres, +Y up); uvs used by leaves only (may be empty otherwise)
+};
+
+/// Axis-aligned bounding box; empty when lo > hi.
+struct Bounds {
+    glm::vec3 lo{1e30f};
+    glm::vec3 hi{-1e30f};
+    bool empty() const { return lo.x > hi.x || lo.y > hi.y || lo.z > hi.z; }
+    void add(const glm::vec3& p);
+};
+
+/// Everything a picture shows besides the sky.
+struct RenderScene {
+    std::vector<RenderItem> items;
+    RgbaImage leaf_texture;                ///< RGBA8 (sRGB colours, alpha cut-out); empty: white
+    std::uint64_t leaf_texture_version = 0; ///< as RenderItem::version
+    bool ground = true;                    ///< the ground grid at `ground_y`
+    float ground_y = 0.0f;                 ///< height of the trunk base
+    /// What the ground grid is centred under and sized by (8 × its largest side, at least
+    /// 4 m across each way); empty: the items' bounds.
+    Bounds ground_area;
+};
+
+/// Bounds of every item of `scene` (the ground excluded).
+Bounds scene_bounds(const RenderScene& scene);
+
+/// A perspective camera.
+struct Camera {
+    glm::vec3 eye{0.0f, 0.0f, 1.0f};
+    glm::vec3 target{0.0f};
+    glm::vec3 up{0.0f, 1.0f, 0.0f};
+    float fov_y_deg = 30.0f;
+    float near_m = 0.01f;
+    float far_m = 100.0f;
+};
+
+/// Where a camera looks from: the direction it looks along is −(cos e · sin a, sin e, cos e · cos a)
+/// for azimuth a and elevation e, so azimuth 0 looks along −Z and azimuth 90° along −X.
+struct ViewAngles {
+    float azimuth_deg = 0.0f;
+    float elevation_deg = 0.0f;
+};
+ViewAngles front_view(); ///< looks along −Z (from +Z), horizontally
+ViewAngles side_view();  ///< looks along −X (from +X), horizontally
+ViewAngles top_view();   ///< looks down −Y; −Z is up in the picture
+
+/// A camera looking at the centre of `bounds` from `view`, as close as it can be with every
+/// corner of the box inside the frame (plus a margin of `margin` of the frame on each side).
+/// `aspect` is width / height. An empty box frames a 1 m box at the origin.
+Camera frame_view(const Bounds& bounds, const ViewAngles& view, float aspect, float fov_y_deg = 30.0f,
+                  float margin = 0.06f);
+
+struct RendererOptions {
+    int samples = 4;             ///< MSAA samples (1, 2, 4, 8); lowered to what the device supports
+    bool prefer_software = false; ///< pick the CPU device (lavapipe) even when a GPU is present
+};
+
+/// How much GPU upload the last set_scene did, and what the last render took.
+struct RenderStats {
+    std::size_t meshes_uploaded = 0; ///< by the last set_scene
+    std::size_t meshes_kept = 0;     ///< cached meshes the last set_scene did not touch
+    std::size_t bytes_uploaded = 0;  ///< by the last set_scene (vertices, indices, texture)
+    double record_ms = 0.0;          ///< CPU time recording the last frame's command buffer
+    double gpu_ms = 0.0;             ///< submit to fence of the last frame (drawing, resolve, copy)
+};
+
+/// A Vulkan renderer with an offscreen target. Not thread-safe: one thread uses it.
+class Renderer {
+public:
+    /// Creates the Vulkan instance and device: the first discrete GPU, else an integrated
+    /// one, else any other, else the CPU (lavapipe). Sets XDG_RUNTIME_DIR to a private temp
+    /// folder when it is unset (lavapipe warns without it).
+    /// \throw RenderUnavailable when no instance or no device can be made; RenderError.
+    explicit Renderer(const RendererOptions& options = {});
+    ~Renderer();
+    Renderer(const Renderer&) = delete;
+    Renderer& operator=(const Renderer&) = delete;
+
+    const std::string& device_name() const; ///< e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
+    bool is_software() const;               ///< the device is a CPU implementation
+    int samples() const;                    ///< MSAA samples in use
+
+    /// Makes `scene` the one drawn. Meshes whose key and version are cached stay on the GPU;
+    /// new or changed ones are uploaded; ones no longer in the scene are freed.
+    /// \throw InvalidInput for a mesh with mismatched array sizes or out-of-range indices,
+    /// repeated keys, or a texture whose byte count is not width × height × 4.
+    void set_scene(const RenderScene& scene);
+
+    /// Draws the scene into a width × height offscreen picture (4× MSAA resolved) and reads it
+    /// back: RGBA8, sRGB-encoded, rows top to bottom, alpha 255.
+    /// \throw InvalidInput for a size outside 1..16384; RenderError.
+    RgbaImage render(const Camera& camera, int width, int height);
+
+    const RenderStats& stats() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+} // namespace lobe

@@ -1,0 +1,98 @@
+// Pictures of the largest Table 1 tree (4 lobes, 22 strokes) at 1280×720 with tree and
+// leaves: the CPU time to record one frame's command buffer, and the whole frame (record,
+// draw with 4× MSAA and resolve, copy out, read back) on the device the renderer picks
+// (lavapipe on a machine without a GPU), at LOD0 and LOD2.
+// Run with --benchmark_filter=Render --benchmark_repetitions=5 and read the medians.
+#include <benchmark/benchmark.h>
+
+#include <memory>
+#include <string>
+
+#include "app/edit_hooks.h"
+#include "app/render_scene.h"
+#include "app/renderer.h"
+#include "app/tree_output.h"
+#include "app/tree_pipeline.h"
+#include "input/pipeline.h"
+#include "input/recording.h"
+#include "input/session_builder.h"
+#include "tests/test_paths.h"
+
+using namespace lobe;
+
+namespace {
+
+struct Fixture {
+    TreeGeometry geometry;
+    float ground_y = 0.0f;
+    std::unique_ptr<Renderer> renderer;
+};
+
+Fixture& fixture()
+{
+    static Fixture f = [] {
+        Fixture out;
+        const Recording rec = read_recording(test::source_path("recordings/table1-4lobes-22strokes.lrec"));
+        const InputResult r = run_input_pipeline(rec);
+        SessionBuilder b(Document{}, EditPickOptions{}, meshing_edit_hooks());
+        b.apply(r.actions);
+        const Document doc = b.take_document();
+        const BuiltTree tree = build_document_tree(doc);
+        out.geometry = document_tree_geometry(doc, tree);
+        out.ground_y = tree.growth.tree.nodes[0].position.y;
+        out.renderer = std::make_unique<Renderer>();
+        return out;
+    }();
+    return f;
+}
+
+/// Sets up the scene of LOD `lod` and its front camera.
+Camera prepare(benchmark::State& state, int lod)
+{
+    Fixture& f = fixture();
+    RenderContent content;
+    content.lod = lod;
+    const RenderScene scene = tree_render_scene(f.geometry, {}, {}, f.ground_y, content);
+    f.renderer->set_scene(scene);
+    std::size_t triangles = 0;
+    for (const RenderItem& item : scene.items) triangles += item.geometry.triangle_count();
+    state.counters["triangles"] = static_cast<double>(triangles);
+    state.SetLabel(f.renderer->device_name());
+    return frame_view(scene_bounds(scene), front_view(), 1280.0f / 720.0f);
+}
+
+} // namespace
+
+// The whole frame, as `lobesketch render` draws it (wall time).
+static void BM_RenderFrame1280x720(benchmark::State& state)
+{
+    const Camera camera = prepare(state, static_cast<int>(state.range(0)));
+    Renderer& r = *fixture().renderer;
+    r.render(camera, 1280, 720); // the target is made once
+    double record = 0.0, gpu = 0.0;
+    for (auto _ : state) {
+        RgbaImage image = r.render(camera, 1280, 720);
+        benchmark::DoNotOptimize(image.pixels.data());
+        record += r.stats().record_ms;
+        gpu += r.stats().gpu_ms;
+    }
+    state.counters["record_ms"] = record / static_cast<double>(state.iterations());
+    state.counters["gpu_ms"] = gpu / static_cast<double>(state.iterations());
+}
+// A frame on lavapipe takes hundreds of milliseconds: a fixed, small number of iterations.
+BENCHMARK(BM_RenderFrame1280x720)->ArgName("lod")->Arg(0)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+
+// Only the recording of the frame's command buffer (CPU), timed by the renderer.
+static void BM_RenderRecordCommandBuffer(benchmark::State& state)
+{
+    const Camera camera = prepare(state, static_cast<int>(state.range(0)));
+    Renderer& r = *fixture().renderer;
+    r.render(camera, 1280, 720);
+    for (auto _ : state) {
+        r.render(camera, 1280, 720);
+        state.SetIterationTime(r.stats().record_ms / 1000.0);
+    }
+}
+// Manual time is only the recording (microseconds): without a fixed count the library would
+// run thousands of whole frames to fill its minimum time.
+BENCHMARK(BM_RenderRecordCommandBuffer)->ArgName("lod")->Arg(0)->Arg(2)->Unit(benchmark::kMicrosecond)->UseManualTime()->Iterations(3);
