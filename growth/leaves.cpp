@@ -288,18 +288,24 @@ void emit_leaf_quads(const LeafCloud& cloud, const LeafSettings& leaves, const L
         quad_nodes->clear();
         quad_nodes->reserve(quads);
     }
-    const double scale = std::sqrt(1.0 / keep); // area × 1/keep
-    const auto length = static_cast<float>(leaves.length_m * scale);
-    const auto half_width = static_cast<float>(0.5 * leaves.width_m * scale);
+    // Area × 1/keep, mostly in width: a coarse leaf grows a little longer and much wider,
+    // centred where the LOD0 leaf was, so the crown's outline stays where LOD0's is (longer
+    // leaves would reach out of it).
+    const double grow = 1.0 / keep;
+    const double length_scale = std::pow(grow, 0.125), width_scale = grow / length_scale;
+    const auto length = static_cast<float>(leaves.length_m * length_scale);
+    const auto half_width = static_cast<float>(0.5 * leaves.width_m * width_scale);
+    const auto back = static_cast<float>(0.5 * leaves.length_m * (length_scale - 1.0));
     for (const LeafCloud::Leaf& leaf : cloud.leaves) {
         if (leaf.rank >= kept_per_tip(cloud.per_node, keep, leaf.keep_offset)) continue;
         const glm::vec3 normal = glm::normalize(glm::cross(leaf.across, leaf.axis));
         const auto first = static_cast<std::uint32_t>(out.positions.size());
         const glm::vec3 side = half_width * leaf.across, up = length * leaf.axis;
-        out.positions.push_back(leaf.base - side);
-        out.positions.push_back(leaf.base + side);
-        out.positions.push_back(leaf.base + up + side);
-        out.positions.push_back(leaf.base + up - side);
+        const glm::vec3 base = leaf.base - back * leaf.axis;
+        out.positions.push_back(base - side);
+        out.positions.push_back(base + side);
+        out.positions.push_back(base + up + side);
+        out.positions.push_back(base + up - side);
         out.uvs.emplace_back(0.0f, 1.0f);
         out.uvs.emplace_back(1.0f, 1.0f);
         out.uvs.emplace_back(1.0f, 0.0f);

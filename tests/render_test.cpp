@@ -253,28 +253,18 @@ std::string describe(const LodSilhouette& s, int lod)
            " only in LOD" + std::to_string(lod);
 }
 
-// What holds today: the coarse LODs cover LOD0's silhouette (the tree does not lose parts).
-TEST(RenderPicture, CoarserLodsCoverAtLeast97PercentOfTheSilhouetteOfLod0)
+// The growth issue's LOD check: coarse LODs keep LOD0's silhouette (coarse leaves are fewer
+// and larger, grown mostly in width about their centre so the crown's outline stays).
+TEST(RenderPicture, CoarserLodsKeepTheSilhouetteOfLod0WithIntersectionOverUnionOfAtLeast0_9)
 {
     const std::vector<LodSilhouette> lods = lod_silhouettes();
     ASSERT_EQ(lods.size(), 2u);
     for (int lod = 1; lod <= 2; ++lod) {
         const LodSilhouette& s = lods[std::size_t(lod - 1)];
-        EXPECT_GE(s.lod0_covered(), 0.97) << describe(s, lod);
+        EXPECT_GE(s.iou(), 0.9) << describe(s, lod);
+        EXPECT_GE(s.lod0_covered(), 0.95) << describe(s, lod);
         RecordProperty("silhouette_lod" + std::to_string(lod), describe(s, lod));
     }
-}
-
-// The growth issue's LOD check. It fails with the current leaf LODs: coarse leaves are fewer
-// and scaled up (leaf area kept within ±25 %), so the crown of LOD1 and LOD2 reaches beyond
-// LOD0's (measured at 192×144: IoU 0.88 for LOD1, 0.73 for LOD2, with 99 % and 98 % of
-// LOD0's silhouette covered). Enable it once growth/leaves.cpp keeps the crown outline;
-// run it with --gtest_also_run_disabled_tests.
-TEST(RenderPicture, DISABLED_CoarserLodsKeepTheSilhouetteOfLod0WithIntersectionOverUnionOfAtLeast0_9)
-{
-    const std::vector<LodSilhouette> lods = lod_silhouettes();
-    ASSERT_EQ(lods.size(), 2u);
-    for (int lod = 1; lod <= 2; ++lod) EXPECT_GE(lods[std::size_t(lod - 1)].iou(), 0.9) << describe(lods[std::size_t(lod - 1)], lod);
 }
 
 TEST(RenderPicture, LobesAndStrokesAreDrawnOverTheTreeWhenAsked)
