@@ -21,7 +21,7 @@ namespace {
 
 constexpr int kMinSide = 16, kMaxSide = 8192;
 
-/// "WxH" with both sides in kMinSide..kMaxSide; empty string when it is not.
+/// Parses "WxH" with both sides in kMinSide..kMaxSide; false (sizes untouched) otherwise.
 bool parse_size(const std::string& text, int& width, int& height)
 {
     int w = 0, h = 0;

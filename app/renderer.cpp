@@ -26,6 +26,8 @@
 #include <glm/matrix.hpp>
 #include <glm/vec4.hpp>
 
+#include <dlfcn.h>
+#include <link.h>
 #include <unistd.h>
 
 #include "app/embedded_shaders.h"
@@ -122,6 +124,30 @@ void ensure_runtime_dir()
     std::filesystem::create_directories(dir, ec);
     std::filesystem::permissions(dir, std::filesystem::perms::owner_all, std::filesystem::perm_options::replace, ec);
     if (!ec) ::setenv("XDG_RUNTIME_DIR", dir.c_str(), 0);
+}
+
+/// Paths of the shared libraries loaded in the process now.
+std::vector<std::string> loaded_libraries()
+{
+    std::vector<std::string> out;
+    dl_iterate_phdr(
+        [](dl_phdr_info* info, std::size_t, void* data) {
+            if (info->dlpi_name && info->dlpi_name[0]) static_cast<std::vector<std::string>*>(data)->push_back(info->dlpi_name);
+            return 0;
+        },
+        &out);
+    return out;
+}
+
+/// Keeps the libraries that creating an instance loaded (the Vulkan drivers and what they
+/// need, e.g. lavapipe and LLVM) loaded until the process ends. Mesa's drivers keep global
+/// state that they do not free when the loader unloads them with the last instance; loaded
+/// once, they are not loaded again for the next Renderer either.
+void keep_drivers_loaded(const std::vector<std::string>& before)
+{
+    for (const std::string& lib : loaded_libraries())
+        if (std::find(before.begin(), before.end(), lib) == before.end())
+            dlopen(lib.c_str(), RTLD_NOW | RTLD_NOLOAD | RTLD_NODELETE);
 }
 
 const char* const kInstallHint =
@@ -296,7 +322,10 @@ private:
             info.enabledLayerCount = 1;
             info.ppEnabledLayerNames = &validation;
         }
-        if (VkResult r = vkCreateInstance(&info, nullptr, &instance_); r != VK_SUCCESS) {
+        const std::vector<std::string> libraries = loaded_libraries();
+        const VkResult created = vkCreateInstance(&info, nullptr, &instance_);
+        keep_drivers_loaded(libraries);
+        if (VkResult r = created; r != VK_SUCCESS) {
             instance_ = VK_NULL_HANDLE;
             throw RenderUnavailable(std::string("render: no Vulkan driver (vkCreateInstance: ") + vk::result_name(r) +
                                     "); " + kInstallHint);
