@@ -16,30 +16,16 @@
 #include "core/document.h"
 #include "meshing/mesh_io.h"
 #include "meshing/mesh_quality.h"
+#include "tests/cli_run.h"
 #include "tests/test_paths.h"
 
 using namespace lobe;
 
 namespace {
 
-struct CliRun {
-    int code = -1;
-    std::string out; ///< stdout and stderr together
-};
+using test::CliRun;
 
-CliRun run(const std::string& args)
-{
-    CliRun r;
-    const std::string cmd = test::cli_path() + " " + args + " 2>&1";
-    FILE* p = ::popen(cmd.c_str(), "r");
-    if (!p) return r;
-    std::array<char, 4096> buf;
-    std::size_t n;
-    while ((n = std::fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
-    int status = ::pclose(p);
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    return r;
-}
+CliRun run(const std::string& args) { return test::run_cli(args); }
 
 std::size_t count_lines_with(const std::string& text, const std::string& needle)
 {

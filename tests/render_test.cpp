@@ -22,6 +22,7 @@
 #include "input/recording.h"
 #include "input/session_builder.h"
 #include "meshing/edit_ops.h"
+#include "tests/cli_run.h"
 #include "tests/test_paths.h"
 
 namespace lobe {
@@ -361,22 +362,8 @@ TEST(RenderScene, FramingKeepsEveryCornerOfTheBoxInsideThePicture)
 
 // --- the command line -------------------------------------------------------------------------
 
-struct CliRun {
-    int code = -1;
-    std::string out;
-};
-
-CliRun run_cli(const std::string& args, const std::string& env = "")
-{
-    CliRun r;
-    FILE* p = ::popen((env + (env.empty() ? "" : " ") + test::cli_path() + " " + args + " 2>&1").c_str(), "r");
-    if (!p) return r;
-    std::array<char, 4096> buf;
-    while (std::size_t n = std::fread(buf.data(), 1, buf.size(), p)) r.out.append(buf.data(), n);
-    const int status = ::pclose(p);
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    return r;
-}
+using test::CliRun;
+using test::run_cli;
 
 std::size_t count(const std::string& text, const std::string& needle)
 {

@@ -23,6 +23,7 @@
 #include "growth/mesh_raycast.h"
 #include "tests/gltf_check.h"
 #include "tests/replay_fixture.h"
+#include "tests/cli_run.h"
 #include "tests/test_paths.h"
 
 namespace lobe {
@@ -30,22 +31,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct CliRun {
-    int code = -1;
-    std::string out;
-};
-
-CliRun run_cli(const std::string& args)
-{
-    CliRun r;
-    FILE* p = ::popen((test::cli_path() + " " + args + " 2>&1").c_str(), "r");
-    if (!p) return r;
-    std::array<char, 4096> buf;
-    while (std::size_t n = std::fread(buf.data(), 1, buf.size(), p)) r.out.append(buf.data(), n);
-    const int status = ::pclose(p);
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    return r;
-}
+using test::CliRun;
+using test::run_cli;
 
 std::string rec(const std::string& name) { return test::source_path("recordings/" + name + ".lrec"); }
 
