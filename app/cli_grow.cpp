@@ -55,13 +55,9 @@ void report_and_write(const TreeArgs& a, const Document& doc, const BuiltTree& t
         attractors += l.attractors;
         reached += l.reached;
     }
-    std::string lods;
-    for (std::size_t i = 0; i < geometry.lods.size(); ++i)
-        lods += (i ? ", " : "") + std::string("LOD") + std::to_string(i) + " " +
-                std::to_string(lod_triangles(geometry.lods[i]));
     progress("grew " + std::to_string(tree.growth.tree.size()) + " nodes in " + std::to_string(tree.lobes.size()) +
              " lobe(s), " + std::to_string(reached) + " of " + std::to_string(attractors) + " attractors reached");
-    progress("geometry in " + std::to_string(static_cast<int>(geometry_ms)) + " ms, triangles " + lods);
+    progress("geometry in " + std::to_string(static_cast<int>(geometry_ms)) + " ms, triangles " + lod_triangle_summary(geometry));
     progress("wrote " + a.out);
     exit_code = kExitOk;
 }

@@ -53,11 +53,8 @@ void add_replay_command(CLI::App& app, int& exit_code)
             const TreeGeometry geometry = document_tree_geometry(out_doc, tree);
             write_tree_file(a->out + "/tree.glb", out_doc, tree, geometry, ExportOptions{});
             tree_written = true;
-            std::string lods;
-            for (std::size_t i = 0; i < geometry.lods.size(); ++i)
-                lods += (i ? ", " : "") + std::string("LOD") + std::to_string(i) + " " +
-                        std::to_string(lod_triangles(geometry.lods[i]));
-            progress("grew a tree of " + std::to_string(tree.growth.tree.size()) + " nodes (triangles " + lods + ")");
+            progress("grew a tree of " + std::to_string(tree.growth.tree.size()) + " nodes (triangles " +
+                     lod_triangle_summary(geometry) + ")");
         }
         std::size_t lobe_strokes = 0, trunk_strokes = 0;
         for (const Stroke& s : out_doc.strokes) (s.kind == StrokeKind::Lobe ? lobe_strokes : trunk_strokes)++;

@@ -21,6 +21,14 @@ TreeGeometry document_tree_geometry(const Document& doc, const BuiltTree& tree)
 
 std::size_t lod_triangles(const TreeLod& lod) { return lod.branches.triangle_count() + lod.leaves.triangle_count(); }
 
+std::string lod_triangle_summary(const TreeGeometry& geometry)
+{
+    std::string out;
+    for (std::size_t i = 0; i < geometry.lods.size(); ++i)
+        out += (i ? ", LOD" : "LOD") + std::to_string(i) + " " + std::to_string(lod_triangles(geometry.lods[i]));
+    return out;
+}
+
 void write_tree_file(const std::string& path, const Document& doc, const BuiltTree& tree,
                      const TreeGeometry& geometry, const ExportOptions& options)
 {

@@ -18,6 +18,8 @@ TreeGeometry document_tree_geometry(const Document& doc, const BuiltTree& tree);
 
 /// Triangles of one LOD (branches + leaves).
 std::size_t lod_triangles(const TreeLod& lod);
+/// "LOD0 114392, LOD1 51224, LOD2 15442": the triangles of every LOD, for progress lines.
+std::string lod_triangle_summary(const TreeGeometry& geometry);
 
 /// Writes `geometry` of `tree` to `path`: glTF binary for ".glb", OBJ + MTL + PNG for ".obj".
 /// The sketch extras (lobes, strokes) come from `tree` and `doc` when `options` asks.

@@ -91,23 +91,45 @@ glm::dvec3 growth_vector(const glm::dvec3& v_cluster, const glm::dvec3& v_defaul
     return v_cluster + alpha * v_default + beta * glm::dvec3(0.0, -1.0, 0.0);
 }
 
+namespace {
+
+// Azimuths (about +Y) and elevations of unit directions, radians.
+void azimuth_elevation(const std::vector<glm::vec3>& unit_dirs, std::vector<double>& az, std::vector<double>& el)
+{
+    az.resize(unit_dirs.size());
+    el.resize(unit_dirs.size());
+    for (std::size_t i = 0; i < unit_dirs.size(); ++i) {
+        const glm::vec3& d = unit_dirs[i];
+        az[i] = std::atan2(static_cast<double>(d.z), static_cast<double>(d.x));
+        el[i] = std::asin(std::clamp(static_cast<double>(d.y), -1.0, 1.0));
+    }
+}
+
+// The smallest arc of azimuths holding them all: its start and its length (radians).
+std::pair<double, double> azimuth_arc(const std::vector<double>& az)
+{
+    std::vector<double> sorted = az;
+    std::sort(sorted.begin(), sorted.end());
+    double start = sorted.front(), gap = sorted.front() + 2 * kPi - sorted.back();
+    for (std::size_t i = 1; i < sorted.size(); ++i)
+        if (sorted[i] - sorted[i - 1] > gap) {
+            gap = sorted[i] - sorted[i - 1];
+            start = sorted[i];
+        }
+    return {start, 2 * kPi - gap};
+}
+
+} // namespace
+
 ClusterSpan cluster_span(const std::vector<glm::vec3>& unit_dirs)
 {
     ClusterSpan span;
     if (unit_dirs.empty()) return span;
-    std::vector<double> az;
-    double vmin = 1e9, vmax = -1e9;
-    for (const glm::vec3& d : unit_dirs) {
-        az.push_back(std::atan2(static_cast<double>(d.z), static_cast<double>(d.x)));
-        const double el = std::asin(std::clamp(static_cast<double>(d.y), -1.0, 1.0));
-        vmin = std::min(vmin, el);
-        vmax = std::max(vmax, el);
-    }
-    std::sort(az.begin(), az.end());
-    double gap = az.front() + 2 * kPi - az.back();
-    for (std::size_t i = 1; i < az.size(); ++i) gap = std::max(gap, az[i] - az[i - 1]);
-    span.horizontal_deg = (2 * kPi - gap) * 180.0 / kPi;
-    span.vertical_deg = (vmax - vmin) * 180.0 / kPi;
+    std::vector<double> az, el;
+    azimuth_elevation(unit_dirs, az, el);
+    const auto [lo, hi] = std::minmax_element(el.begin(), el.end());
+    span.horizontal_deg = azimuth_arc(az).second * 180.0 / kPi;
+    span.vertical_deg = (*hi - *lo) * 180.0 / kPi;
     return span;
 }
 
@@ -116,10 +138,14 @@ std::vector<std::vector<int>> split_cluster(const std::vector<glm::vec3>& unit_d
 {
     const int n = static_cast<int>(unit_dirs.size());
     if (n == 0) return {};
-    const double t = std::max(split_angle_deg, 1e-3);
-    const ClusterSpan span = cluster_span(unit_dirs);
-    int nh = span.horizontal_deg > t ? static_cast<int>(std::ceil(span.horizontal_deg / t)) : 1;
-    int nv = span.vertical_deg > t ? static_cast<int>(std::ceil(span.vertical_deg / t)) : 1;
+    const double t = std::max(split_angle_deg, 1e-3) * kPi / 180.0;
+    std::vector<double> az, el;
+    azimuth_elevation(unit_dirs, az, el);
+    const auto [start, hspan] = azimuth_arc(az);
+    const auto [lo, hi] = std::minmax_element(el.begin(), el.end());
+    const double vmin = *lo, vspan = *hi - *lo;
+    int nh = hspan > t ? static_cast<int>(std::ceil(hspan / t)) : 1;
+    int nv = vspan > t ? static_cast<int>(std::ceil(vspan / t)) : 1;
     while (nh * nv > kMaxPiecesPerNode) {
         if (nh >= nv) nh = (nh + 1) / 2; else nv = (nv + 1) / 2;
     }
@@ -131,29 +157,12 @@ std::vector<std::vector<int>> split_cluster(const std::vector<glm::vec3>& unit_d
         return {all};
     }
     // Azimuths measured from the start of the smallest arc holding them all.
-    std::vector<double> az(static_cast<std::size_t>(n)), el(static_cast<std::size_t>(n));
-    for (int i = 0; i < n; ++i) {
-        const glm::vec3& d = unit_dirs[static_cast<std::size_t>(i)];
-        az[static_cast<std::size_t>(i)] = std::atan2(static_cast<double>(d.z), static_cast<double>(d.x));
-        el[static_cast<std::size_t>(i)] = std::asin(std::clamp(static_cast<double>(d.y), -1.0, 1.0));
-    }
-    std::vector<double> sorted = az;
-    std::sort(sorted.begin(), sorted.end());
-    double start = sorted.front(), gap = sorted.front() + 2 * kPi - sorted.back();
-    for (std::size_t i = 1; i < sorted.size(); ++i)
-        if (sorted[i] - sorted[i - 1] > gap) {
-            gap = sorted[i] - sorted[i - 1];
-            start = sorted[i];
-        }
-    const double hspan = std::max(span.horizontal_deg * kPi / 180.0, 1e-12);
-    const double vmin = *std::min_element(el.begin(), el.end());
-    const double vspan = std::max(span.vertical_deg * kPi / 180.0, 1e-12);
     std::vector<std::vector<int>> bins(static_cast<std::size_t>(nh * nv));
     for (int i = 0; i < n; ++i) {
         double rel = az[static_cast<std::size_t>(i)] - start;
         if (rel < 0) rel += 2 * kPi;
-        const int ih = std::clamp(static_cast<int>(rel / hspan * nh), 0, nh - 1);
-        const int iv = std::clamp(static_cast<int>((el[static_cast<std::size_t>(i)] - vmin) / vspan * nv), 0, nv - 1);
+        const int ih = std::clamp(static_cast<int>(rel / std::max(hspan, 1e-12) * nh), 0, nh - 1);
+        const int iv = std::clamp(static_cast<int>((el[static_cast<std::size_t>(i)] - vmin) / std::max(vspan, 1e-12) * nv), 0, nv - 1);
         bins[static_cast<std::size_t>(iv * nh + ih)].push_back(i);
     }
     std::vector<std::vector<int>> pieces;
