@@ -321,7 +321,8 @@ PinchEditor::PinchEditor(const TriangleMesh& mesh, int handle_vertex, const Pinc
     dist[std::size_t(handle_vertex)] = 0.0;
     queue.emplace(0.0, handle_vertex);
     while (!queue.empty()) {
-        const auto [d, v] = queue.top();
+        const double d = queue.top().first; // named copies: lambdas may not capture bindings (clang 14)
+        const int v = queue.top().second;
         queue.pop();
         if (d > dist[std::size_t(v)])
             continue;

@@ -14,6 +14,7 @@ PACKAGES=(
   libcgal-dev libopenmesh-dev libgmp-dev libmpfr-dev
   libnanoflann-dev libtinygltf-dev libstb-dev
   libvulkan-dev mesa-vulkan-drivers glslc
+  clang libclang-rt-14-dev
 )
 
 missing=()
