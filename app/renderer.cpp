@@ -1,12 +1,16 @@
-// The Vulkan renderer behind app/renderer.h. Three parts, each a small class:
-//  - VulkanContext: instance, device choice, queue, memory helpers, one-shot submits;
+// The Vulkan renderer behind app/renderer.h. Five parts, each a small class:
+//  - VulkanContext: instance (with the caller's instance extensions), device choice (with
+//    VK_KHR_swapchain when presenting), queue, memory helpers, one-shot submits;
 //  - OffscreenTarget: the images a frame is drawn into (MSAA colour, depth, resolve) and the
-//    buffer it is read back through. A swapchain target would bring its own images and a
-//    render pass of the same formats and sample count (compatible with the pipelines, which
-//    only need compatibility), and reuse SceneDrawer unchanged;
+//    buffer it is read back through (made on first use);
 //  - SceneDrawer: pipelines, the leaf texture, the per-mesh GPU buffer cache (keyed by
 //    RenderItem::key, re-uploaded only when RenderItem::version changes) and recording the
-//    draws of one frame into a command buffer inside any compatible render pass.
+//    draws of one frame into a command buffer inside any compatible render pass;
+//  - OverlayDrawer: the 2D overlay's pipeline, font texture and host-visible buffers, drawn
+//    after the scene in the same render pass;
+//  - WindowTarget: a window's surface and swapchain. A window's frame is drawn offscreen
+//    exactly as a picture is, then blitted into the acquired swapchain image and presented.
+// Every submit is waited for (one frame in flight), so buffers may be rewritten between frames.
 #include "app/renderer.h"
 
 #include <algorithm>
@@ -17,6 +21,7 @@
 #include <filesystem>
 #include <functional>
 #include <unordered_map>
+#include <type_traits>
 #include <unordered_set>
 
 #include <glm/ext/matrix_clip_space.hpp>
@@ -165,6 +170,13 @@ struct GpuImage {
     VkImageView view = VK_NULL_HANDLE;
 };
 
+/// Semaphores of a submit: waited on at `wait_stage` before it runs, signalled after it.
+struct SubmitSync {
+    VkSemaphore wait = VK_NULL_HANDLE;
+    VkPipelineStageFlags wait_stage = VK_PIPELINE_STAGE_TRANSFER_BIT;
+    VkSemaphore signal = VK_NULL_HANDLE;
+};
+
 // ---------------------------------------------------------------------------------------------
 class VulkanContext {
 public:
@@ -181,12 +193,18 @@ public:
     VulkanContext(const VulkanContext&) = delete;
     VulkanContext& operator=(const VulkanContext&) = delete;
 
+    VkInstance instance() const { return instance_; }
     VkDevice device() const { return device_; }
     VkPhysicalDevice physical() const { return physical_; }
     VkQueue queue() const { return queue_; }
     std::uint32_t queue_family() const { return queue_family_; }
     const std::string& name() const { return name_; }
     bool software() const { return software_; }
+    bool presentation() const { return presentation_; }
+    bool instance_extension_enabled(const std::string& name) const
+    {
+        return std::find(instance_extensions_.begin(), instance_extensions_.end(), name) != instance_extensions_.end();
+    }
     const VkPhysicalDeviceProperties& properties() const { return properties_; }
 
     std::uint32_t memory_type(std::uint32_t bits, VkMemoryPropertyFlags wanted, VkMemoryPropertyFlags required) const
@@ -284,7 +302,7 @@ public:
 
     /// Records with `record` into the context's command buffer, submits and waits.
     void submit_and_wait(const std::function<void(VkCommandBuffer)>& record, double* record_ms = nullptr,
-                         double* gpu_ms = nullptr) const
+                         double* gpu_ms = nullptr, const SubmitSync& sync = {}) const
     {
         const auto t0 = std::chrono::steady_clock::now();
         CHECK_VKCMD(vkResetCommandBuffer(command_buffer_, 0));
@@ -298,6 +316,15 @@ public:
         auto submit = vk_struct<VkSubmitInfo>(VK_STRUCTURE_TYPE_SUBMIT_INFO);
         submit.commandBufferCount = 1;
         submit.pCommandBuffers = &command_buffer_;
+        if (sync.wait) {
+            submit.waitSemaphoreCount = 1;
+            submit.pWaitSemaphores = &sync.wait;
+            submit.pWaitDstStageMask = &sync.wait_stage;
+        }
+        if (sync.signal) {
+            submit.signalSemaphoreCount = 1;
+            submit.pSignalSemaphores = &sync.signal;
+        }
         CHECK_VKCMD(vkQueueSubmit(queue_, 1, &submit, fence_));
         CHECK_VKCMD(vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX));
         const auto t2 = std::chrono::steady_clock::now();
@@ -316,13 +343,35 @@ private:
         app.apiVersion = VK_API_VERSION_1_1;
         auto info = vk_struct<VkInstanceCreateInfo>(VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO);
         info.pApplicationInfo = &app;
+        // The caller's instance extensions (a window's surface extensions), checked first so a
+        // missing one is named rather than reported as a missing driver.
+        const std::vector<std::string> libraries = loaded_libraries();
+        instance_extensions_ = options.instance_extensions;
+        std::vector<const char*> extension_names;
+        if (!instance_extensions_.empty()) {
+            std::uint32_t n = 0;
+            const VkResult listed = vkEnumerateInstanceExtensionProperties(nullptr, &n, nullptr);
+            std::vector<VkExtensionProperties> available(n);
+            if (listed == VK_SUCCESS && n) vkEnumerateInstanceExtensionProperties(nullptr, &n, available.data());
+            keep_drivers_loaded(libraries);
+            for (const std::string& e : instance_extensions_) {
+                const bool found = std::any_of(available.begin(), available.end(),
+                                               [&](const VkExtensionProperties& p) { return e == p.extensionName; });
+                if (!found)
+                    throw RenderUnavailable("render: the Vulkan instance extension " + e +
+                                            " is not available (a window needs the Vulkan loader and a driver with surface support); " +
+                                            kInstallHint);
+                extension_names.push_back(e.c_str());
+            }
+            info.enabledExtensionCount = static_cast<std::uint32_t>(extension_names.size());
+            info.ppEnabledExtensionNames = extension_names.data();
+        }
         // LOBE_VK_VALIDATION=1 turns on the Khronos validation layer (package vulkan-validationlayers).
         const char* validation = "VK_LAYER_KHRONOS_validation";
         if (const char* v = std::getenv("LOBE_VK_VALIDATION"); v && std::string(v) == "1") {
             info.enabledLayerCount = 1;
             info.ppEnabledLayerNames = &validation;
         }
-        const std::vector<std::string> libraries = loaded_libraries();
         const VkResult created = vkCreateInstance(&info, nullptr, &instance_);
         keep_drivers_loaded(libraries);
         if (VkResult r = created; r != VK_SUCCESS) {
@@ -349,6 +398,7 @@ private:
         };
         int best_rank = -1;
         for (VkPhysicalDevice d : devices) {
+            if (options.presentation && !has_device_extension(d, VK_KHR_SWAPCHAIN_EXTENSION_NAME)) continue;
             std::uint32_t families = 0;
             vkGetPhysicalDeviceQueueFamilyProperties(d, &families, nullptr);
             std::vector<VkQueueFamilyProperties> props(families);
@@ -366,8 +416,10 @@ private:
             }
         }
         if (!physical_)
-            throw RenderUnavailable(std::string("render: no Vulkan device with graphics (") + std::to_string(count) +
-                                    " device(s) found); " + kInstallHint);
+            throw RenderUnavailable(std::string("render: no Vulkan device with graphics") +
+                                    (options.presentation ? " and VK_KHR_swapchain (presentation to a window)" : "") + " (" +
+                                    std::to_string(count) + " device(s) found); " + kInstallHint);
+        presentation_ = options.presentation;
         vkGetPhysicalDeviceProperties(physical_, &properties_);
         vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
         name_ = properties_.deviceName;
@@ -381,6 +433,11 @@ private:
         auto dev = vk_struct<VkDeviceCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO);
         dev.queueCreateInfoCount = 1;
         dev.pQueueCreateInfos = &queue;
+        const char* swapchain = VK_KHR_SWAPCHAIN_EXTENSION_NAME;
+        if (presentation_) {
+            dev.enabledExtensionCount = 1;
+            dev.ppEnabledExtensionNames = &swapchain;
+        }
         if (VkResult r = vkCreateDevice(physical_, &dev, nullptr, &device_); r != VK_SUCCESS) {
             device_ = VK_NULL_HANDLE;
             throw RenderUnavailable("render: cannot open the Vulkan device '" + name_ + "' (vkCreateDevice: " +
@@ -398,6 +455,15 @@ private:
         CHECK_VKCMD(vkAllocateCommandBuffers(device_, &cb, &command_buffer_));
         auto fence = vk_struct<VkFenceCreateInfo>(VK_STRUCTURE_TYPE_FENCE_CREATE_INFO);
         CHECK_VKCMD(vkCreateFence(device_, &fence, nullptr, &fence_));
+    }
+
+    static bool has_device_extension(VkPhysicalDevice d, const char* name)
+    {
+        std::uint32_t n = 0;
+        if (vkEnumerateDeviceExtensionProperties(d, nullptr, &n, nullptr) != VK_SUCCESS) return false;
+        std::vector<VkExtensionProperties> props(n);
+        if (n && vkEnumerateDeviceExtensionProperties(d, nullptr, &n, props.data()) < VK_SUCCESS) return false;
+        return std::any_of(props.begin(), props.end(), [&](const VkExtensionProperties& p) { return std::strcmp(p.extensionName, name) == 0; });
     }
 
     void destroy()
@@ -425,6 +491,8 @@ private:
     VkPhysicalDeviceMemoryProperties memory_{};
     std::string name_;
     bool software_ = false;
+    bool presentation_ = false;
+    std::vector<std::string> instance_extensions_;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -560,8 +628,6 @@ public:
             fb.height = extent.height;
             fb.layers = 1;
             CHECK_VKCMD(vkCreateFramebuffer(ctx.device(), &fb, nullptr, &framebuffer_));
-            readback_ = ctx.create_buffer(VkDeviceSize(extent.width) * extent.height * 4u, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                          VK_MEMORY_PROPERTY_HOST_CACHED_BIT);
         } catch (...) {
             destroy();
             throw;
@@ -573,15 +639,23 @@ public:
 
     VkExtent2D extent() const { return extent_; }
     VkFramebuffer framebuffer() const { return framebuffer_; }
+    /// The single-sample picture (the resolve image, or the colour image when not
+    /// multisampled), in TRANSFER_SRC_OPTIMAL after the render pass.
+    VkImage picture() const { return resolve_.image ? resolve_.image : color_.image; }
+    /// Whether a frame has been drawn into it (set by the caller after a submit).
+    bool drawn = false;
 
-    /// After the render pass: copies the picture into the readback buffer.
-    void record_copy_out(VkCommandBuffer cmd) const
+    /// After the render pass: copies the picture into the readback buffer (made on first use:
+    /// a window's target never needs one unless last_frame() is called).
+    void record_copy_out(VkCommandBuffer cmd)
     {
+        if (!readback_.buffer)
+            readback_ = ctx_.create_buffer(VkDeviceSize(extent_.width) * extent_.height * 4u, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                           VK_MEMORY_PROPERTY_HOST_CACHED_BIT);
         VkBufferImageCopy region{};
         region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
         region.imageExtent = {extent_.width, extent_.height, 1};
-        vkCmdCopyImageToBuffer(cmd, resolve_.image ? resolve_.image : color_.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                               readback_.buffer, 1, &region);
+        vkCmdCopyImageToBuffer(cmd, picture(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback_.buffer, 1, &region);
         auto barrier = vk_struct<VkBufferMemoryBarrier>(VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER);
         barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
         barrier.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
@@ -593,6 +667,7 @@ public:
                              nullptr);
     }
 
+    /// The readback buffer's pixels, alpha set to 255 (after a submitted record_copy_out).
     RgbaImage read() const
     {
         RgbaImage out;
@@ -603,6 +678,7 @@ public:
         CHECK_VKCMD(vkMapMemory(ctx_.device(), readback_.memory, 0, readback_.size, 0, &mapped));
         std::memcpy(out.pixels.data(), mapped, out.pixels.size());
         vkUnmapMemory(ctx_.device(), readback_.memory);
+        for (std::size_t i = 3; i < out.pixels.size(); i += 4) out.pixels[i] = 255;
         return out;
     }
 
@@ -623,6 +699,175 @@ private:
     VkFramebuffer framebuffer_ = VK_NULL_HANDLE;
     GpuBuffer readback_;
 };
+
+/// An RGBA8 sRGB texture (`tex` checked by the caller), uploaded through a staging buffer and
+/// left in SHADER_READ_ONLY_OPTIMAL.
+GpuImage upload_rgba_texture(const VulkanContext& ctx, const RgbaImage& tex)
+{
+    const VkExtent2D extent{static_cast<std::uint32_t>(tex.width), static_cast<std::uint32_t>(tex.height)};
+    GpuImage texture = ctx.create_image(extent, VK_FORMAT_R8G8B8A8_SRGB, VK_SAMPLE_COUNT_1_BIT,
+                                        VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, VK_IMAGE_ASPECT_COLOR_BIT);
+    GpuBuffer staging;
+    try {
+        staging = ctx.create_buffer(tex.pixels.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, 0);
+        ctx.write(staging, 0, tex.pixels.data(), tex.pixels.size());
+        ctx.submit_and_wait([&](VkCommandBuffer cmd) {
+            auto barrier = vk_struct<VkImageMemoryBarrier>(VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER);
+            barrier.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+            barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+            barrier.image = texture.image;
+            barrier.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+            barrier.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+            barrier.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+            barrier.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+            vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0, nullptr,
+                                 1, &barrier);
+            VkBufferImageCopy region{};
+            region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+            region.imageExtent = {extent.width, extent.height, 1};
+            vkCmdCopyBufferToImage(cmd, staging.buffer, texture.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+            barrier.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+            barrier.newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+            barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+            barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
+            vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, 0, 0, nullptr, 0,
+                                 nullptr, 1, &barrier);
+        });
+    } catch (...) {
+        ctx.destroy(staging);
+        ctx.destroy(texture);
+        throw;
+    }
+    ctx.destroy(staging);
+    return texture;
+}
+
+/// Points binding 0 of `set` at `texture` through `sampler`.
+void write_texture_descriptor(VkDevice device, VkDescriptorSet set, VkSampler sampler, const GpuImage& texture)
+{
+    VkDescriptorImageInfo image{sampler, texture.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    auto write = vk_struct<VkWriteDescriptorSet>(VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET);
+    write.dstSet = set;
+    write.dstBinding = 0;
+    write.descriptorCount = 1;
+    write.descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+    write.pImageInfo = &image;
+    vkUpdateDescriptorSets(device, 1, &write, 0, nullptr);
+}
+
+/// "an RGBA8 image" check shared by the leaf texture and the overlay's font: throws
+/// InvalidInput naming `what` unless it is empty (0 × 0) or has width × height × 4 bytes.
+bool check_rgba(const RgbaImage& tex, const char* what)
+{
+    if (tex.width == 0 && tex.height == 0 && tex.pixels.empty()) return false;
+    if (tex.width < 1 || tex.height < 1 || tex.width > 16384 || tex.height > 16384 ||
+        tex.pixels.size() != std::size_t(tex.width) * std::size_t(tex.height) * 4u)
+        throw InvalidInput(std::string("render: ") + what + " of " + std::to_string(tex.width) + "x" +
+                           std::to_string(tex.height) + " with " + std::to_string(tex.pixels.size()) +
+                           " bytes (expected width x height x 4, each side 1 to 16384)");
+    return true;
+}
+
+const RgbaImage kWhiteTexel{1, 1, {255, 255, 255, 255}};
+
+/// What a pipeline differs in (app/renderer.cpp's pipelines share everything else: triangle
+/// lists, dynamic viewport and scissor, the target's sample count).
+struct PipelineState {
+    const char* vert;
+    const char* frag;
+    const VkPipelineVertexInputStateCreateInfo* input = nullptr; // none: no vertex input
+    VkCullModeFlags cull = VK_CULL_MODE_NONE;
+    bool depth_test = true;
+    bool depth_write = true;
+    bool blend = false;
+};
+
+VkShaderModule create_shader(VkDevice device, const char* name)
+{
+    const std::span<const std::uint32_t> code = embedded_shader(name);
+    if (code.empty()) throw RenderError(std::string("render: shader ") + name + " is not embedded");
+    auto info = vk_struct<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
+    info.codeSize = code.size_bytes();
+    info.pCode = code.data();
+    VkShaderModule m = VK_NULL_HANDLE;
+    CHECK_VKCMD(vkCreateShaderModule(device, &info, nullptr, &m));
+    return m;
+}
+
+VkPipeline create_pipeline(VkDevice device, VkRenderPass pass, const FrameFormat& format, VkPipelineLayout layout,
+                           const PipelineState& s)
+{
+    VkShaderModule vert = create_shader(device, s.vert), frag = VK_NULL_HANDLE;
+    VkPipeline p = VK_NULL_HANDLE;
+    try {
+        frag = create_shader(device, s.frag);
+        VkPipelineShaderStageCreateInfo stages[2]{};
+        stages[0].sType = stages[1].sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+        stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
+        stages[0].module = vert;
+        stages[0].pName = "main";
+        stages[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
+        stages[1].module = frag;
+        stages[1].pName = "main";
+        const auto no_input = vk_struct<VkPipelineVertexInputStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO);
+        auto assembly = vk_struct<VkPipelineInputAssemblyStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO);
+        assembly.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
+        auto viewport = vk_struct<VkPipelineViewportStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO);
+        viewport.viewportCount = 1;
+        viewport.scissorCount = 1;
+        auto raster = vk_struct<VkPipelineRasterizationStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO);
+        raster.polygonMode = VK_POLYGON_MODE_FILL;
+        raster.cullMode = s.cull;
+        raster.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE; // with the projection's y flip
+        raster.lineWidth = 1.0f;
+        auto ms = vk_struct<VkPipelineMultisampleStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO);
+        ms.rasterizationSamples = format.samples;
+        auto depth = vk_struct<VkPipelineDepthStencilStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO);
+        depth.depthTestEnable = s.depth_test ? VK_TRUE : VK_FALSE;
+        depth.depthWriteEnable = s.depth_write ? VK_TRUE : VK_FALSE;
+        depth.depthCompareOp = VK_COMPARE_OP_LESS_OR_EQUAL;
+        VkPipelineColorBlendAttachmentState blend{};
+        blend.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
+        if (s.blend) {
+            blend.blendEnable = VK_TRUE;
+            blend.srcColorBlendFactor = VK_BLEND_FACTOR_SRC_ALPHA;
+            blend.dstColorBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA;
+            blend.colorBlendOp = VK_BLEND_OP_ADD;
+            blend.srcAlphaBlendFactor = VK_BLEND_FACTOR_ZERO;
+            blend.dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE;
+            blend.alphaBlendOp = VK_BLEND_OP_ADD;
+        }
+        auto blending = vk_struct<VkPipelineColorBlendStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO);
+        blending.attachmentCount = 1;
+        blending.pAttachments = &blend;
+        const VkDynamicState dynamic_states[2] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+        auto dynamic = vk_struct<VkPipelineDynamicStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO);
+        dynamic.dynamicStateCount = 2;
+        dynamic.pDynamicStates = dynamic_states;
+        auto info = vk_struct<VkGraphicsPipelineCreateInfo>(VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO);
+        info.stageCount = 2;
+        info.pStages = stages;
+        info.pVertexInputState = s.input ? s.input : &no_input;
+        info.pInputAssemblyState = &assembly;
+        info.pViewportState = &viewport;
+        info.pRasterizationState = &raster;
+        info.pMultisampleState = &ms;
+        info.pDepthStencilState = &depth;
+        info.pColorBlendState = &blending;
+        info.pDynamicState = &dynamic;
+        info.layout = layout;
+        info.renderPass = pass;
+        info.subpass = 0;
+        CHECK_VKCMD(vkCreateGraphicsPipelines(device, VK_NULL_HANDLE, 1, &info, nullptr, &p));
+    } catch (...) {
+        vkDestroyShaderModule(device, vert, nullptr);
+        if (frag) vkDestroyShaderModule(device, frag, nullptr);
+        throw;
+    }
+    vkDestroyShaderModule(device, vert, nullptr);
+    vkDestroyShaderModule(device, frag, nullptr);
+    return p;
+}
 
 // ---------------------------------------------------------------------------------------------
 /// Pipelines, the leaf texture, the mesh cache, and the draws of one frame.
@@ -661,10 +906,7 @@ public:
                                            std::to_string(i) + " out of range (" + std::to_string(n) + " vertices)");
         }
         const RgbaImage& tex = scene.leaf_texture;
-        const bool has_texture = tex.width > 0 && tex.height > 0;
-        if (has_texture && tex.pixels.size() != std::size_t(tex.width) * std::size_t(tex.height) * 4u)
-            throw InvalidInput("render: a leaf texture of " + std::to_string(tex.width) + "x" + std::to_string(tex.height) +
-                               " with " + std::to_string(tex.pixels.size()) + " bytes");
+        const bool has_texture = check_rgba(tex, "a leaf texture");
 
         stats.meshes_uploaded = stats.meshes_kept = stats.bytes_uploaded = 0;
         for (auto it = cache_.begin(); it != cache_.end();) {
@@ -689,19 +931,22 @@ public:
             it->second.color = glm::vec4(item.color[0], item.color[1], item.color[2], item.color[3]);
             if (it->second.index_count > 0) draws_.push_back(item.key);
         }
+        // The white texel stands for "no texture": a texture replacing it (or replaced by it)
+        // is uploaded whatever its version.
         const std::uint64_t texture_version = has_texture ? scene.leaf_texture_version : 0;
-        if (!texture_ready_ || texture_version != texture_version_) {
-            if (has_texture)
-                upload_texture(tex, stats);
-            else
-                upload_texture(RgbaImage{1, 1, {255, 255, 255, 255}}, stats);
+        if (!texture_ready_ || has_texture != texture_is_real_ || texture_version != texture_version_) {
+            upload_texture(has_texture ? tex : kWhiteTexel, stats);
             texture_version_ = texture_version;
+            texture_is_real_ = has_texture;
             texture_ready_ = true;
         }
         ground_ = scene.ground;
         bounds_ = scene.ground_area.empty() ? scene_bounds(scene) : scene.ground_area;
         ground_y_ = scene.ground_y;
     }
+
+    VkDescriptorSetLayout texture_set_layout() const { return set_layout_; }
+    VkSampler sampler() const { return sampler_; }
 
     /// The draws of one frame, inside a begun render pass of `extent`.
     void record(VkCommandBuffer cmd, const Camera& camera, VkExtent2D extent) const
@@ -816,157 +1061,11 @@ private:
 
     void upload_texture(const RgbaImage& tex, RenderStats& stats)
     {
+        GpuImage fresh = upload_rgba_texture(ctx_, tex);
         ctx_.destroy(texture_);
-        const VkExtent2D extent{static_cast<std::uint32_t>(tex.width), static_cast<std::uint32_t>(tex.height)};
-        texture_ = ctx_.create_image(extent, VK_FORMAT_R8G8B8A8_SRGB, VK_SAMPLE_COUNT_1_BIT,
-                                     VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, VK_IMAGE_ASPECT_COLOR_BIT);
-        GpuBuffer staging = ctx_.create_buffer(tex.pixels.size(), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, 0);
-        try {
-            ctx_.write(staging, 0, tex.pixels.data(), tex.pixels.size());
-            ctx_.submit_and_wait([&](VkCommandBuffer cmd) {
-                auto barrier = vk_struct<VkImageMemoryBarrier>(VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER);
-                barrier.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-                barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-                barrier.image = texture_.image;
-                barrier.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-                barrier.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-                barrier.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
-                barrier.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-                vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0,
-                                     nullptr, 1, &barrier);
-                VkBufferImageCopy region{};
-                region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-                region.imageExtent = {extent.width, extent.height, 1};
-                vkCmdCopyBufferToImage(cmd, staging.buffer, texture_.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-                barrier.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
-                barrier.newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
-                barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-                barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
-                vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, 0, 0, nullptr,
-                                     0, nullptr, 1, &barrier);
-            });
-        } catch (...) {
-            ctx_.destroy(staging);
-            throw;
-        }
-        ctx_.destroy(staging);
+        texture_ = fresh;
         stats.bytes_uploaded += tex.pixels.size();
-        VkDescriptorImageInfo image{sampler_, texture_.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-        auto write = vk_struct<VkWriteDescriptorSet>(VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET);
-        write.dstSet = descriptor_set_;
-        write.dstBinding = 0;
-        write.descriptorCount = 1;
-        write.descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-        write.pImageInfo = &image;
-        vkUpdateDescriptorSets(ctx_.device(), 1, &write, 0, nullptr);
-    }
-
-    VkShaderModule shader(const char* name) const
-    {
-        const std::span<const std::uint32_t> code = embedded_shader(name);
-        if (code.empty()) throw RenderError(std::string("render: shader ") + name + " is not embedded");
-        auto info = vk_struct<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
-        info.codeSize = code.size_bytes();
-        info.pCode = code.data();
-        VkShaderModule m = VK_NULL_HANDLE;
-        CHECK_VKCMD(vkCreateShaderModule(ctx_.device(), &info, nullptr, &m));
-        return m;
-    }
-
-    struct PipelineState {
-        const char* vert;
-        const char* frag;
-        bool vertices = true; // mesh vertex input
-        VkCullModeFlags cull = VK_CULL_MODE_NONE;
-        bool depth_test = true;
-        bool depth_write = true;
-        bool blend = false;
-    };
-
-    VkPipeline pipeline(VkRenderPass pass, const FrameFormat& format, const PipelineState& s) const
-    {
-        VkShaderModule vert = shader(s.vert), frag = VK_NULL_HANDLE;
-        VkPipeline p = VK_NULL_HANDLE;
-        try {
-            frag = shader(s.frag);
-            VkPipelineShaderStageCreateInfo stages[2]{};
-            stages[0].sType = stages[1].sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
-            stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
-            stages[0].module = vert;
-            stages[0].pName = "main";
-            stages[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
-            stages[1].module = frag;
-            stages[1].pName = "main";
-            VkVertexInputBindingDescription binding{0, sizeof(Vertex), VK_VERTEX_INPUT_RATE_VERTEX};
-            VkVertexInputAttributeDescription attributes[3] = {
-                {0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, position)},
-                {1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, normal)},
-                {2, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, uv)},
-            };
-            auto input = vk_struct<VkPipelineVertexInputStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO);
-            if (s.vertices) {
-                input.vertexBindingDescriptionCount = 1;
-                input.pVertexBindingDescriptions = &binding;
-                input.vertexAttributeDescriptionCount = 3;
-                input.pVertexAttributeDescriptions = attributes;
-            }
-            auto assembly = vk_struct<VkPipelineInputAssemblyStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO);
-            assembly.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
-            auto viewport = vk_struct<VkPipelineViewportStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO);
-            viewport.viewportCount = 1;
-            viewport.scissorCount = 1;
-            auto raster = vk_struct<VkPipelineRasterizationStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO);
-            raster.polygonMode = VK_POLYGON_MODE_FILL;
-            raster.cullMode = s.cull;
-            raster.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE; // with the projection's y flip
-            raster.lineWidth = 1.0f;
-            auto ms = vk_struct<VkPipelineMultisampleStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO);
-            ms.rasterizationSamples = format.samples;
-            auto depth = vk_struct<VkPipelineDepthStencilStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO);
-            depth.depthTestEnable = s.depth_test ? VK_TRUE : VK_FALSE;
-            depth.depthWriteEnable = s.depth_write ? VK_TRUE : VK_FALSE;
-            depth.depthCompareOp = VK_COMPARE_OP_LESS_OR_EQUAL;
-            VkPipelineColorBlendAttachmentState blend{};
-            blend.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
-            if (s.blend) {
-                blend.blendEnable = VK_TRUE;
-                blend.srcColorBlendFactor = VK_BLEND_FACTOR_SRC_ALPHA;
-                blend.dstColorBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA;
-                blend.colorBlendOp = VK_BLEND_OP_ADD;
-                blend.srcAlphaBlendFactor = VK_BLEND_FACTOR_ZERO;
-                blend.dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE;
-                blend.alphaBlendOp = VK_BLEND_OP_ADD;
-            }
-            auto blending = vk_struct<VkPipelineColorBlendStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO);
-            blending.attachmentCount = 1;
-            blending.pAttachments = &blend;
-            const VkDynamicState dynamic_states[2] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
-            auto dynamic = vk_struct<VkPipelineDynamicStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO);
-            dynamic.dynamicStateCount = 2;
-            dynamic.pDynamicStates = dynamic_states;
-            auto info = vk_struct<VkGraphicsPipelineCreateInfo>(VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO);
-            info.stageCount = 2;
-            info.pStages = stages;
-            info.pVertexInputState = &input;
-            info.pInputAssemblyState = &assembly;
-            info.pViewportState = &viewport;
-            info.pRasterizationState = &raster;
-            info.pMultisampleState = &ms;
-            info.pDepthStencilState = &depth;
-            info.pColorBlendState = &blending;
-            info.pDynamicState = &dynamic;
-            info.layout = layout_;
-            info.renderPass = pass;
-            info.subpass = 0;
-            CHECK_VKCMD(vkCreateGraphicsPipelines(ctx_.device(), VK_NULL_HANDLE, 1, &info, nullptr, &p));
-        } catch (...) {
-            vkDestroyShaderModule(ctx_.device(), vert, nullptr);
-            if (frag) vkDestroyShaderModule(ctx_.device(), frag, nullptr);
-            throw;
-        }
-        vkDestroyShaderModule(ctx_.device(), vert, nullptr);
-        vkDestroyShaderModule(ctx_.device(), frag, nullptr);
-        return p;
+        write_texture_descriptor(ctx_.device(), descriptor_set_, sampler_, texture_);
     }
 
     void create(VkRenderPass pass, const FrameFormat& format)
@@ -1003,11 +1102,23 @@ private:
         sampler.maxLod = 0.0f;
         CHECK_VKCMD(vkCreateSampler(dev, &sampler, nullptr, &sampler_));
 
-        sky_ = pipeline(pass, format, {"sky.vert", "sky.frag", false, VK_CULL_MODE_NONE, false, false, false});
-        ground_pipeline_ = pipeline(pass, format, {"ground.vert", "ground.frag", false, VK_CULL_MODE_NONE, true, true, false});
-        opaque_ = pipeline(pass, format, {"mesh.vert", "mesh.frag", true, VK_CULL_MODE_BACK_BIT, true, true, false});
-        leaf_ = pipeline(pass, format, {"mesh.vert", "mesh.frag", true, VK_CULL_MODE_NONE, true, true, false});
-        lobe_ = pipeline(pass, format, {"mesh.vert", "mesh.frag", true, VK_CULL_MODE_NONE, true, false, true});
+        VkVertexInputBindingDescription vertex_binding{0, sizeof(Vertex), VK_VERTEX_INPUT_RATE_VERTEX};
+        const VkVertexInputAttributeDescription attributes[3] = {
+            {0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, position)},
+            {1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, normal)},
+            {2, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, uv)},
+        };
+        auto mesh = vk_struct<VkPipelineVertexInputStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO);
+        mesh.vertexBindingDescriptionCount = 1;
+        mesh.pVertexBindingDescriptions = &vertex_binding;
+        mesh.vertexAttributeDescriptionCount = 3;
+        mesh.pVertexAttributeDescriptions = attributes;
+        auto make = [&](const PipelineState& state) { return create_pipeline(dev, pass, format, layout_, state); };
+        sky_ = make({"sky.vert", "sky.frag", nullptr, VK_CULL_MODE_NONE, false, false, false});
+        ground_pipeline_ = make({"ground.vert", "ground.frag", nullptr, VK_CULL_MODE_NONE, true, true, false});
+        opaque_ = make({"mesh.vert", "mesh.frag", &mesh, VK_CULL_MODE_BACK_BIT, true, true, false});
+        leaf_ = make({"mesh.vert", "mesh.frag", &mesh, VK_CULL_MODE_NONE, true, true, false});
+        lobe_ = make({"mesh.vert", "mesh.frag", &mesh, VK_CULL_MODE_NONE, true, false, true});
     }
 
     void destroy()
@@ -1035,12 +1146,416 @@ private:
     GpuImage texture_;
     std::uint64_t texture_version_ = 0;
     bool texture_ready_ = false;
+    bool texture_is_real_ = false;
     std::unordered_map<std::uint64_t, GpuMesh> cache_;
     std::vector<std::uint64_t> draws_; // keys in scene order
     bool ground_ = true;
     float ground_y_ = 0.0f;
     Bounds bounds_;
 };
+
+// ---------------------------------------------------------------------------------------------
+/// The 2D overlay (app/shaders/ui.*): its pipeline, font texture, host-visible vertex and index
+/// buffers (grown geometrically, reused across frames) and the commands of the last
+/// set_overlay. Every submit of the renderer is waited for, so set() may write the buffers.
+class OverlayDrawer {
+public:
+    OverlayDrawer(const VulkanContext& ctx, VkRenderPass pass, const FrameFormat& format, VkDescriptorSetLayout set_layout,
+                  VkSampler sampler)
+        : ctx_(ctx), sampler_(sampler)
+    {
+        try {
+            create(pass, format, set_layout);
+        } catch (...) {
+            destroy();
+            throw;
+        }
+    }
+    ~OverlayDrawer() { destroy(); }
+    OverlayDrawer(const OverlayDrawer&) = delete;
+    OverlayDrawer& operator=(const OverlayDrawer&) = delete;
+
+    /// Checks everything first: a bad overlay throws InvalidInput and leaves the last one.
+    void set(const Overlay& overlay)
+    {
+        const std::uint64_t nv = overlay.vertices.size(), ni = overlay.indices.size();
+        for (std::size_t c = 0; c < overlay.commands.size(); ++c) {
+            const OverlayCommand& cmd = overlay.commands[c];
+            const std::string which = "render: overlay command " + std::to_string(c);
+            const std::uint64_t first = cmd.first_index, end = first + cmd.index_count;
+            if (end > ni)
+                throw InvalidInput(which + " draws indices " + std::to_string(first) + " to " + std::to_string(end) + " of " +
+                                   std::to_string(ni));
+            for (float v : cmd.clip)
+                if (!std::isfinite(v)) throw InvalidInput(which + " has a clip rectangle that is not finite");
+            for (std::uint64_t i = first; i < end; ++i) {
+                const std::int64_t v = std::int64_t(overlay.indices[i]) + cmd.vertex_offset;
+                if (v < 0 || std::uint64_t(v) >= nv)
+                    throw InvalidInput(which + ": index " + std::to_string(overlay.indices[i]) + " + vertex offset " +
+                                       std::to_string(cmd.vertex_offset) + " is outside the " + std::to_string(nv) +
+                                       " vertices");
+            }
+        }
+        const bool has_font = check_rgba(overlay.font, "an overlay font");
+
+        const std::uint64_t font_version = has_font ? overlay.font_version : 0;
+        if (!font_ready_ || has_font != font_is_real_ || font_version != font_version_) {
+            GpuImage fresh = upload_rgba_texture(ctx_, has_font ? overlay.font : kWhiteTexel);
+            ctx_.destroy(font_);
+            font_ = fresh;
+            write_texture_descriptor(ctx_.device(), descriptor_set_, sampler_, font_);
+            font_version_ = font_version;
+            font_is_real_ = has_font;
+            font_ready_ = true;
+        }
+        commands_.clear();
+        if (overlay.commands.empty()) return;
+        static_assert(sizeof(OverlayVertex) == 20 && offsetof(OverlayVertex, u) == 8 && offsetof(OverlayVertex, rgba) == 16);
+        const std::size_t vertex_bytes = overlay.vertices.size() * sizeof(OverlayVertex);
+        const std::size_t index_bytes = overlay.indices.size() * sizeof(std::uint32_t);
+        reserve(vertices_, vertex_bytes, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+        reserve(indices_, index_bytes, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
+        ctx_.write(vertices_, 0, overlay.vertices.data(), vertex_bytes);
+        ctx_.write(indices_, 0, overlay.indices.data(), index_bytes);
+        commands_ = overlay.commands;
+    }
+
+    /// The overlay's draws, inside a begun render pass of `extent` (after the scene's).
+    void record(VkCommandBuffer cmd, VkExtent2D extent) const
+    {
+        if (commands_.empty()) return;
+        const float w = float(extent.width), h = float(extent.height);
+        VkViewport viewport{0.0f, 0.0f, w, h, 0.0f, 1.0f};
+        vkCmdSetViewport(cmd, 0, 1, &viewport);
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline_);
+        vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, layout_, 0, 1, &descriptor_set_, 0, nullptr);
+        const VkDeviceSize offset = 0;
+        vkCmdBindVertexBuffers(cmd, 0, 1, &vertices_.buffer, &offset);
+        vkCmdBindIndexBuffer(cmd, indices_.buffer, 0, VK_INDEX_TYPE_UINT32);
+        // Pixels (origin top-left, y down) to Vulkan's NDC (-1 at the top-left, y down).
+        const float push[4] = {2.0f / w, 2.0f / h, -1.0f, -1.0f};
+        vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(push), push);
+        // A pixel is drawn when its centre lies in the clip rectangle: pixels ceil(x0 - 0.5) to
+        // ceil(x1 - 0.5) (exclusive), clamped to the frame.
+        auto edge = [](float v, std::uint32_t size) {
+            return static_cast<std::uint32_t>(std::clamp(std::ceil(double(v) - 0.5), 0.0, double(size)));
+        };
+        for (const OverlayCommand& c : commands_) {
+            if (c.index_count == 0) continue;
+            const std::uint32_t x0 = edge(c.clip[0], extent.width), y0 = edge(c.clip[1], extent.height);
+            const std::uint32_t x1 = edge(c.clip[2], extent.width), y1 = edge(c.clip[3], extent.height);
+            if (x1 <= x0 || y1 <= y0) continue;
+            const VkRect2D scissor{{std::int32_t(x0), std::int32_t(y0)}, {x1 - x0, y1 - y0}};
+            vkCmdSetScissor(cmd, 0, 1, &scissor);
+            vkCmdDrawIndexed(cmd, c.index_count, 1, c.first_index, c.vertex_offset, 0);
+        }
+        const VkRect2D full{{0, 0}, extent};
+        vkCmdSetScissor(cmd, 0, 1, &full);
+    }
+
+private:
+    /// Makes `b` hold at least `bytes`, growing it to twice its size (or more) when it must.
+    void reserve(GpuBuffer& b, std::size_t bytes, VkBufferUsageFlags usage) const
+    {
+        if (b.buffer && b.size >= bytes) return;
+        const VkDeviceSize size = std::max<VkDeviceSize>({VkDeviceSize(bytes), 2 * b.size, 4096});
+        ctx_.destroy(b);
+        b = ctx_.create_buffer(size, usage, 0);
+    }
+
+    void create(VkRenderPass pass, const FrameFormat& format, VkDescriptorSetLayout set_layout)
+    {
+        const VkDevice dev = ctx_.device();
+        VkPushConstantRange range{VK_SHADER_STAGE_VERTEX_BIT, 0, 4 * sizeof(float)};
+        auto layout = vk_struct<VkPipelineLayoutCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO);
+        layout.setLayoutCount = 1;
+        layout.pSetLayouts = &set_layout;
+        layout.pushConstantRangeCount = 1;
+        layout.pPushConstantRanges = &range;
+        CHECK_VKCMD(vkCreatePipelineLayout(dev, &layout, nullptr, &layout_));
+        VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1};
+        auto pool = vk_struct<VkDescriptorPoolCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO);
+        pool.maxSets = 1;
+        pool.poolSizeCount = 1;
+        pool.pPoolSizes = &size;
+        CHECK_VKCMD(vkCreateDescriptorPool(dev, &pool, nullptr, &descriptor_pool_));
+        auto alloc = vk_struct<VkDescriptorSetAllocateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO);
+        alloc.descriptorPool = descriptor_pool_;
+        alloc.descriptorSetCount = 1;
+        alloc.pSetLayouts = &set_layout;
+        CHECK_VKCMD(vkAllocateDescriptorSets(dev, &alloc, &descriptor_set_));
+
+        VkVertexInputBindingDescription binding{0, sizeof(OverlayVertex), VK_VERTEX_INPUT_RATE_VERTEX};
+        const VkVertexInputAttributeDescription attributes[3] = {
+            {0, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(OverlayVertex, x)},
+            {1, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(OverlayVertex, u)},
+            {2, 0, VK_FORMAT_R8G8B8A8_UNORM, offsetof(OverlayVertex, rgba)}, // bytes R, G, B, A
+        };
+        auto input = vk_struct<VkPipelineVertexInputStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO);
+        input.vertexBindingDescriptionCount = 1;
+        input.pVertexBindingDescriptions = &binding;
+        input.vertexAttributeDescriptionCount = 3;
+        input.pVertexAttributeDescriptions = attributes;
+        pipeline_ = create_pipeline(dev, pass, format, layout_, {"ui.vert", "ui.frag", &input, VK_CULL_MODE_NONE, false, false, true});
+    }
+
+    void destroy()
+    {
+        const VkDevice dev = ctx_.device();
+        ctx_.destroy(vertices_);
+        ctx_.destroy(indices_);
+        ctx_.destroy(font_);
+        if (pipeline_) vkDestroyPipeline(dev, pipeline_, nullptr);
+        if (descriptor_pool_) vkDestroyDescriptorPool(dev, descriptor_pool_, nullptr);
+        if (layout_) vkDestroyPipelineLayout(dev, layout_, nullptr);
+    }
+
+    const VulkanContext& ctx_;
+    VkSampler sampler_;
+    VkPipelineLayout layout_ = VK_NULL_HANDLE;
+    VkPipeline pipeline_ = VK_NULL_HANDLE;
+    VkDescriptorPool descriptor_pool_ = VK_NULL_HANDLE;
+    VkDescriptorSet descriptor_set_ = VK_NULL_HANDLE;
+    GpuImage font_;
+    std::uint64_t font_version_ = 0;
+    bool font_ready_ = false;
+    bool font_is_real_ = false;
+    GpuBuffer vertices_, indices_;
+    std::vector<OverlayCommand> commands_;
+};
+
+// ---------------------------------------------------------------------------------------------
+/// A window's surface and swapchain (FIFO). Frames are drawn offscreen and blitted (copied
+/// when the swapchain's format cannot be blitted into but is the picture's own) into the
+/// acquired image. One image-acquired semaphore (each frame's submit is waited for, so it is
+/// free again at the next acquire) and one render-done semaphore per swapchain image (the
+/// presentation engine has consumed it once the image is acquired again).
+class WindowTarget {
+public:
+    /// Takes ownership of `surface` (destroyed here, also when this throws).
+    WindowTarget(const VulkanContext& ctx, VkSurfaceKHR surface) : ctx_(ctx), surface_(surface)
+    {
+        try {
+            VkBool32 supported = VK_FALSE;
+            CHECK_VKCMD(vkGetPhysicalDeviceSurfaceSupportKHR(ctx.physical(), ctx.queue_family(), surface_, &supported));
+            if (!supported)
+                throw RenderUnavailable("render: the Vulkan device '" + ctx.name() + "' cannot present to this window (queue family " +
+                                        std::to_string(ctx.queue_family()) + " has no present support)");
+            auto info = vk_struct<VkSemaphoreCreateInfo>(VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO);
+            CHECK_VKCMD(vkCreateSemaphore(ctx.device(), &info, nullptr, &acquired_));
+        } catch (...) {
+            destroy();
+            throw;
+        }
+    }
+    ~WindowTarget() { destroy(); }
+    WindowTarget(const WindowTarget&) = delete;
+    WindowTarget& operator=(const WindowTarget&) = delete;
+
+    VkSemaphore acquired() const { return acquired_; }
+    VkSemaphore rendered(std::uint32_t image) const { return rendered_[image]; }
+
+    /// Acquires the next image for a frame of `wanted` pixels, making or remaking the
+    /// swapchain first when the size changed or the last acquire or present said it is out of
+    /// date or suboptimal. False when there is none (the surface is 0 × 0, or none came in
+    /// time); `acquired()` is then not signalled.
+    bool acquire(VkExtent2D wanted, std::uint32_t* image)
+    {
+        for (int attempt = 0; attempt < 2; ++attempt) {
+            if (!swapchain_ || stale_ || wanted.width != wanted_.width || wanted.height != wanted_.height)
+                if (!create_swapchain(wanted)) return false;
+            const VkResult r = vkAcquireNextImageKHR(ctx_.device(), swapchain_, kAcquireTimeoutNs, acquired_, VK_NULL_HANDLE, image);
+            if (r == VK_SUCCESS) return true;
+            if (r == VK_SUBOPTIMAL_KHR) { // acquired (the semaphore will be signalled): use it, remake next frame
+                stale_ = true;
+                return true;
+            }
+            if (r == VK_TIMEOUT || r == VK_NOT_READY) return false;
+            if (r != VK_ERROR_OUT_OF_DATE_KHR) vk::throw_vk_error(r, "vkAcquireNextImageKHR(...)", __FILE__, __LINE__);
+            stale_ = true; // out of date: remake and try once more
+        }
+        return false;
+    }
+
+    /// After the render pass: `picture` (TRANSFER_SRC_OPTIMAL, `size`) into swapchain image
+    /// `image`, left in PRESENT_SRC_KHR.
+    void record_blit(VkCommandBuffer cmd, VkImage picture, VkExtent2D size, std::uint32_t image) const
+    {
+        auto barrier = vk_struct<VkImageMemoryBarrier>(VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER);
+        barrier.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        barrier.image = images_[image];
+        barrier.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+        barrier.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+        barrier.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+        barrier.srcAccessMask = 0;
+        barrier.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+        // TRANSFER is the stage the submit waits for the image-acquired semaphore at.
+        vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0, nullptr, 1,
+                             &barrier);
+        if (blit_) {
+            VkImageBlit region{};
+            region.srcSubresource = region.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+            region.srcOffsets[1] = {std::int32_t(size.width), std::int32_t(size.height), 1};
+            region.dstOffsets[1] = {std::int32_t(extent_.width), std::int32_t(extent_.height), 1};
+            const bool same = size.width == extent_.width && size.height == extent_.height;
+            vkCmdBlitImage(cmd, picture, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, images_[image], VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                           1, &region, same ? VK_FILTER_NEAREST : filter_);
+        } else {
+            VkImageCopy region{};
+            region.srcSubresource = region.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+            region.extent = {std::min(size.width, extent_.width), std::min(size.height, extent_.height), 1};
+            vkCmdCopyImage(cmd, picture, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, images_[image], VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
+                           &region);
+        }
+        barrier.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+        barrier.newLayout = VK_IMAGE_LAYOUT_PRESENT_SRC_KHR;
+        barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+        barrier.dstAccessMask = 0;
+        vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, 0, 0, nullptr, 0, nullptr, 1,
+                             &barrier);
+    }
+
+    /// Queues image `image` for presentation after its render-done semaphore.
+    void present(std::uint32_t image)
+    {
+        auto info = vk_struct<VkPresentInfoKHR>(VK_STRUCTURE_TYPE_PRESENT_INFO_KHR);
+        info.waitSemaphoreCount = 1;
+        info.pWaitSemaphores = &rendered_[image];
+        info.swapchainCount = 1;
+        info.pSwapchains = &swapchain_;
+        info.pImageIndices = &image;
+        const VkResult r = vkQueuePresentKHR(ctx_.queue(), &info);
+        if (r == VK_SUBOPTIMAL_KHR || r == VK_ERROR_OUT_OF_DATE_KHR)
+            stale_ = true;
+        else
+            CHECK_VKCMD(r);
+    }
+
+private:
+    static constexpr std::uint64_t kAcquireTimeoutNs = 2'000'000'000; // 2 s: a window that never gives an image draws nothing
+
+    /// The swapchain for a frame of `wanted` pixels (the surface's own size when it has one);
+    /// false, with no swapchain, when the surface is 0 × 0.
+    bool create_swapchain(VkExtent2D wanted)
+    {
+        const VkDevice dev = ctx_.device();
+        VkSurfaceCapabilitiesKHR caps;
+        CHECK_VKCMD(vkGetPhysicalDeviceSurfaceCapabilitiesKHR(ctx_.physical(), surface_, &caps));
+        VkExtent2D extent = caps.currentExtent;
+        if (extent.width == 0xFFFFFFFFu)
+            extent = {std::clamp(wanted.width, caps.minImageExtent.width, caps.maxImageExtent.width),
+                      std::clamp(wanted.height, caps.minImageExtent.height, caps.maxImageExtent.height)};
+        if (extent.width == 0 || extent.height == 0) return false;
+        if (!(caps.supportedUsageFlags & VK_IMAGE_USAGE_TRANSFER_DST_BIT))
+            throw RenderUnavailable("render: the window's swapchain images of '" + ctx_.name() +
+                                    "' cannot be written by transfers (no TRANSFER_DST usage)");
+        std::uint32_t n = 0;
+        CHECK_VKCMD(vkGetPhysicalDeviceSurfaceFormatsKHR(ctx_.physical(), surface_, &n, nullptr));
+        std::vector<VkSurfaceFormatKHR> formats(n);
+        if (n) CHECK_VKCMD(vkGetPhysicalDeviceSurfaceFormatsKHR(ctx_.physical(), surface_, &n, formats.data()));
+        formats.resize(n);
+        if (formats.empty()) throw RenderError("render: the window's surface offers no format");
+        VkSurfaceFormatKHR format = formats[0];
+        if (format.format == VK_FORMAT_UNDEFINED) format = {VK_FORMAT_B8G8R8A8_SRGB, VK_COLOR_SPACE_SRGB_NONLINEAR_KHR};
+        for (VkFormat preferred : {VK_FORMAT_R8G8B8A8_SRGB, VK_FORMAT_B8G8R8A8_SRGB}) // the last found wins: B8G8R8A8 first
+            for (const VkSurfaceFormatKHR& f : formats)
+                if (f.format == preferred && f.colorSpace == VK_COLOR_SPACE_SRGB_NONLINEAR_KHR) format = f;
+        VkFormatProperties src, dst;
+        vkGetPhysicalDeviceFormatProperties(ctx_.physical(), kColorFormat, &src);
+        vkGetPhysicalDeviceFormatProperties(ctx_.physical(), format.format, &dst);
+        blit_ = (src.optimalTilingFeatures & VK_FORMAT_FEATURE_BLIT_SRC_BIT) && (dst.optimalTilingFeatures & VK_FORMAT_FEATURE_BLIT_DST_BIT);
+        filter_ = (src.optimalTilingFeatures & VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT) ? VK_FILTER_LINEAR : VK_FILTER_NEAREST;
+        if (!blit_ && format.format != kColorFormat)
+            throw RenderUnavailable("render: the Vulkan device '" + ctx_.name() + "' cannot blit into the window's format (" +
+                                    std::to_string(int(format.format)) + ")");
+
+        std::uint32_t count = caps.minImageCount + 1;
+        if (caps.maxImageCount > 0) count = std::min(count, caps.maxImageCount);
+        VkCompositeAlphaFlagBitsKHR alpha = VK_COMPOSITE_ALPHA_OPAQUE_BIT_KHR;
+        if (!(caps.supportedCompositeAlpha & alpha))
+            for (std::uint32_t bit = 1; bit <= VK_COMPOSITE_ALPHA_INHERIT_BIT_KHR; bit <<= 1)
+                if (caps.supportedCompositeAlpha & bit) {
+                    alpha = static_cast<VkCompositeAlphaFlagBitsKHR>(bit);
+                    break;
+                }
+        auto info = vk_struct<VkSwapchainCreateInfoKHR>(VK_STRUCTURE_TYPE_SWAPCHAIN_CREATE_INFO_KHR);
+        info.surface = surface_;
+        info.minImageCount = count;
+        info.imageFormat = format.format;
+        info.imageColorSpace = format.colorSpace;
+        info.imageExtent = extent;
+        info.imageArrayLayers = 1;
+        info.imageUsage = VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+        info.imageSharingMode = VK_SHARING_MODE_EXCLUSIVE;
+        info.preTransform = (caps.supportedTransforms & VK_SURFACE_TRANSFORM_IDENTITY_BIT_KHR) ? VK_SURFACE_TRANSFORM_IDENTITY_BIT_KHR
+                                                                                               : caps.currentTransform;
+        info.compositeAlpha = alpha;
+        info.presentMode = VK_PRESENT_MODE_FIFO_KHR;
+        info.clipped = VK_TRUE;
+        info.oldSwapchain = swapchain_;
+        // Every frame's submit was waited for; the presentation engine may still read the old
+        // images until the device is idle.
+        CHECK_VKCMD(vkDeviceWaitIdle(dev));
+        VkSwapchainKHR fresh = VK_NULL_HANDLE;
+        const VkResult created = vkCreateSwapchainKHR(dev, &info, nullptr, &fresh);
+        destroy_swapchain();
+        CHECK_VKCMD(created);
+        swapchain_ = fresh;
+        CHECK_VKCMD(vkGetSwapchainImagesKHR(dev, swapchain_, &n, nullptr));
+        images_.resize(n);
+        CHECK_VKCMD(vkGetSwapchainImagesKHR(dev, swapchain_, &n, images_.data()));
+        rendered_.assign(n, VK_NULL_HANDLE);
+        auto semaphore = vk_struct<VkSemaphoreCreateInfo>(VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO);
+        for (VkSemaphore& s : rendered_) CHECK_VKCMD(vkCreateSemaphore(dev, &semaphore, nullptr, &s));
+        extent_ = extent;
+        wanted_ = wanted;
+        stale_ = false;
+        return true;
+    }
+
+    void destroy_swapchain()
+    {
+        for (VkSemaphore s : rendered_)
+            if (s) vkDestroySemaphore(ctx_.device(), s, nullptr);
+        rendered_.clear();
+        images_.clear();
+        if (swapchain_) vkDestroySwapchainKHR(ctx_.device(), swapchain_, nullptr);
+        swapchain_ = VK_NULL_HANDLE;
+    }
+
+    void destroy()
+    {
+        vkDeviceWaitIdle(ctx_.device());
+        destroy_swapchain();
+        if (acquired_) vkDestroySemaphore(ctx_.device(), acquired_, nullptr);
+        acquired_ = VK_NULL_HANDLE;
+        if (surface_) vkDestroySurfaceKHR(ctx_.instance(), surface_, nullptr);
+        surface_ = VK_NULL_HANDLE;
+    }
+
+    const VulkanContext& ctx_;
+    VkSurfaceKHR surface_ = VK_NULL_HANDLE;
+    VkSwapchainKHR swapchain_ = VK_NULL_HANDLE;
+    std::vector<VkImage> images_;
+    std::vector<VkSemaphore> rendered_;
+    VkSemaphore acquired_ = VK_NULL_HANDLE;
+    VkExtent2D extent_{0, 0}, wanted_{0, 0};
+    bool stale_ = false;
+    bool blit_ = true;
+    VkFilter filter_ = VK_FILTER_LINEAR;
+};
+
+/// A non-dispatchable handle from an integer, e.g. the VkSurfaceKHR attach_window's callback
+/// returns (a pointer on 64-bit builds, a 64-bit integer on 32-bit ones).
+template <class Handle>
+Handle handle_from_integer(std::uint64_t v)
+{
+    if constexpr (std::is_pointer_v<Handle>)
+        return reinterpret_cast<Handle>(static_cast<std::uintptr_t>(v));
+    else
+        return static_cast<Handle>(v);
+}
 
 } // namespace
 
@@ -1053,25 +1568,68 @@ struct Renderer::Impl {
         try {
             drawer = std::make_unique<SceneDrawer>(ctx, pass, format);
             drawer->set_scene(RenderScene{}, stats);
+            overlay = std::make_unique<OverlayDrawer>(ctx, pass, format, drawer->texture_set_layout(), drawer->sampler());
+            overlay->set(Overlay{});
         } catch (...) {
+            overlay.reset();
             drawer.reset();
             vkDestroyRenderPass(ctx.device(), pass, nullptr);
             throw;
         }
     }
+    // Device idle, then the window (swapchain, surface), the targets, the drawers and the
+    // pass; the context (device, then instance) goes last.
     ~Impl()
     {
         vkDeviceWaitIdle(ctx.device());
+        window.reset();
+        last = nullptr;
         target.reset();
+        window_frame.reset();
+        overlay.reset();
         drawer.reset();
         vkDestroyRenderPass(ctx.device(), pass, nullptr);
+    }
+
+    /// `t` made for `extent` (remade when its size differs).
+    OffscreenTarget& target_of(std::unique_ptr<OffscreenTarget>& t, VkExtent2D extent)
+    {
+        if (!t || t->extent().width != extent.width || t->extent().height != extent.height) {
+            if (last == t.get()) last = nullptr;
+            t.reset();
+            t = std::make_unique<OffscreenTarget>(ctx, pass, format, extent);
+        }
+        return *t;
+    }
+
+    /// The scene and the overlay into `t`'s render pass (clear, draw, resolve).
+    void record_frame(VkCommandBuffer cmd, const OffscreenTarget& t, const Camera& camera) const
+    {
+        const VkExtent2D extent = t.extent();
+        VkClearValue clears[3]{};
+        clears[0].color = {{0.0f, 0.0f, 0.0f, 1.0f}};
+        clears[1].depthStencil = {1.0f, 0};
+        auto begin = vk_struct<VkRenderPassBeginInfo>(VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO);
+        begin.renderPass = pass;
+        begin.framebuffer = t.framebuffer();
+        begin.renderArea = {{0, 0}, extent};
+        begin.clearValueCount = multisampled(format) ? 3u : 2u;
+        begin.pClearValues = clears;
+        vkCmdBeginRenderPass(cmd, &begin, VK_SUBPASS_CONTENTS_INLINE);
+        drawer->record(cmd, camera, extent);
+        overlay->record(cmd, extent);
+        vkCmdEndRenderPass(cmd);
     }
 
     VulkanContext ctx;
     FrameFormat format;
     VkRenderPass pass = VK_NULL_HANDLE;
     std::unique_ptr<SceneDrawer> drawer;
-    std::unique_ptr<OffscreenTarget> target;
+    std::unique_ptr<OverlayDrawer> overlay;
+    std::unique_ptr<OffscreenTarget> target;       // render()'s pictures
+    std::unique_ptr<OffscreenTarget> window_frame; // present()'s frames, so screenshots of another size do not remake it
+    std::unique_ptr<WindowTarget> window;
+    OffscreenTarget* last = nullptr; // the target of the last frame drawn (last_frame())
     RenderStats stats;
 };
 
@@ -1085,37 +1643,79 @@ const RenderStats& Renderer::stats() const { return impl_->stats; }
 
 void Renderer::set_scene(const RenderScene& scene) { impl_->drawer->set_scene(scene, impl_->stats); }
 
-RgbaImage Renderer::render(const Camera& camera, int width, int height)
+namespace {
+
+void check_size(int width, int height, const char* what)
 {
     if (width < 1 || height < 1 || width > 16384 || height > 16384)
-        throw InvalidInput("render: a picture of " + std::to_string(width) + "x" + std::to_string(height) +
+        throw InvalidInput(std::string("render: ") + what + " of " + std::to_string(width) + "x" + std::to_string(height) +
                            " pixels (1 to 16384 on each side)");
+}
+
+} // namespace
+
+RgbaImage Renderer::render(const Camera& camera, int width, int height)
+{
+    check_size(width, height, "a picture");
     Impl& im = *impl_;
-    const VkExtent2D extent{static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height)};
-    if (!im.target || im.target->extent().width != extent.width || im.target->extent().height != extent.height) {
-        im.target.reset();
-        im.target = std::make_unique<OffscreenTarget>(im.ctx, im.pass, im.format, extent);
-    }
+    OffscreenTarget& target =
+        im.target_of(im.target, {static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height)});
     im.ctx.submit_and_wait(
         [&](VkCommandBuffer cmd) {
-            VkClearValue clears[3]{};
-            clears[0].color = {{0.0f, 0.0f, 0.0f, 1.0f}};
-            clears[1].depthStencil = {1.0f, 0};
-            auto begin = vk_struct<VkRenderPassBeginInfo>(VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO);
-            begin.renderPass = im.pass;
-            begin.framebuffer = im.target->framebuffer();
-            begin.renderArea = {{0, 0}, extent};
-            begin.clearValueCount = multisampled(im.format) ? 3u : 2u;
-            begin.pClearValues = clears;
-            vkCmdBeginRenderPass(cmd, &begin, VK_SUBPASS_CONTENTS_INLINE);
-            im.drawer->record(cmd, camera, extent);
-            vkCmdEndRenderPass(cmd);
-            im.target->record_copy_out(cmd);
+            im.record_frame(cmd, target, camera);
+            target.record_copy_out(cmd);
         },
         &im.stats.record_ms, &im.stats.gpu_ms);
-    RgbaImage out = im.target->read();
-    for (std::size_t i = 3; i < out.pixels.size(); i += 4) out.pixels[i] = 255;
-    return out;
+    target.drawn = true;
+    im.last = &target;
+    return target.read();
+}
+
+void Renderer::set_overlay(const Overlay& overlay) { impl_->overlay->set(overlay); }
+
+void Renderer::attach_window(const std::function<std::uint64_t(std::uint64_t vk_instance)>& create_surface)
+{
+    Impl& im = *impl_;
+    if (!im.ctx.presentation())
+        throw RenderError("render: attach_window needs a Renderer made with RendererOptions::presentation = true");
+    if (!im.ctx.instance_extension_enabled(VK_KHR_SURFACE_EXTENSION_NAME))
+        throw RenderError("render: attach_window needs the instance extension " VK_KHR_SURFACE_EXTENSION_NAME
+                          " (pass glfwGetRequiredInstanceExtensions in RendererOptions::instance_extensions)");
+    im.window.reset(); // a window has one surface at a time: the old one goes first
+    const std::uint64_t surface = create_surface(reinterpret_cast<std::uint64_t>(im.ctx.instance()));
+    if (!surface) throw RenderError("render: the window's Vulkan surface could not be made (create_surface returned 0)");
+    im.window = std::make_unique<WindowTarget>(im.ctx, handle_from_integer<VkSurfaceKHR>(surface));
+}
+
+bool Renderer::present(const Camera& camera, int width, int height)
+{
+    Impl& im = *impl_;
+    if (!im.window) throw RenderError("render: present needs a window (call attach_window first)");
+    if (width == 0 || height == 0) return false; // minimised
+    check_size(width, height, "a window frame");
+    const VkExtent2D extent{static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height)};
+    OffscreenTarget& target = im.target_of(im.window_frame, extent);
+    std::uint32_t image = 0;
+    if (!im.window->acquire(extent, &image)) return false;
+    im.ctx.submit_and_wait(
+        [&](VkCommandBuffer cmd) {
+            im.record_frame(cmd, target, camera);
+            im.window->record_blit(cmd, target.picture(), extent, image);
+        },
+        &im.stats.record_ms, &im.stats.gpu_ms, {im.window->acquired(), VK_PIPELINE_STAGE_TRANSFER_BIT, im.window->rendered(image)});
+    target.drawn = true;
+    im.last = &target;
+    im.window->present(image);
+    return true;
+}
+
+RgbaImage Renderer::last_frame()
+{
+    Impl& im = *impl_;
+    if (!im.last || !im.last->drawn) return {};
+    OffscreenTarget& target = *im.last;
+    im.ctx.submit_and_wait([&](VkCommandBuffer cmd) { target.record_copy_out(cmd); });
+    return target.read();
 }
 
 } // namespace lobe

@@ -9,9 +9,21 @@
 /// renderer.set_scene(scene);               // uploads only the meshes whose version changed
 /// RgbaImage png_pixels = renderer.render(frame_view(scene_bounds(scene), front_view(), 16.0f / 9.0f), 1280, 720);
 /// ```
+///
+/// In a window (GLFW; the window must outlive the Renderer, which owns the surface):
+/// ```cpp
+/// RendererOptions o;
+/// o.presentation = true;
+/// o.instance_extensions = {names from glfwGetRequiredInstanceExtensions};
+/// Renderer renderer(o);
+/// renderer.attach_window([&](std::uint64_t instance) { /* glfwCreateWindowSurface */ return surface; });
+/// renderer.set_overlay(panel);             // optional 2D triangles over the scene (Dear ImGui)
+/// renderer.present(camera, fb_width, fb_height);  // false when minimised (0 × 0)
+/// ```
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -101,9 +113,40 @@ ViewAngles top_view();   ///< looks down −Y; −Z is up in the picture
 Camera frame_view(const Bounds& bounds, const ViewAngles& view, float aspect, float fov_y_deg = 30.0f,
                   float margin = 0.06f);
 
+/// One vertex of the 2D overlay: window pixels (origin top-left, y down), texture coordinates
+/// into Overlay::font, and a colour, sRGB, bytes R, G, B, A in memory (Dear ImGui's IM_COL32).
+struct OverlayVertex {
+    float x = 0, y = 0, u = 0, v = 0;
+    std::uint32_t rgba = 0xffffffffu;
+};
+
+/// One draw of the overlay: indices [first_index, first_index + index_count) of
+/// Overlay::indices, each plus vertex_offset naming a vertex; only pixels whose centre lies in
+/// clip = x0, y0, x1, y1 (pixels, clamped to the frame) are drawn.
+struct OverlayCommand {
+    std::uint32_t first_index = 0, index_count = 0;
+    std::int32_t vertex_offset = 0;
+    float clip[4]{};
+};
+
+/// 2D triangles drawn over the 3D scene, in window pixels (origin top-left, y down), e.g. a
+/// Dear ImGui panel's draw data converted by the caller. Alpha blended, no depth, in order.
+struct Overlay {
+    std::vector<OverlayVertex> vertices;
+    std::vector<std::uint32_t> indices;
+    std::vector<OverlayCommand> commands;
+    RgbaImage font;                 ///< RGBA8 atlas the uvs index (sRGB colours, linear alpha); empty: one white texel
+    std::uint64_t font_version = 0; ///< re-uploaded only when this (or whether there is a font) changes
+};
+
 struct RendererOptions {
     int samples = 4;             ///< MSAA samples (1, 2, 4, 8); lowered to what the device supports
     bool prefer_software = false; ///< pick the CPU device (lavapipe) even when a GPU is present
+    /// Instance extensions to enable, e.g. what glfwGetRequiredInstanceExtensions names
+    /// (VK_KHR_surface and the platform's surface extension).
+    std::vector<std::string> instance_extensions;
+    /// Enable VK_KHR_swapchain: only devices that have it are chosen. Needed by attach_window.
+    bool presentation = false;
 };
 
 /// How much GPU upload the last set_scene did, and what the last render took.
@@ -112,16 +155,18 @@ struct RenderStats {
     std::size_t meshes_kept = 0;     ///< cached meshes the last set_scene did not touch
     std::size_t bytes_uploaded = 0;  ///< by the last set_scene (vertices, indices, texture)
     double record_ms = 0.0;          ///< CPU time recording the last frame's command buffer
-    double gpu_ms = 0.0;             ///< submit to fence of the last frame (drawing, resolve, copy)
+    double gpu_ms = 0.0;             ///< submit to fence of the last frame (drawing, resolve, copy or blit)
 };
 
 /// A Vulkan renderer with an offscreen target. Not thread-safe: one thread uses it.
 class Renderer {
 public:
     /// Creates the Vulkan instance and device: the first discrete GPU, else an integrated
-    /// one, else any other, else the CPU (lavapipe). Sets XDG_RUNTIME_DIR to a private temp
-    /// folder when it is unset (lavapipe warns without it).
-    /// \throw RenderUnavailable when no instance or no device can be made; RenderError.
+    /// one, else any other, else the CPU (lavapipe); with `presentation`, only among devices
+    /// with VK_KHR_swapchain. Sets XDG_RUNTIME_DIR to a private temp folder when it is unset
+    /// (lavapipe warns without it).
+    /// \throw RenderUnavailable when no instance or no device can be made, an instance
+    /// extension is missing, or `presentation` and no device can present; RenderError.
     explicit Renderer(const RendererOptions& options = {});
     ~Renderer();
     Renderer(const Renderer&) = delete;
@@ -141,6 +186,38 @@ public:
     /// back: RGBA8, sRGB-encoded, rows top to bottom, alpha 255.
     /// \throw InvalidInput for a size outside 1..16384; RenderError.
     RgbaImage render(const Camera& camera, int width, int height);
+
+    /// Makes `overlay` the 2D layer drawn over the scene by render() and present() (copied to
+    /// host-visible GPU buffers now; the font only when its version changes). An empty overlay
+    /// (no commands) draws nothing.
+    /// \throw InvalidInput (one line; the previous overlay stays) for a command whose indices
+    /// run past `indices`, an index + vertex_offset outside `vertices`, a clip rectangle that is
+    /// not finite, or a font whose byte count is not width × height × 4.
+    void set_overlay(const Overlay& overlay);
+
+    /// Gives the renderer a window to present to. `create_surface` gets the VkInstance as an
+    /// integer and returns a VkSurfaceKHR made on it as an integer (glfwCreateWindowSurface);
+    /// the renderer owns the surface from then on and destroys it (before the instance) when
+    /// destroyed or given another window. The window must outlive the renderer.
+    /// \throw RenderError when the renderer was made without `presentation` or VK_KHR_surface,
+    /// or the callback returns 0; RenderUnavailable when the device's queue cannot present to
+    /// the surface (the surface is destroyed).
+    void attach_window(const std::function<std::uint64_t(std::uint64_t vk_instance)>& create_surface);
+
+    /// Draws the scene and the overlay exactly as render() does (into a width × height
+    /// offscreen MSAA target, resolved), blits it into the window's next swapchain image and
+    /// presents it (FIFO: waits for the display's vertical blank when the queue is full).
+    /// Makes or remakes the swapchain when the size changes or the surface says it is out of
+    /// date or suboptimal. Returns false, drawing nothing, when width or height is 0
+    /// (minimised) or no swapchain image could be had; true when a frame was submitted.
+    /// \throw RenderError before attach_window, or when presenting fails; InvalidInput for a
+    /// negative size or one over 16384.
+    bool present(const Camera& camera, int width, int height);
+
+    /// The pixels of the last frame drawn by render() or present() (as render() returns them),
+    /// read back from the offscreen target now; empty before any frame. For screenshots and
+    /// tests: costs nothing until called.
+    RgbaImage last_frame();
 
     const RenderStats& stats() const;
 

@@ -6,10 +6,13 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <type_traits>
 
+#include <dlfcn.h>
 #include <sys/wait.h>
 
 #include "app/edit_hooks.h"
@@ -360,6 +363,379 @@ TEST(RenderScene, FramingKeepsEveryCornerOfTheBoxInsideThePicture)
     EXPECT_NEAR(glm::normalize(frame_view(b, top_view(), 1.0f).target - frame_view(b, top_view(), 1.0f).eye).y, -1.0f, 1e-5f);
 }
 
+// --- the 2D overlay and presenting to a window ---------------------------------------------------
+
+constexpr int kOw = 64, kOh = 48; // overlay pictures: small, the overlay is all they test
+
+/// IM_COL32's layout: bytes R, G, B, A in memory.
+constexpr std::uint32_t rgba32(std::uint32_t r, std::uint32_t g, std::uint32_t b, std::uint32_t a)
+{
+    return r | g << 8 | b << 16 | a << 24;
+}
+
+/// Appends a rectangle [x0, x1) × [y0, y1) as two triangles with its own command.
+void add_quad(Overlay& o, float x0, float y0, float x1, float y1, std::uint32_t color, std::array<float, 4> clip = {0, 0, 1e6f, 1e6f},
+              float u = 0.0f, float v = 0.0f)
+{
+    const auto first = static_cast<std::uint32_t>(o.indices.size());
+    const auto base = static_cast<std::int32_t>(o.vertices.size());
+    for (const auto& [x, y] : {std::pair{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}) o.vertices.push_back({x, y, u, v, color});
+    for (std::uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) o.indices.push_back(i); // relative to the command's vertex_offset
+    OverlayCommand c;
+    c.first_index = first;
+    c.index_count = 6;
+    c.vertex_offset = base;
+    std::copy(clip.begin(), clip.end(), c.clip);
+    o.commands.push_back(c);
+}
+
+/// Sky and ground only, and a camera for them.
+struct OverlayFixture {
+    RenderScene scene;
+    Camera camera = frame_view(Bounds{glm::vec3(-0.5f), glm::vec3(0.5f)}, front_view(), float(kOw) / float(kOh));
+    RgbaImage background; // with no overlay
+    OverlayFixture()
+    {
+        Renderer& r = *shared().renderer;
+        r.set_overlay(Overlay{});
+        r.set_scene(scene);
+        background = r.render(camera, kOw, kOh);
+    }
+    ~OverlayFixture() { shared().renderer->set_overlay(Overlay{}); } // the other tests draw none
+    RgbaImage with(const Overlay& overlay) const
+    {
+        Renderer& r = *shared().renderer;
+        r.set_overlay(overlay);
+        return r.render(camera, kOw, kOh);
+    }
+};
+
+const std::uint8_t* pixel(const RgbaImage& im, int x, int y) { return &im.pixels[(std::size_t(y) * std::size_t(im.width) + std::size_t(x)) * 4]; }
+
+std::uint8_t linear_to_srgb(double c)
+{
+    c = std::clamp(c, 0.0, 1.0);
+    const double e = c <= 0.0031308 ? c * 12.92 : 1.055 * std::pow(c, 1.0 / 2.4) - 0.055;
+    return static_cast<std::uint8_t>(std::lround(e * 255.0));
+}
+
+/// Pixels inside [x0, x1) × [y0, y1) are checked by `inside`; every other one must equal the
+/// background's bytes. Returns how many pixels differ from the background.
+template <class Inside>
+std::size_t check_rect(const RgbaImage& picture, const RgbaImage& background, int x0, int y0, int x1, int y1, Inside inside)
+{
+    std::size_t changed = 0;
+    for (int y = 0; y < picture.height; ++y)
+        for (int x = 0; x < picture.width; ++x) {
+            const std::uint8_t* p = pixel(picture, x, y);
+            const std::uint8_t* b = pixel(background, x, y);
+            changed += !std::equal(p, p + 4, b);
+            if (x >= x0 && x < x1 && y >= y0 && y < y1)
+                inside(p, b, x, y);
+            else
+                EXPECT_TRUE(std::equal(p, p + 4, b)) << "pixel " << x << "," << y << " outside the rectangle changed";
+        }
+    return changed;
+}
+
+TEST(RenderOverlay, AnOpaqueQuadKeepsItsSrgbColourAndNoPixelOutsideItChanges)
+{
+    OverlayFixture f;
+    Overlay o;
+    add_quad(o, 10, 8, 30, 24, rgba32(200, 40, 40, 255));
+    const RgbaImage picture = f.with(o);
+    ASSERT_EQ(picture.width, kOw);
+    ASSERT_EQ(picture.height, kOh);
+    const std::size_t changed = check_rect(picture, f.background, 10, 8, 30, 24, [](const std::uint8_t* p, const std::uint8_t*, int x, int y) {
+        EXPECT_NEAR(int(p[0]), 200, 1) << x << "," << y;
+        EXPECT_NEAR(int(p[1]), 40, 1) << x << "," << y;
+        EXPECT_NEAR(int(p[2]), 40, 1) << x << "," << y;
+        EXPECT_EQ(int(p[3]), 255);
+    });
+    EXPECT_EQ(changed, 20u * 16u);
+}
+
+TEST(RenderOverlay, AHalfTransparentQuadBlendsWithTheSceneInLinearLight)
+{
+    OverlayFixture f;
+    Overlay o;
+    add_quad(o, 4, 20, 60, 44, rgba32(200, 40, 40, 128)); // over sky and ground
+    const RgbaImage picture = f.with(o);
+    const double a = 128.0 / 255.0;
+    const int colour[3] = {200, 40, 40};
+    check_rect(picture, f.background, 4, 20, 60, 44, [&](const std::uint8_t* p, const std::uint8_t* b, int x, int y) {
+        for (int c = 0; c < 3; ++c) {
+            const int expected = linear_to_srgb(a * srgb_to_linear(std::uint8_t(colour[c])) + (1.0 - a) * srgb_to_linear(b[c]));
+            EXPECT_NEAR(int(p[c]), expected, 2) << "channel " << c << " at " << x << "," << y;
+        }
+    });
+}
+
+/// Two commands: an off-screen quad with a clip far beyond the frame (clamped), and a quad
+/// over [10, 30) × [8, 24) read through vertex_offset 4 and clipped to x 15..20, y 10..40.
+Overlay clipped_overlay()
+{
+    Overlay o;
+    add_quad(o, -100, -100, -50, -50, rgba32(0, 0, 255, 255), {-1e9f, -1e9f, 1e9f, 1e9f});
+    add_quad(o, 10, 8, 30, 24, rgba32(20, 220, 60, 255), {15, 10, 20, 40});
+    return o;
+}
+constexpr int kClipX0 = 15, kClipY0 = 10, kClipX1 = 20, kClipY1 = 24; // the drawn pixels
+
+void expect_clip_colour(const std::uint8_t* p, int x, int y)
+{
+    EXPECT_NEAR(int(p[0]), 20, 1) << x << "," << y;
+    EXPECT_NEAR(int(p[1]), 220, 1) << x << "," << y;
+    EXPECT_NEAR(int(p[2]), 60, 1) << x << "," << y;
+}
+
+TEST(RenderOverlay, EachCommandIsClippedToItsScissorRectangleAndUsesItsVertexOffset)
+{
+    // Single-sampled, the scissor is exact: lavapipe (Mesa 22.3) lets the samples of the pixel
+    // row and column just outside a scissor's top and left edges through with 4x MSAA.
+    RendererOptions options;
+    options.samples = 1;
+    Renderer r(options);
+    const OverlayFixture f;
+    r.set_scene(f.scene);
+    const RgbaImage background = r.render(f.camera, kOw, kOh);
+    const Overlay o = clipped_overlay();
+    ASSERT_EQ(o.commands[1].vertex_offset, 4);
+    r.set_overlay(o);
+    const RgbaImage picture = r.render(f.camera, kOw, kOh);
+    const std::size_t changed = check_rect(picture, background, kClipX0, kClipY0, kClipX1, kClipY1,
+                                           [](const std::uint8_t* p, const std::uint8_t*, int x, int y) { expect_clip_colour(p, x, y); });
+    EXPECT_EQ(changed, std::size_t(kClipX1 - kClipX0) * std::size_t(kClipY1 - kClipY0));
+    // A clip rectangle that misses the frame draws nothing.
+    Overlay outside;
+    add_quad(outside, 0, 0, kOw, kOh, rgba32(255, 255, 255, 255), {float(kOw), 0, float(kOw) + 10, float(kOh)});
+    r.set_overlay(outside);
+    EXPECT_EQ(r.render(f.camera, kOw, kOh).pixels, background.pixels);
+}
+
+TEST(RenderOverlay, WithMultisamplingTheScissorHoldsToWithinOnePixelOfItsEdges)
+{
+    OverlayFixture f;
+    const RgbaImage picture = f.with(clipped_overlay());
+    std::size_t changed = 0;
+    for (int y = 0; y < kOh; ++y)
+        for (int x = 0; x < kOw; ++x) {
+            const std::uint8_t* p = pixel(picture, x, y);
+            const bool same = std::equal(p, p + 4, pixel(f.background, x, y));
+            changed += !same;
+            if (x >= kClipX0 + 1 && x < kClipX1 - 1 && y >= kClipY0 + 1 && y < kClipY1 - 1) {
+                expect_clip_colour(p, x, y);
+            } else if (x < kClipX0 - 1 || x > kClipX1 || y < kClipY0 - 1 || y > kClipY1) {
+                EXPECT_TRUE(same) << "pixel " << x << "," << y << " well outside the clip changed";
+            }
+        }
+    EXPECT_GE(changed, std::size_t(kClipX1 - kClipX0 - 2) * std::size_t(kClipY1 - kClipY0 - 2));
+    EXPECT_LE(changed, std::size_t(kClipX1 - kClipX0 + 2) * std::size_t(kClipY1 - kClipY0 + 2));
+}
+
+TEST(RenderOverlay, OutOfRangeIndicesAndBadFontsAreRefusedWithOneLineAndThePreviousOverlayStays)
+{
+    OverlayFixture f;
+    Overlay good;
+    add_quad(good, 10, 8, 30, 24, rgba32(200, 40, 40, 255));
+    const RgbaImage before = f.with(good);
+    ASSERT_NE(before.pixels, f.background.pixels);
+
+    std::vector<Overlay> bad(5, good);
+    bad[0].indices[2] = 4;                  // index 4 of 4 vertices
+    bad[1].commands[0].index_count = 7;     // past the 6 indices
+    bad[2].commands[0].vertex_offset = -1;  // index 0 - 1
+    bad[3].commands[0].clip[2] = std::nanf("");
+    bad[4].font = RgbaImage{2, 2, std::vector<std::uint8_t>(15, 255)}; // 15 bytes, not 16
+    Renderer& r = *shared().renderer;
+    for (std::size_t i = 0; i < bad.size(); ++i) {
+        try {
+            r.set_overlay(bad[i]);
+            ADD_FAILURE() << "bad overlay " << i << " was accepted";
+        } catch (const InvalidInput& e) {
+            const std::string what = e.what();
+            EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+            EXPECT_NE(what.find("overlay"), std::string::npos) << what;
+        }
+    }
+    EXPECT_EQ(r.render(f.camera, kOw, kOh).pixels, before.pixels) << "the good overlay is still drawn";
+}
+
+TEST(RenderOverlay, TheFontIsSampledAndUploadedAgainOnlyWhenItsVersionChanges)
+{
+    OverlayFixture f;
+    // Texel 0 opaque white, texel 1 transparent; the quad samples the centre of texel 1.
+    Overlay o;
+    o.font = RgbaImage{2, 1, {255, 255, 255, 255, 0, 0, 0, 0}};
+    o.font_version = 1;
+    add_quad(o, 10, 8, 30, 24, rgba32(200, 40, 40, 255), {0, 0, 1e6f, 1e6f}, 0.75f, 0.5f);
+    EXPECT_EQ(f.with(o).pixels, f.background.pixels) << "a transparent texel hides the quad";
+    // The same version with other pixels is not uploaded again: still transparent.
+    Overlay same = o;
+    same.font.pixels = {255, 255, 255, 255, 255, 255, 255, 255};
+    EXPECT_EQ(f.with(same).pixels, f.background.pixels);
+    // A new version is.
+    same.font_version = 2;
+    const RgbaImage shown = f.with(same);
+    EXPECT_NEAR(int(pixel(shown, 20, 16)[0]), 200, 1);
+    EXPECT_NEAR(int(pixel(shown, 20, 16)[1]), 40, 1);
+    // The empty font is one white texel, whatever the version.
+    Overlay white = o;
+    white.font = RgbaImage{};
+    EXPECT_NEAR(int(pixel(f.with(white), 20, 16)[0]), 200, 1);
+}
+
+TEST(RenderOverlay, LastFrameReadsBackTheLastPictureWithoutDrawingAgain)
+{
+    Renderer& r = *shared().renderer;
+    OverlayFixture f;
+    Overlay o;
+    add_quad(o, 10, 8, 30, 24, rgba32(200, 40, 40, 255));
+    const RgbaImage picture = f.with(o);
+    r.set_overlay(Overlay{}); // not drawn until the next frame
+    const RgbaImage again = r.last_frame();
+    EXPECT_EQ(again.width, kOw);
+    EXPECT_EQ(again.height, kOh);
+    EXPECT_EQ(again.pixels, picture.pixels);
+}
+
+TEST(RenderWindow, PresentationOptionsAndAttachWindowFailClearlyWithoutADisplay)
+{
+    RendererOptions unknown;
+    unknown.instance_extensions = {"VK_LOBE_no_such_extension"};
+    try {
+        Renderer r(unknown);
+        ADD_FAILURE() << "an unknown instance extension was accepted";
+    } catch (const RenderUnavailable& e) {
+        EXPECT_NE(std::string(e.what()).find("VK_LOBE_no_such_extension"), std::string::npos) << e.what();
+    }
+    // Without presentation, and before a window, the window calls are refused; the callback is
+    // never called.
+    Renderer& plain = *shared().renderer;
+    bool called = false;
+    EXPECT_THROW(plain.attach_window([&](std::uint64_t) { return called = true, std::uint64_t(0); }), RenderError);
+    EXPECT_FALSE(called);
+    EXPECT_THROW(plain.present(Camera{}, kOw, kOh), RenderError);
+    // With presentation (lavapipe has VK_KHR_swapchain) and VK_KHR_surface, a callback that
+    // makes no surface is refused; it got a Vulkan instance.
+    RendererOptions options;
+    options.presentation = true;
+    options.instance_extensions = {"VK_KHR_surface"};
+    Renderer presenting(options);
+    EXPECT_TRUE(presenting.last_frame().pixels.empty()) << "no frame yet";
+    std::uint64_t instance = 0;
+    EXPECT_THROW(presenting.attach_window([&](std::uint64_t vk_instance) { return instance = vk_instance, std::uint64_t(0); }), RenderError);
+    EXPECT_NE(instance, 0u);
+    EXPECT_THROW(presenting.present(Camera{}, kOw, kOh), RenderError);
+}
+
+/// The pixels an X11 window shows (RGBA, alpha 255), read with XGetImage through the GLFW
+/// library's glfwGetX11Display/glfwGetX11Window and libX11.so.6, loaded at run time; empty
+/// when either or the X11 headers are missing (defined at the end of this file, apart from
+/// Xlib's macros).
+RgbaImage read_x11_window(void* glfw_library, void* glfw_window, int width, int height);
+
+/// GLFW 3, loaded at run time (the suite does not link it): what the window test needs.
+struct Glfw {
+    void* lib = nullptr;
+    int (*init)() = nullptr;
+    void (*terminate)() = nullptr;
+    void (*window_hint)(int, int) = nullptr;
+    void* (*create_window)(int, int, const char*, void*, void*) = nullptr;
+    void (*destroy_window)(void*) = nullptr;
+    const char** (*required_extensions)(std::uint32_t*) = nullptr;
+    int (*create_surface)(void*, void*, const void*, std::uint64_t*) = nullptr; // VkResult (VkInstance, GLFWwindow*, allocator, VkSurfaceKHR*)
+    void (*framebuffer_size)(void*, int*, int*) = nullptr;
+    void (*set_window_size)(void*, int, int) = nullptr;
+    void (*poll_events)() = nullptr;
+    static constexpr int kClientApi = 0x00022001, kNoApi = 0;
+
+    bool load()
+    {
+        lib = dlopen("libglfw.so.3", RTLD_NOW | RTLD_LOCAL); // never closed: X11 keeps state in it
+        if (!lib) return false;
+        auto get = [&](auto& fn, const char* name) {
+            fn = reinterpret_cast<std::remove_reference_t<decltype(fn)>>(dlsym(lib, name));
+            return fn != nullptr;
+        };
+        return get(init, "glfwInit") && get(terminate, "glfwTerminate") && get(window_hint, "glfwWindowHint") &&
+               get(create_window, "glfwCreateWindow") && get(destroy_window, "glfwDestroyWindow") &&
+               get(required_extensions, "glfwGetRequiredInstanceExtensions") && get(create_surface, "glfwCreateWindowSurface") &&
+               get(framebuffer_size, "glfwGetFramebufferSize") && get(set_window_size, "glfwSetWindowSize") &&
+               get(poll_events, "glfwPollEvents");
+    }
+};
+
+// Needs an X server (xvfb-run) and libglfw.so.3 at run time; skipped otherwise.
+TEST(RenderWindow, PresentShowsTheFrameRenderDrawsAndFollowsAResize)
+{
+    if (!std::getenv("DISPLAY") || !*std::getenv("DISPLAY")) GTEST_SKIP() << "DISPLAY is unset: presenting needs an X server (xvfb-run)";
+    Glfw glfw;
+    if (!glfw.load()) GTEST_SKIP() << "libglfw.so.3 (package libglfw3) is not installed";
+    ASSERT_TRUE(glfw.init()) << "glfwInit failed on DISPLAY=" << std::getenv("DISPLAY");
+    glfw.window_hint(Glfw::kClientApi, Glfw::kNoApi);
+    void* window = glfw.create_window(kOw, kOh, "lobesketch render test", nullptr, nullptr);
+    ASSERT_NE(window, nullptr);
+    {
+        std::uint32_t n = 0;
+        const char** names = glfw.required_extensions(&n);
+        ASSERT_NE(names, nullptr) << "GLFW finds no Vulkan loader";
+        RendererOptions options;
+        options.presentation = true;
+        options.instance_extensions.assign(names, names + n);
+        Renderer r(options);
+        r.attach_window([&](std::uint64_t instance) {
+            std::uint64_t surface = 0;
+            return glfw.create_surface(reinterpret_cast<void*>(instance), window, nullptr, &surface) == 0 ? surface : 0;
+        });
+        OverlayFixture f; // sky, ground and a camera
+        r.set_scene(f.scene);
+        Overlay o;
+        add_quad(o, 10, 8, 30, 24, rgba32(200, 40, 40, 255));
+        r.set_overlay(o);
+        int w = 0, h = 0;
+        glfw.framebuffer_size(window, &w, &h);
+        ASSERT_EQ(w, kOw);
+        ASSERT_EQ(h, kOh);
+        for (int frame = 0; frame < 3; ++frame) ASSERT_TRUE(r.present(f.camera, w, h)) << "frame " << frame;
+        EXPECT_GT(r.stats().gpu_ms, 0.0);
+        const RgbaImage presented = r.last_frame();
+        const RgbaImage rendered = r.render(f.camera, w, h);
+        EXPECT_EQ(presented.pixels, rendered.pixels) << "present draws what render draws";
+        // What the window shows (Xvfb has no compositor: the window's pixels are the screen's).
+        const RgbaImage shown = read_x11_window(glfw.lib, window, w, h);
+        if (shown.pixels.empty()) {
+            std::printf("RenderWindow: not comparing the X window's pixels (no X11 headers, libX11 or GLFW X11 functions)\n");
+        } else {
+            EXPECT_EQ(shown.pixels, presented.pixels) << "the window shows the presented frame";
+        }
+        EXPECT_NEAR(int(pixel(presented, 20, 16)[0]), 200, 1) << "with the overlay";
+        EXPECT_FALSE(r.present(f.camera, 0, 0)) << "minimised: nothing drawn";
+        EXPECT_EQ(r.last_frame().pixels, rendered.pixels);
+        // A new size remakes the swapchain and the frame.
+        glfw.set_window_size(window, 80, 60);
+        for (int i = 0; i < 50 && (w != 80 || h != 60); ++i) {
+            glfw.poll_events();
+            glfw.framebuffer_size(window, &w, &h);
+        }
+        ASSERT_EQ(w, 80);
+        ASSERT_EQ(h, 60);
+        for (int frame = 0; frame < 2; ++frame) ASSERT_TRUE(r.present(f.camera, w, h)) << "frame " << frame << " after the resize";
+        const RgbaImage resized = r.last_frame();
+        EXPECT_EQ(resized.width, 80);
+        EXPECT_EQ(resized.height, 60);
+        const RgbaImage shown_resized = read_x11_window(glfw.lib, window, 80, 60);
+        if (!shown_resized.pixels.empty()) {
+            EXPECT_EQ(shown_resized.pixels, resized.pixels) << "the window shows the resized frame";
+        }
+        // A frame of another size than the window's is scaled into it.
+        EXPECT_TRUE(r.present(f.camera, 40, 30));
+        EXPECT_EQ(r.last_frame().width, 40);
+    } // the renderer (and the surface) before the window
+    glfw.destroy_window(window);
+    glfw.terminate();
+}
+
 // --- the command line -------------------------------------------------------------------------
 
 using test::CliRun;
@@ -446,3 +822,48 @@ TEST(RenderCli, WithoutAVulkanDriverItExitsWithOneLineNamingThePackage)
 
 } // namespace
 } // namespace lobe
+
+// Apart from the code above: Xlib's macros (None, Bool, Status, ...) clash with names there.
+#if __has_include(<X11/Xlib.h>) && __has_include(<X11/Xutil.h>)
+#include <X11/Xlib.h>
+#include <X11/Xutil.h>
+
+namespace lobe {
+namespace {
+
+RgbaImage read_x11_window(void* glfw_library, void* glfw_window, int width, int height)
+{
+    void* x11 = dlopen("libX11.so.6", RTLD_NOW | RTLD_LOCAL); // never closed, as GLFW
+    if (!x11) return {};
+    auto display_of = reinterpret_cast<Display* (*)()>(dlsym(glfw_library, "glfwGetX11Display"));
+    auto window_of = reinterpret_cast<Window (*)(void*)>(dlsym(glfw_library, "glfwGetX11Window"));
+    auto get_image = reinterpret_cast<decltype(&XGetImage)>(dlsym(x11, "XGetImage"));
+    auto sync = reinterpret_cast<decltype(&XSync)>(dlsym(x11, "XSync"));
+    if (!display_of || !window_of || !get_image || !sync || !display_of()) return {};
+    Display* display = display_of();
+    sync(display, False);
+    XImage* image = get_image(display, window_of(glfw_window), 0, 0, unsigned(width), unsigned(height), AllPlanes, ZPixmap);
+    if (!image) return {};
+    RgbaImage out{width, height, std::vector<std::uint8_t>(std::size_t(width) * std::size_t(height) * 4)};
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            const unsigned long v = XGetPixel(image, x, y); // 24-bit TrueColor: 0xRRGGBB
+            std::uint8_t* p = &out.pixels[(std::size_t(y) * std::size_t(width) + std::size_t(x)) * 4];
+            p[0] = std::uint8_t(v >> 16);
+            p[1] = std::uint8_t(v >> 8);
+            p[2] = std::uint8_t(v);
+            p[3] = 255;
+        }
+    XDestroyImage(image);
+    return out;
+}
+
+} // namespace
+} // namespace lobe
+#else
+namespace lobe {
+namespace {
+RgbaImage read_x11_window(void*, void*, int, int) { return {}; }
+} // namespace
+} // namespace lobe
+#endif
