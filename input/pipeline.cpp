@@ -1,6 +1,7 @@
 #include "input/pipeline.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cstdio>
 #include <map>
 
@@ -19,18 +20,56 @@ const char* action_name(InputAction::Type t)
     case InputAction::Type::Grow: return "grow";
     case InputAction::Type::Undo: return "undo";
     case InputAction::Type::Redo: return "redo";
+    case InputAction::Type::DeleteStroke: return "delete-stroke";
+    case InputAction::Type::DeleteLobe: return "delete-lobe";
+    case InputAction::Type::Duplicate: return "duplicate";
+    case InputAction::Type::Mirror: return "mirror";
+    case InputAction::Type::SettingChanged: return "setting";
     }
     return "unknown";
 }
 
 InputPipeline::InputPipeline(const InputOptions& options) : options_(options), gestures_(options) {}
 
+namespace {
+
+/// The double whose shortest decimal text is the float's (0.03f → 0.03).
+double shortest_double(float x)
+{
+    char buf[32];
+    const auto r = std::to_chars(buf, buf + sizeof buf, x);
+    double d = static_cast<double>(x);
+    if (r.ec == std::errc()) std::from_chars(buf, r.ptr, d);
+    return d;
+}
+
+} // namespace
+
+void InputPipeline::attach_tip(InputAction& a) const
+{
+    for (Hand h : {Hand::Right, Hand::Left}) {
+        const HandGesture& g = gestures_.hand(h);
+        if (!g.tracked) continue;
+        a.tip = g.index_tip;
+        a.tip_hand = h;
+        return;
+    }
+}
+
 void InputPipeline::push_event(const InputEvent& event)
 {
     last_time_ = std::max(last_time_, event.time);
-    if (event.kind != InputEventKind::Key || event.value != 1) return; // act on key presses
     InputAction a;
     a.time = event.time;
+    if (event.kind == InputEventKind::Setting) {
+        a.type = InputAction::Type::SettingChanged;
+        a.setting.id = static_cast<SettingId>(event.code);
+        a.setting.lobe = event.value;
+        a.setting.value = shortest_double(event.x);
+        actions_.push_back(std::move(a));
+        return;
+    }
+    if (event.kind != InputEventKind::Key || event.value != 1) return; // act on key presses
     auto set_tool = [&](Tool t) {
         tool_ = t;
         a.type = InputAction::Type::ToolChanged;
@@ -53,8 +92,15 @@ void InputPipeline::push_event(const InputEvent& event)
     case keys::kGrow: a.type = InputAction::Type::Grow; break;
     case keys::kUndo: a.type = InputAction::Type::Undo; break;
     case keys::kRedo: a.type = InputAction::Type::Redo; break;
+    case keys::kDeleteStroke: a.type = InputAction::Type::DeleteStroke; break;
+    case keys::kDeleteLobe: a.type = InputAction::Type::DeleteLobe; break;
+    case keys::kDuplicate: a.type = InputAction::Type::Duplicate; break;
+    case keys::kMirror: a.type = InputAction::Type::Mirror; break;
     default: return; // other keys mean nothing to the pipeline
     }
+    if (a.type == InputAction::Type::DeleteStroke || a.type == InputAction::Type::DeleteLobe ||
+        a.type == InputAction::Type::Duplicate || a.type == InputAction::Type::Mirror)
+        attach_tip(a);
     actions_.push_back(std::move(a));
 }
 

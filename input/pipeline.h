@@ -2,7 +2,7 @@
 /// \file pipeline.h
 /// Hand frames → pen events → raw strokes. Feeds frames and raw events through the gesture
 /// recogniser and turns pinches into what the active tool says: a stroke (draw tools) or a
-/// drag (editing tools). The same code runs live (VR, desktop) and on replay, so a session is
+/// drag (editing tools); keys and panel settings become actions too. The same code runs live (VR, desktop) and on replay, so a session is
 /// a deterministic function of its recording and settings.
 
 #include <cstdint>
@@ -30,6 +30,15 @@ struct Drag {
     std::optional<glm::vec3> other_tip;
 };
 
+/// A Setting event as the session builder applies it.
+struct SettingChange {
+    SettingId id = SettingId::SplitAngle;
+    std::int64_t lobe = 0; ///< 0: the whole tree
+    /// The event's number (a float in the recording) as the double with the same shortest
+    /// decimal text, so a slider at 0.03 sets exactly 0.03.
+    double value = 0.0;
+};
+
 /// Something the person did, derived from raw input, in the order it happened.
 struct InputAction {
     enum class Type : std::uint8_t {
@@ -39,12 +48,23 @@ struct InputAction {
         ToolChanged,     ///< `tool`
         NewLobe,         ///< the next lobe stroke starts a new lobe
         Grow, Undo, Redo,
+        DeleteStroke,    ///< delete the stroke at `tip`
+        DeleteLobe,      ///< delete the lobe at `tip` (its strokes too)
+        Duplicate,       ///< copy the lobe (else the trunk stroke) at `tip` beside itself
+        Mirror,          ///< mirror the lobe (else the trunk stroke) at `tip` across the trunk's plane
+        SettingChanged,  ///< `setting`
     } type = Type::StrokeCompleted;
     double time = 0.0;
     Stroke stroke;
     Drag drag;
     Tool tool = Tool::DrawLobe;
     std::string message;
+    /// DeleteStroke, DeleteLobe, Duplicate, Mirror: the filtered index tip of the right hand
+    /// when the key was pressed, else the left hand's (`tip_hand` says which); absent when
+    /// neither hand was tracked.
+    std::optional<glm::vec3> tip;
+    Hand tip_hand = Hand::Right;
+    SettingChange setting;
 };
 
 const char* action_name(InputAction::Type t);
@@ -68,6 +88,8 @@ public:
     const Stroke& current_stroke(Hand hand) const { return pen_[static_cast<int>(hand)].stroke; }
 
 private:
+    /// The right hand's filtered index tip if it is tracked, else the left hand's.
+    void attach_tip(InputAction& a) const;
     struct Pen {
         bool down = false;
         bool drag = false;   ///< an editing-tool pinch rather than a drawn stroke

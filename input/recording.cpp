@@ -378,7 +378,7 @@ std::size_t json_nesting(std::string_view s)
 }
 
 
-bool known_event_kind(std::uint8_t k) { return k >= 1 && k <= 4; }
+bool known_event_kind(std::uint8_t k) { return k >= 1 && k <= 5; }
 
 // ---------------------------------------------------------------------------------------
 // Collector: validation and bounded report shared by both readers
@@ -470,6 +470,12 @@ public:
     {
         ++event_number_;
         drop_event(w, "unknown event kind " + kind + " skipped");
+    }
+
+    void skip_unknown_setting(Where w, std::int32_t id)
+    {
+        ++event_number_;
+        drop_event(w, "unknown setting id " + std::to_string(id) + " skipped");
     }
 
     void add_annotation(Annotation a, Where w)
@@ -861,6 +867,10 @@ void decode_record(Collector& c, RecordType type, ByteReader r, Where w)
             return;
         }
         e.kind = static_cast<InputEventKind>(kind);
+        if (e.kind == InputEventKind::Setting && !known_setting_id(e.code)) {
+            c.skip_unknown_setting(w, e.code);
+            return;
+        }
         c.add_event(e, w);
         return;
     }
@@ -1037,6 +1047,15 @@ void append_event_line(std::string& out, const InputEvent& e)
         out += kind;
         out += ' ';
         append_number(out, e.y);
+        break;
+    case InputEventKind::Setting:
+        out += kind;
+        out += ' ';
+        append_number(out, e.code);
+        out += ' ';
+        append_number(out, e.value);
+        out += ' ';
+        append_number(out, e.x);
         break;
     default: // a kind this build does not know: written so that readers skip it
         out += "kind_" + std::to_string(static_cast<int>(e.kind));
@@ -1241,6 +1260,11 @@ void parse_text_line(Collector& c, std::string_view line, Where w)
         } else if (ek == "wheel") {
             e.kind = InputEventKind::MouseWheel;
             ok = take_number(t, e.y, "wheel delta", error);
+        } else if (ek == "setting") {
+            e.kind = InputEventKind::Setting;
+            ok = take_number(t, e.code, "setting id", error) && take_number(t, e.value, "lobe id", error) &&
+                 take_number(t, e.x, "value", error);
+            if (ok && t.peek().empty() && !known_setting_id(e.code)) return c.skip_unknown_setting(w, e.code);
         } else if (ek.empty()) {
             return c.drop_event(w, "missing event kind");
         } else {
@@ -1476,6 +1500,20 @@ const char* event_kind_name(InputEventKind k)
     case InputEventKind::MouseButton: return "mouse_button";
     case InputEventKind::MouseMove: return "mouse_move";
     case InputEventKind::MouseWheel: return "wheel";
+    case InputEventKind::Setting: return "setting";
+    }
+    return nullptr;
+}
+
+const char* setting_name(SettingId id)
+{
+    switch (id) {
+    case SettingId::SplitAngle: return "split-angle";
+    case SettingId::AttractorSpacing: return "attractor-spacing";
+    case SettingId::LeafLength: return "leaf-length";
+    case SettingId::LeavesPerNode: return "leaves-per-node";
+    case SettingId::Species: return "species";
+    case SettingId::Seed: return "seed";
     }
     return nullptr;
 }

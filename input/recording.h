@@ -34,16 +34,37 @@ struct RecordingHeader {
     std::string created;              ///< ISO 8601, informational
 };
 
-/// Raw non-hand input. Desktop mouse/keyboard and controller buttons; codes are GLFW key
-/// and button codes. Unknown kinds in a file are skipped with a warning.
+/// Raw non-hand input. Desktop mouse/keyboard and controller buttons (codes are GLFW key
+/// and button codes) and panel settings. Unknown kinds in a file are skipped with a warning.
 enum class InputEventKind : std::uint8_t {
     Key = 1,         ///< code = key, value = 1 press / 0 release
     MouseButton = 2, ///< code = button, value = 1 press / 0 release
     MouseMove = 3,   ///< x, y = cursor position in window pixels
     MouseWheel = 4,  ///< y = wheel delta
+    Setting = 5,     ///< an appearance setting: code = SettingId, value = lobe id (0 = the whole tree), x = the number
 };
 
-/// "key", "mouse_button", "mouse_move", "wheel"; nullptr for a kind this build does not know.
+/// What a Setting event sets (InputEvent::code). A reader skips an id it does not know with
+/// a warning, like an unknown event kind. Ranges and units: docs/recording-format.md.
+enum class SettingId : std::int32_t {
+    SplitAngle = 1,       ///< degrees; tree-wide or per lobe (LobeRecord::split_angle_deg)
+    AttractorSpacing = 2, ///< metres (settings.lobes.edge_length_m); tree-wide only
+    LeafLength = 3,       ///< metres (settings.leaves.length_m; the width keeps its ratio); tree-wide only
+    LeavesPerNode = 4,    ///< an integer (settings.leaves.per_node); tree-wide only
+    Species = 5,          ///< an index into kSettingSpecies; tree-wide or per lobe (LobeRecord::species)
+    Seed = 6,             ///< an integer in [1, 2^24) (Document::seed); tree-wide only
+};
+
+/// "split-angle", "attractor-spacing", "leaf-length", "leaves-per-node", "species", "seed";
+/// nullptr for an id this build does not know.
+const char* setting_name(SettingId id);
+inline bool known_setting_id(std::int32_t id) { return id >= 1 && id <= 6; }
+
+/// The species a Setting event of id Species chooses from, by index (x = 0 … 3).
+inline constexpr const char* kSettingSpecies[] = {"broadleaf", "conifer", "willow", "birch"};
+inline constexpr int kSettingSpeciesCount = 4;
+
+/// "key", "mouse_button", "mouse_move", "wheel", "setting"; nullptr for a kind this build does not know.
 const char* event_kind_name(InputEventKind kind);
 
 struct InputEvent {

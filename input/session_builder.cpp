@@ -4,8 +4,11 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <set>
 
 #include <glm/geometric.hpp>
+
+#include "core/errors.h"
 
 namespace lobe {
 
@@ -35,6 +38,146 @@ const Stroke* find_stroke(const std::vector<Stroke>& strokes, std::int64_t id)
     for (const Stroke& s : strokes)
         if (s.id == id) return &s;
     return nullptr;
+}
+
+std::string op_type(Tool t) { return std::string("drag:") + tool_name(t); }
+
+bool is_transform_op(const std::string& type)
+{
+    return type == op_type(Tool::MoveLobe) || type == op_type(Tool::RotateLobe) || type == op_type(Tool::ScaleLobe);
+}
+
+/// Operations whose target is a lobe id (the others written now target a stroke id).
+bool is_lobe_op(const std::string& type) { return type == op_type(Tool::DeformLobe) || is_transform_op(type); }
+
+/// The stroke (of `kind`, or any when none is given) with the point nearest `p`, and that
+/// distance (infinity when there is none).
+const Stroke* nearest_stroke(const std::vector<Stroke>& view, const glm::dvec3& p, double& distance,
+                             std::optional<StrokeKind> kind = std::nullopt)
+{
+    const Stroke* best = nullptr;
+    distance = std::numeric_limits<double>::infinity();
+    for (const Stroke& s : view) {
+        if (kind && s.kind != *kind) continue;
+        const double d = distance_to_stroke(s, p);
+        if (d < distance) {
+            distance = d;
+            best = &s;
+        }
+    }
+    return best;
+}
+
+/// What a lobe pick found: `lobe` is null when it picked nothing; `nearest_any` is the
+/// distance to the nearest lobe stroke (infinity when no lobe has strokes to see).
+struct LobePick {
+    const LobeRecord* lobe = nullptr;
+    glm::dvec3 centre{0.0};
+    double radius = 0.0;
+    double nearest_any = std::numeric_limits<double>::infinity();
+};
+
+/// Among the lobes whose strokes (as seen in `view`) come within `pick_distance` of `p`,
+/// or whose bounding sphere (centre: lobe_centre, radius: its farthest stroke point) holds
+/// it, the one whose strokes are nearest.
+LobePick pick_lobe(const Document& doc, const std::vector<Stroke>& view, const glm::dvec3& p, double pick_distance)
+{
+    LobePick pick;
+    double best_d = std::numeric_limits<double>::infinity();
+    for (const LobeRecord& lobe : doc.lobes) {
+        glm::dvec3 c;
+        if (!lobe_centre(lobe, view, c)) continue;
+        double d = std::numeric_limits<double>::infinity(), radius = 0.0;
+        for (std::int64_t id : lobe.stroke_ids)
+            if (const Stroke* s = find_stroke(view, id)) {
+                d = std::min(d, distance_to_stroke(*s, p));
+                for (const StrokePoint& q : s->points) radius = std::max(radius, glm::distance(glm::dvec3(q.position), c));
+            }
+        pick.nearest_any = std::min(pick.nearest_any, d);
+        const bool near = d <= pick_distance || glm::distance(p, c) <= radius;
+        if (near && d < best_d) {
+            best_d = d;
+            pick.lobe = &lobe;
+            pick.centre = c;
+            pick.radius = radius;
+        }
+    }
+    return pick;
+}
+
+/// Removes the strokes `strokes` and the lobes `lobes` from `doc`, with every lobe left
+/// without strokes, the operations that target any of them and the removed lobes' trees;
+/// the remaining transform operations forget the removed strokes in their `strokes` lists.
+void erase_from_document(Document& doc, const std::set<std::int64_t>& strokes, std::set<std::int64_t> lobes)
+{
+    doc.strokes.erase(std::remove_if(doc.strokes.begin(), doc.strokes.end(),
+                                     [&](const Stroke& s) { return strokes.count(s.id) > 0; }),
+                      doc.strokes.end());
+    for (LobeRecord& l : doc.lobes) {
+        const std::size_t before = l.stroke_ids.size();
+        l.stroke_ids.erase(std::remove_if(l.stroke_ids.begin(), l.stroke_ids.end(),
+                                          [&](std::int64_t id) { return strokes.count(id) > 0; }),
+                           l.stroke_ids.end());
+        if (l.stroke_ids.empty() && before > 0) lobes.insert(l.id);
+    }
+    doc.lobes.erase(std::remove_if(doc.lobes.begin(), doc.lobes.end(),
+                                   [&](const LobeRecord& l) { return lobes.count(l.id) > 0; }),
+                    doc.lobes.end());
+    const std::string edit_stroke = op_type(Tool::EditStroke);
+    doc.edits.erase(std::remove_if(doc.edits.begin(), doc.edits.end(),
+                                   [&](const EditOperation& op) {
+                                       if (op.type == edit_stroke) return strokes.count(op.target) > 0;
+                                       return is_lobe_op(op.type) && lobes.count(op.target) > 0;
+                                   }),
+                    doc.edits.end());
+    for (EditOperation& op : doc.edits) {
+        if (!is_transform_op(op.type) || !op.params.is_object()) continue;
+        auto list = op.params.find("strokes");
+        if (list == op.params.end() || !list->is_array()) continue;
+        nlohmann::json kept = nlohmann::json::array();
+        for (const nlohmann::json& id : *list)
+            if (!id.is_number_integer() || strokes.count(id.get<std::int64_t>()) == 0) kept.push_back(id);
+        *list = std::move(kept);
+    }
+    // A tree that listed only removed lobes would otherwise mean "every lobe" (empty list).
+    doc.trees.erase(std::remove_if(doc.trees.begin(), doc.trees.end(),
+                                   [&](TreeInstance& t) {
+                                       if (t.lobe_ids.empty()) return false;
+                                       t.lobe_ids.erase(std::remove_if(t.lobe_ids.begin(), t.lobe_ids.end(),
+                                                                       [&](std::int64_t id) { return lobes.count(id) > 0; }),
+                                                        t.lobe_ids.end());
+                                       return t.lobe_ids.empty();
+                                   }),
+                    doc.trees.end());
+}
+
+/// x of the lowest point of all trunk strokes (the trunk's base); 0 when there are none.
+double trunk_base_x(const std::vector<Stroke>& view)
+{
+    double lowest = std::numeric_limits<double>::infinity(), x = 0.0;
+    for (const Stroke& s : view) {
+        if (s.kind != StrokeKind::Trunk) continue;
+        for (const StrokePoint& p : s.points)
+            if (p.position.y < lowest) {
+                lowest = p.position.y;
+                x = p.position.x;
+            }
+    }
+    return x;
+}
+
+/// A point of a copy: mirrored across the plane x = mirror_x, or shifted.
+glm::vec3 place_point(const glm::vec3& p, bool mirror, const glm::dvec3& shift, double mirror_x)
+{
+    if (mirror) return {static_cast<float>(2.0 * mirror_x - static_cast<double>(p.x)), p.y, p.z};
+    return glm::vec3(glm::dvec3(p) + shift);
+}
+
+std::string when(const char* what, double t)
+{
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "%s at t=%.2fs changes nothing: ", what, t);
+    return buf;
 }
 
 } // namespace
@@ -68,6 +211,12 @@ SessionBuilder::SessionBuilder(Document doc, EditPickOptions pick, EditHooks hoo
 {
     for (const LobeRecord& l : doc_.lobes) next_lobe_id_ = std::max(next_lobe_id_, l.id + 1);
     for (const EditOperation& e : doc_.edits) next_edit_id_ = std::max(next_edit_id_, e.id + 1);
+    for (const Stroke& st : doc_.strokes) next_stroke_id_ = std::max(next_stroke_id_, st.id + 1);
+}
+
+std::vector<Stroke> SessionBuilder::view() const
+{
+    return hooks_.current_strokes ? hooks_.current_strokes(doc_) : doc_.strokes;
 }
 
 namespace {
@@ -98,8 +247,11 @@ void lobe_distance(const Document& doc, const LobeRecord& lobe, const Stroke& st
 
 } // namespace
 
-void SessionBuilder::add_stroke(const Stroke& stroke)
+void SessionBuilder::add_stroke(const Stroke& drawn)
 {
+    Stroke stroke = drawn;
+    if (find_stroke(doc_.strokes, stroke.id)) stroke.id = next_stroke_id_;
+    next_stroke_id_ = std::max(next_stroke_id_, stroke.id + 1);
     doc_.strokes.push_back(stroke);
     if (stroke.kind != StrokeKind::Lobe) return;
     // A stroke joins the lobe it is drawn into: the current lobe when it comes near it, else
@@ -152,7 +304,7 @@ bool SessionBuilder::add_drag(const InputAction& a)
     if (drag.path.empty()) return nothing("it has no points");
     if (drag.tool == Tool::DrawLobe || drag.tool == Tool::DrawTrunk) return nothing("not an editing tool");
     const glm::dvec3 start(drag.path.front().position);
-    const std::vector<Stroke> view = hooks_.current_strokes ? hooks_.current_strokes(doc_) : doc_.strokes;
+    const std::vector<Stroke> view = this->view();
 
     EditOperation op;
     op.id = next_edit_id_;
@@ -163,15 +315,8 @@ bool SessionBuilder::add_drag(const InputAction& a)
 
     if (drag.tool == Tool::EditStroke) {
         // The stroke with the point nearest to the drag start (the first on a tie).
-        const Stroke* best = nullptr;
-        double best_d = std::numeric_limits<double>::infinity();
-        for (const Stroke& s : view) {
-            const double d = distance_to_stroke(s, start);
-            if (d < best_d) {
-                best_d = d;
-                best = &s;
-            }
-        }
+        double best_d = 0.0;
+        const Stroke* best = nearest_stroke(view, start, best_d);
         if (!best) return nothing("there are no strokes");
         if (best_d > pick_.stroke_pick_distance_m)
             return nothing("its start is " + cm(best_d) + " from the nearest stroke (pick distance " +
@@ -189,35 +334,16 @@ bool SessionBuilder::add_drag(const InputAction& a)
     } else {
         // Lobe tools: the lobe whose strokes are nearest the drag start, among those it is
         // near or inside.
-        const LobeRecord* best = nullptr;
-        double best_d = std::numeric_limits<double>::infinity(), nearest_any = best_d;
-        glm::dvec3 best_centre(0.0);
-        for (const LobeRecord& lobe : doc_.lobes) {
-            glm::dvec3 c;
-            if (!lobe_centre(lobe, view, c)) continue;
-            double d = std::numeric_limits<double>::infinity(), radius = 0.0;
-            for (std::int64_t id : lobe.stroke_ids)
-                if (const Stroke* s = find_stroke(view, id)) {
-                    d = std::min(d, distance_to_stroke(*s, start));
-                    for (const StrokePoint& p : s->points) radius = std::max(radius, glm::distance(glm::dvec3(p.position), c));
-                }
-            nearest_any = std::min(nearest_any, d);
-            const bool near = d <= pick_.lobe_pick_distance_m || glm::distance(start, c) <= radius;
-            if (near && d < best_d) {
-                best_d = d;
-                best = &lobe;
-                best_centre = c;
-            }
-        }
-        if (!best) {
-            if (!std::isfinite(nearest_any)) return nothing("there are no lobes");
-            return nothing("its start is outside every lobe and " + cm(nearest_any) +
+        const LobePick pick = pick_lobe(doc_, view, start, pick_.lobe_pick_distance_m);
+        if (!pick.lobe) {
+            if (!std::isfinite(pick.nearest_any)) return nothing("there are no lobes");
+            return nothing("its start is outside every lobe and " + cm(pick.nearest_any) +
                            " from the nearest lobe stroke (pick distance " + cm(pick_.lobe_pick_distance_m) + ")");
         }
-        op.target = best->id;
+        op.target = pick.lobe->id;
         if (drag.tool == Tool::MoveLobe || drag.tool == Tool::RotateLobe || drag.tool == Tool::ScaleLobe) {
-            op.params["centre"] = point_json(best_centre);
-            op.params["strokes"] = best->stroke_ids;
+            op.params["centre"] = point_json(pick.centre);
+            op.params["strokes"] = pick.lobe->stroke_ids;
         }
     }
     if (hooks_.check) {
@@ -232,6 +358,7 @@ bool SessionBuilder::add_drag(const InputAction& a)
 
 bool SessionBuilder::apply(const InputAction& a)
 {
+    if (a.type != InputAction::Type::SettingChanged) setting_run_.reset();
     switch (a.type) {
     case InputAction::Type::StrokeCompleted:
         snapshot();
@@ -254,12 +381,310 @@ bool SessionBuilder::apply(const InputAction& a)
         doc_ = std::move(redo_.back());
         redo_.pop_back();
         return true;
+    case InputAction::Type::DeleteStroke:
+    case InputAction::Type::DeleteLobe: return delete_at_tip(a);
+    case InputAction::Type::Duplicate:
+    case InputAction::Type::Mirror: return copy_at_tip(a);
+    case InputAction::Type::SettingChanged: return apply_setting(a);
     case InputAction::Type::StrokeDiscarded:
     case InputAction::Type::ToolChanged:
     case InputAction::Type::Grow:
         return false;
     }
     return false;
+}
+
+bool SessionBuilder::delete_at_tip(const InputAction& a)
+{
+    const bool lobe_wanted = a.type == InputAction::Type::DeleteLobe;
+    const std::string prefix = when(action_name(a.type), a.time);
+    auto nothing = [&](const std::string& why) {
+        messages_.push_back(prefix + why);
+        return false;
+    };
+    if (!a.tip) return nothing("no hand was tracked");
+    const glm::dvec3 tip(*a.tip);
+    const std::vector<Stroke> view = this->view();
+    if (lobe_wanted) {
+        const LobePick pick = pick_lobe(doc_, view, tip, pick_.lobe_pick_distance_m);
+        if (!pick.lobe) {
+            if (!std::isfinite(pick.nearest_any)) return nothing("there are no lobes");
+            return nothing("the fingertip is outside every lobe and " + cm(pick.nearest_any) +
+                           " from the nearest lobe stroke (pick distance " + cm(pick_.lobe_pick_distance_m) + ")");
+        }
+        const std::set<std::int64_t> strokes(pick.lobe->stroke_ids.begin(), pick.lobe->stroke_ids.end());
+        const std::int64_t lobe = pick.lobe->id;
+        snapshot();
+        erase_from_document(doc_, strokes, {lobe});
+        return true;
+    }
+    double d = 0.0;
+    const Stroke* s = nearest_stroke(view, tip, d);
+    if (!s) return nothing("there are no strokes");
+    if (d > pick_.stroke_pick_distance_m)
+        return nothing("the fingertip is " + cm(d) + " from the nearest stroke (pick distance " +
+                       cm(pick_.stroke_pick_distance_m) + ")");
+    const std::int64_t id = s->id;
+    snapshot();
+    erase_from_document(doc_, {id}, {});
+    return true;
+}
+
+std::vector<EditOperation> SessionBuilder::placed_deforms(const LobeRecord& lobe, bool mirror, const glm::dvec3& shift,
+                                                          double mirror_x, std::string& note) const
+{
+    const std::string deform = op_type(Tool::DeformLobe);
+    std::vector<std::size_t> deforms;
+    for (std::size_t i = 0; i < doc_.edits.size(); ++i)
+        if (doc_.edits[i].type == deform && doc_.edits[i].target == lobe.id) deforms.push_back(i);
+    if (deforms.empty()) return {};
+
+    // Where each deform's path is now: a deform made after k operations sits where a stroke
+    // drawn into the lobe at that moment would, so each path becomes a probe stroke of the
+    // lobe that the transform operations made before it do not list and the later ones do
+    // (see meshing/edit_ops.h, "Frames"). One more probe, listed by every transform, gives
+    // the lobe's scale now.
+    Document probe = doc_;
+    LobeRecord* pl = nullptr;
+    for (LobeRecord& l : probe.lobes)
+        if (l.id == lobe.id) pl = &l;
+    std::int64_t next_id = next_stroke_id_;
+    for (const Stroke& st : doc_.strokes) next_id = std::max(next_id, st.id + 1);
+    const std::int64_t scale_id = next_id++;
+    Stroke unit;
+    unit.id = scale_id;
+    unit.points = {{glm::vec3(0.0f), 0.0}, {glm::vec3(1.0f, 0.0f, 0.0f), 0.0}};
+    probe.strokes.push_back(unit);
+    pl->stroke_ids.push_back(scale_id);
+    std::vector<std::int64_t> probe_ids;
+    std::vector<std::vector<double>> times;
+    for (std::size_t k : deforms) {
+        const nlohmann::json& path = doc_.edits[k].params.is_object() ? doc_.edits[k].params.value("path", nlohmann::json())
+                                                                      : nlohmann::json();
+        Stroke st;
+        st.id = next_id++;
+        std::vector<double> t;
+        bool ok = path.is_array() && !path.empty();
+        for (std::size_t i = 0; ok && i < path.size(); ++i) {
+            const nlohmann::json& q = path[i];
+            ok = q.is_array() && q.size() >= 3 && q[0].is_number() && q[1].is_number() && q[2].is_number();
+            if (!ok) break;
+            st.points.push_back({glm::vec3(q[0].get<float>(), q[1].get<float>(), q[2].get<float>()), 0.0});
+            t.push_back(q.size() >= 4 && q[3].is_number() ? q[3].get<double>() : 0.0);
+        }
+        if (!ok) {
+            note = "edit " + std::to_string(doc_.edits[k].id) + " has no readable path";
+            return {};
+        }
+        probe.strokes.push_back(std::move(st));
+        pl->stroke_ids.push_back(next_id - 1);
+        probe_ids.push_back(next_id - 1);
+        times.push_back(std::move(t));
+    }
+    for (std::size_t i = 0; i < probe.edits.size(); ++i) {
+        EditOperation& op = probe.edits[i];
+        if (!is_transform_op(op.type) || op.target != lobe.id || !op.params.is_object()) continue;
+        // Without a list a transform applies to every stroke of the lobe: list them.
+        auto list = op.params.find("strokes");
+        nlohmann::json ids = list != op.params.end() && list->is_array() ? *list : nlohmann::json(lobe.stroke_ids);
+        ids.push_back(scale_id);
+        for (std::size_t j = 0; j < deforms.size(); ++j)
+            if (deforms[j] < i) ids.push_back(probe_ids[j]);
+        op.params["strokes"] = std::move(ids);
+    }
+    const std::vector<Stroke> now = hooks_.current_strokes ? hooks_.current_strokes(probe) : probe.strokes;
+    const Stroke* u = find_stroke(now, scale_id);
+    const double scale = u && u->points.size() == 2 ? glm::distance(glm::dvec3(u->points[0].position),
+                                                                    glm::dvec3(u->points[1].position))
+                                                    : 1.0;
+    if (std::abs(scale - 1.0) > 1e-4) {
+        // The lobe builder deforms a lobe in its own frame, before its scale: the region and
+        // pick distance of a deform would not scale with the copy.
+        char buf[160];
+        std::snprintf(buf, sizeof buf, "lobe %lld was scaled (x%.3f), so a pinch deform's region would not match",
+                      static_cast<long long>(lobe.id), scale);
+        note = buf;
+        return {};
+    }
+    std::vector<EditOperation> out;
+    for (std::size_t j = 0; j < deforms.size(); ++j) {
+        const Stroke* p = find_stroke(now, probe_ids[j]);
+        if (!p || p->points.size() != times[j].size()) {
+            note = "edit " + std::to_string(doc_.edits[deforms[j]].id) + " could not be placed";
+            return {};
+        }
+        EditOperation op = doc_.edits[deforms[j]];
+        nlohmann::json path = nlohmann::json::array();
+        for (std::size_t i = 0; i < p->points.size(); ++i) {
+            const glm::vec3 q = place_point(p->points[i].position, mirror, shift, mirror_x);
+            path.push_back({q.x, q.y, q.z, times[j][i]});
+        }
+        op.params["path"] = std::move(path);
+        out.push_back(std::move(op));
+    }
+    return out;
+}
+
+bool SessionBuilder::copy_at_tip(const InputAction& a)
+{
+    const bool mirror = a.type == InputAction::Type::Mirror;
+    const char* what = action_name(a.type);
+    const std::string prefix = when(what, a.time);
+    auto nothing = [&](const std::string& why) {
+        messages_.push_back(prefix + why);
+        return false;
+    };
+    if (!a.tip) return nothing("no hand was tracked");
+    const glm::dvec3 tip(*a.tip);
+    const std::vector<Stroke> view = this->view();
+    const double mirror_x = mirror ? trunk_base_x(view) : 0.0;
+    auto copy_of = [&](const Stroke& s, const glm::dvec3& shift) {
+        Stroke c = s;
+        c.id = next_stroke_id_++;
+        for (StrokePoint& p : c.points) p.position = place_point(p.position, mirror, shift, mirror_x);
+        return c;
+    };
+
+    const LobePick pick = pick_lobe(doc_, view, tip, pick_.lobe_pick_distance_m);
+    if (pick.lobe) {
+        const LobeRecord source = *pick.lobe;
+        const glm::dvec3 shift(2.0 * pick.radius + kDuplicateGapM, 0.0, 0.0);
+        std::string note;
+        std::vector<EditOperation> deforms = placed_deforms(source, mirror, shift, mirror_x, note);
+        snapshot();
+        LobeRecord copy;
+        copy.id = next_lobe_id_++;
+        copy.split_angle_deg = source.split_angle_deg;
+        copy.species = source.species;
+        for (std::int64_t id : source.stroke_ids)
+            if (const Stroke* s = find_stroke(view, id)) {
+                doc_.strokes.push_back(copy_of(*s, shift));
+                copy.stroke_ids.push_back(doc_.strokes.back().id);
+            }
+        for (EditOperation& op : deforms) {
+            op.id = next_edit_id_++;
+            op.target = copy.id;
+            doc_.edits.push_back(std::move(op));
+        }
+        if (!note.empty())
+            messages_.push_back(std::string(what) + " of lobe " + std::to_string(source.id) + " as lobe " +
+                                std::to_string(copy.id) + ": its pinch deforms were not copied: " + note);
+        doc_.lobes.push_back(std::move(copy));
+        return true;
+    }
+    double d = 0.0;
+    const Stroke* s = nearest_stroke(view, tip, d, StrokeKind::Trunk);
+    if (!s || d > pick_.stroke_pick_distance_m) {
+        std::string why = std::isfinite(pick.nearest_any)
+                              ? "the fingertip is outside every lobe and " + cm(pick.nearest_any) +
+                                    " from the nearest lobe stroke (pick distance " + cm(pick_.lobe_pick_distance_m) + ")"
+                              : std::string("there are no lobes");
+        why += s ? ", and " + cm(d) + " from the nearest trunk stroke (pick distance " +
+                       cm(pick_.stroke_pick_distance_m) + ")"
+                 : ", and there are no trunk strokes";
+        return nothing(why);
+    }
+    const Stroke source = *s;
+    snapshot();
+    doc_.strokes.push_back(copy_of(source, glm::dvec3(kTrunkCopyOffsetM, 0.0, 0.0)));
+    return true;
+}
+
+bool SessionBuilder::apply_setting(const InputAction& a)
+{
+    const SettingChange& c = a.setting;
+    const char* name = setting_name(c.id);
+    const std::string label = name ? std::string("setting ") + name : "setting";
+    auto refuse = [&](const std::string& why) {
+        messages_.push_back(when(label.c_str(), a.time) + why);
+        return false;
+    };
+    if (!name) return refuse("unknown setting id " + std::to_string(static_cast<std::int32_t>(c.id)));
+    const double v = c.value;
+    if (!std::isfinite(v)) return refuse("the value is not a finite number");
+    // Whole numbers in [lo, hi].
+    auto whole = [&](double lo, double hi) { return v >= lo && v <= hi && v == std::floor(v); };
+
+    Settings s = doc_.settings;
+    std::uint64_t seed = doc_.seed;
+    LobeRecord* lobe = nullptr;
+    std::optional<double> split;
+    std::string species;
+    if (c.lobe != 0) {
+        if (c.id != SettingId::SplitAngle && c.id != SettingId::Species)
+            return refuse(std::string(name) + " is a tree-wide setting (lobe " + std::to_string(c.lobe) +
+                          " given; only split-angle and species can be set per lobe)");
+        for (LobeRecord& l : doc_.lobes)
+            if (l.id == c.lobe) lobe = &l;
+        if (!lobe) return refuse("there is no lobe " + std::to_string(c.lobe));
+        split = lobe->split_angle_deg;
+        species = lobe->species;
+    }
+    try {
+        switch (c.id) {
+        case SettingId::SplitAngle:
+            if (lobe) {
+                GrowthSettings g = s.growth;
+                g.split_angle_deg = v;
+                validate_growth_settings(g);
+                split = v;
+            } else {
+                s.growth.split_angle_deg = v;
+                validate_growth_settings(s.growth);
+            }
+            break;
+        case SettingId::AttractorSpacing:
+            s.lobes.edge_length_m = v;
+            validate_settings(s);
+            break;
+        case SettingId::LeafLength: {
+            const double ratio = s.leaves.width_m / s.leaves.length_m;
+            s.leaves.length_m = v;
+            s.leaves.width_m = v * ratio;
+            validate_leaf_settings(s.leaves);
+            break;
+        }
+        case SettingId::LeavesPerNode:
+            if (!whole(-1e9, 1e9)) return refuse("leaves per node must be a whole number");
+            s.leaves.per_node = static_cast<int>(v);
+            validate_leaf_settings(s.leaves);
+            break;
+        case SettingId::Species: {
+            if (!whole(0, kSettingSpeciesCount - 1))
+                return refuse("the species index must be 0 to 3 (broadleaf, conifer, willow, birch)");
+            const std::string chosen = kSettingSpecies[static_cast<int>(v)];
+            if (lobe) {
+                species = chosen;
+            } else if (hooks_.apply_species) {
+                const std::string why = hooks_.apply_species(s, chosen);
+                if (!why.empty()) return refuse(why);
+            } else {
+                s.growth.species = chosen;
+            }
+            break;
+        }
+        case SettingId::Seed:
+            if (!whole(1, 16777215)) return refuse("the seed must be a whole number from 1 to 16777215");
+            seed = static_cast<std::uint64_t>(v);
+            break;
+        }
+    } catch (const InvalidInput& e) {
+        return refuse(e.what());
+    }
+    const bool changed = seed != doc_.seed || settings_json(s) != settings_json(doc_.settings) ||
+                         (lobe && (split != lobe->split_angle_deg || species != lobe->species));
+    if (!changed) return false;
+    // A slider being dragged: one undo step for the whole run.
+    const bool merge = setting_run_ && setting_run_->first == c.id && setting_run_->second == c.lobe && !undo_.empty();
+    if (!merge) snapshot();
+    doc_.settings = std::move(s);
+    doc_.seed = seed;
+    if (lobe) {
+        lobe->split_angle_deg = split;
+        lobe->species = species;
+    }
+    setting_run_ = std::make_pair(c.id, c.lobe);
+    return true;
 }
 
 void SessionBuilder::apply(const std::vector<InputAction>& actions)

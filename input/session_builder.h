@@ -2,11 +2,14 @@
 /// \file session_builder.h
 /// Applies the actions derived from raw input to a session document: completed strokes are
 /// added (lobe strokes to the current lobe, "new lobe" starts another), drags become edit
-/// operations aimed at what they picked, undo/redo walk the history of those changes.
+/// operations aimed at what they picked, delete/duplicate/mirror act on what the fingertip
+/// is at, panel settings change the settings, undo/redo walk the history of those changes.
 /// Operation types and params: docs/session-format.md; gestures: docs/editing.md.
 
 #include <functional>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/document.h"
@@ -37,6 +40,11 @@ struct EditHooks {
     std::function<std::vector<Stroke>(const Document&)> current_strokes;
     /// Empty when the operation, appended to the document, applies; else why not (one line).
     std::function<std::string(const Document&, const EditOperation&)> check;
+    /// A tree-wide species setting (SettingId::Species, lobe 0): overlays the named preset
+    /// on `settings` as `--species NAME` does (growth/species.h: apply_species(settings,
+    /// load_species(name))); empty when it did, else why not, `settings` unchanged. Absent:
+    /// only settings.growth.species is set to the name.
+    std::function<std::string(Settings&, const std::string&)> apply_species;
 };
 
 /// Centre of a lobe used by rotate and scale: the length-weighted barycentre of its strokes
@@ -52,11 +60,23 @@ public:
     /// when larger) from every lobe's strokes starts a new lobe.
     static constexpr double kJoinDistanceM = 0.10;
 
+    /// Duplicate: a lobe's copy goes its diameter (twice its bounding radius) plus this far
+    /// along +X; a trunk stroke's copy goes kTrunkCopyOffsetM along +X.
+    static constexpr double kDuplicateGapM = 0.05;
+    static constexpr double kTrunkCopyOffsetM = 0.10;
+
     explicit SessionBuilder(Document doc = {}, EditPickOptions pick = {}, EditHooks hooks = {});
 
-    /// Applies one action; returns true when the document changed. A drag that picks nothing
-    /// (too far from every stroke or lobe, or an edit that does not apply) changes nothing
-    /// and adds a warning to messages().
+    /// Applies one action; returns true when the document changed. A drag, delete,
+    /// duplicate or mirror that picks nothing (too far from every stroke or lobe, no hand
+    /// tracked, or an edit that does not apply) and a setting that is refused (unknown id,
+    /// out of range, per-lobe where only tree-wide is allowed) change nothing and add a
+    /// warning to messages(). Every change is one undo step, except that consecutive
+    /// settings of the same id and lobe (a slider being dragged) make one step together.
+    ///
+    /// Stroke ids: a completed stroke keeps its id unless the document already has that id
+    /// (a copy took it), then it gets the next id above every id used so far; copies get
+    /// such ids too.
     bool apply(const InputAction& action);
     void apply(const std::vector<InputAction>& actions);
 
@@ -68,6 +88,15 @@ public:
 private:
     void add_stroke(const Stroke& stroke);
     bool add_drag(const InputAction& action);
+    bool delete_at_tip(const InputAction& action);
+    bool copy_at_tip(const InputAction& action);
+    bool apply_setting(const InputAction& action);
+    /// The lobe's pinch deforms as copies for a lobe copied by `place` (see docs/editing.md):
+    /// their paths where the person sees them now, placed. Empty, with `note` saying why,
+    /// when they cannot be carried over faithfully.
+    std::vector<EditOperation> placed_deforms(const LobeRecord& lobe, bool mirror, const glm::dvec3& shift,
+                                              double mirror_x, std::string& note) const;
+    std::vector<Stroke> view() const;
     void snapshot();
 
     Document doc_;
@@ -78,6 +107,9 @@ private:
     std::vector<std::string> messages_;
     std::int64_t next_edit_id_ = 1;
     std::int64_t next_lobe_id_ = 1;
+    std::int64_t next_stroke_id_ = 1;
+    /// The setting (id, lobe) the last action changed, while only settings followed.
+    std::optional<std::pair<SettingId, std::int64_t>> setting_run_;
 };
 
 } // namespace lobe

@@ -1,8 +1,9 @@
 #pragma once
 /// \file tools.h
-/// Raw key codes that select the active tool. A pinch means whatever the active tool says
-/// (draw, deform, select), never guessed. Codes are GLFW key codes, so desktop keyboard
-/// input, synthesized scenarios and (later) in-VR panel presses share one mapping.
+/// Raw key codes that select the active tool or act on what the fingertip is at. A pinch
+/// means whatever the active tool says (draw, deform, select), never guessed. Codes are GLFW
+/// key codes, so desktop keyboard input, synthesized scenarios and (later) in-VR panel
+/// presses share one mapping. Panel settings are Setting events (input/recording.h).
 
 #include <cstdint>
 
@@ -30,6 +31,12 @@ inline constexpr int kScaleLobe = 75;  // GLFW_KEY_K (S is the desktop app's sav
 inline constexpr int kGrow = 71;       // GLFW_KEY_G
 inline constexpr int kUndo = 90;       // GLFW_KEY_Z
 inline constexpr int kRedo = 89;       // GLFW_KEY_Y
+// Actions on what the fingertip is at when the key is pressed (docs/editing.md, "Delete,
+// duplicate, mirror"): the right hand's filtered index tip, else the left hand's.
+inline constexpr int kDeleteStroke = 259; // GLFW_KEY_BACKSPACE: delete the stroke under the fingertip
+inline constexpr int kDeleteLobe = 261;   // GLFW_KEY_DELETE: delete the lobe under the fingertip
+inline constexpr int kDuplicate = 67;     // GLFW_KEY_C: copy the lobe (else trunk stroke) beside itself
+inline constexpr int kMirror = 88;        // GLFW_KEY_X: mirror the lobe (else trunk stroke) across the trunk's plane
 } // namespace keys
 
 const char* tool_name(Tool t);

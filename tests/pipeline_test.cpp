@@ -275,3 +275,69 @@ TEST(SessionBuilder, NewLobeKeyGroupsStrokesAndUndoRedoRestoreThem)
     EXPECT_EQ(b.document().strokes.size(), 3u);
     EXPECT_EQ(b.document().lobes.size(), 2u);
 }
+
+TEST(Pipeline, ActionKeysCarryTheRightFingertipElseTheLeftElseNone)
+{
+    const glm::vec3 right_tip(0.1f, 1.3f, -0.4f), left_tip(-0.2f, 1.25f, -0.45f);
+    auto actions = [&](bool right, bool left) {
+        Recording rec;
+        for (int i = 0; i < 60; ++i) {
+            HandFrame f = make_frame(i * kDt, make_hand(right_tip, 0.06f));
+            f.hand(Hand::Right).active = right;
+            if (left) f.hand(Hand::Left) = make_hand(left_tip, 0.06f);
+            rec.frames.push_back(f);
+        }
+        for (int key : {keys::kDeleteStroke, keys::kDeleteLobe, keys::kDuplicate, keys::kMirror})
+            rec.events.push_back({0.5, InputEventKind::Key, key, 1, 0, 0});
+        rec.events.push_back({0.55, InputEventKind::Key, keys::kMirror, 0, 0, 0}); // a release does nothing
+        return run_input_pipeline(rec).actions;
+    };
+    const InputAction::Type types[] = {InputAction::Type::DeleteStroke, InputAction::Type::DeleteLobe,
+                                       InputAction::Type::Duplicate, InputAction::Type::Mirror};
+    const std::vector<InputAction> both = actions(true, true), left = actions(false, true), none = actions(false, false);
+    ASSERT_EQ(both.size(), 4u);
+    ASSERT_EQ(left.size(), 4u);
+    ASSERT_EQ(none.size(), 4u);
+    for (int i = 0; i < 4; ++i) {
+        EXPECT_EQ(both[i].type, types[i]);
+        ASSERT_TRUE(both[i].tip.has_value());
+        EXPECT_EQ(both[i].tip_hand, Hand::Right);
+        EXPECT_LT(glm::distance(*both[i].tip, right_tip), 1e-4f); // filtered, at rest
+        ASSERT_TRUE(left[i].tip.has_value());
+        EXPECT_EQ(left[i].tip_hand, Hand::Left);
+        EXPECT_LT(glm::distance(*left[i].tip, left_tip), 1e-4f);
+        EXPECT_FALSE(none[i].tip.has_value());
+    }
+    EXPECT_STREQ(action_name(InputAction::Type::Mirror), "mirror");
+    EXPECT_EQ(keys::kDeleteStroke, 259); // GLFW_KEY_BACKSPACE
+    EXPECT_EQ(keys::kDeleteLobe, 261);   // GLFW_KEY_DELETE
+    EXPECT_EQ(keys::kDuplicate, 67);     // GLFW_KEY_C
+    EXPECT_EQ(keys::kMirror, 88);        // GLFW_KEY_X
+}
+
+TEST(Pipeline, SettingEventsBecomeSettingActionsWithTheDecimalTheSliderShowed)
+{
+    Recording rec;
+    InputEvent e;
+    e.time = 0.25;
+    e.kind = InputEventKind::Setting;
+    e.code = static_cast<std::int32_t>(SettingId::AttractorSpacing);
+    e.value = 0;
+    e.x = 0.03f;
+    rec.events.push_back(e);
+    e.time = 0.5;
+    e.code = static_cast<std::int32_t>(SettingId::Species);
+    e.value = 2;
+    e.x = 1.0f;
+    rec.events.push_back(e);
+    const InputResult r = run_input_pipeline(rec);
+    ASSERT_EQ(r.actions.size(), 2u);
+    EXPECT_EQ(r.actions[0].type, InputAction::Type::SettingChanged);
+    EXPECT_EQ(r.actions[0].time, 0.25);
+    EXPECT_EQ(r.actions[0].setting.id, SettingId::AttractorSpacing);
+    EXPECT_EQ(r.actions[0].setting.lobe, 0);
+    EXPECT_EQ(r.actions[0].setting.value, 0.03); // not 0.029999999329447746
+    EXPECT_EQ(r.actions[1].setting.id, SettingId::Species);
+    EXPECT_EQ(r.actions[1].setting.lobe, 2);
+    EXPECT_EQ(r.actions[1].setting.value, 1.0);
+}

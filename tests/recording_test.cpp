@@ -581,6 +581,70 @@ TEST(RecordingValidation, UnknownEventKindIsSkippedWithAWarning)
     EXPECT_TRUE(has_problem(report, "unknown event kind 'gamepad_axis' skipped")) << problems(report);
 }
 
+TEST(RecordingSettings, SettingEventsRoundTripExactlyInBothForms)
+{
+    Recording rec = sample_recording(4);
+    auto setting = [&](double t, SettingId id, int lobe, float x) {
+        InputEvent e;
+        e.time = t;
+        e.kind = InputEventKind::Setting;
+        e.code = static_cast<std::int32_t>(id);
+        e.value = lobe;
+        e.x = x;
+        rec.events.push_back(e);
+    };
+    setting(0.2, SettingId::SplitAngle, 0, 22.5f);
+    setting(0.21, SettingId::AttractorSpacing, 0, 0.03f);
+    setting(0.22, SettingId::Species, 3, 2.0f);
+    setting(0.23, SettingId::Seed, 0, 16777215.0f);
+    setting(0.24, SettingId::LeafLength, 0, 1e-7f); // out of range, but the reader keeps raw input
+    for (bool binary : {true, false}) {
+        ReadReport report;
+        const std::string bytes = binary ? encode_recording_binary(rec) : encode_recording_text(rec);
+        const Recording back = parse_recording(bytes, "settings", &report);
+        EXPECT_EQ(report.events_dropped, 0u) << problems(report);
+        expect_same_events_and_notes(rec, back);
+        // Text: the same bytes again after reading.
+        if (!binary) {
+            EXPECT_EQ(encode_recording_text(back), bytes);
+        }
+    }
+    EXPECT_NE(encode_recording_text(rec).find("event 0.2 setting 1 0 22.5\n"), std::string::npos);
+    EXPECT_STREQ(event_kind_name(InputEventKind::Setting), "setting");
+    EXPECT_STREQ(setting_name(SettingId::LeavesPerNode), "leaves-per-node");
+    EXPECT_EQ(setting_name(static_cast<SettingId>(7)), nullptr);
+}
+
+TEST(RecordingSettings, UnknownSettingIdIsSkippedWithAWarningNotACrash)
+{
+    std::string text = encode_recording_text(sample_recording(4));
+    text += "event 1 setting 9 0 0.5\n";
+    text += "event 1.1 setting 1 0 25\n";
+    text += "event 1.2 setting -2147483648 7 nan\n";
+    text += "event 1.3 setting 1 0\n";
+    ReadReport report;
+    Recording back = parse_recording(text, "ids.txt", &report);
+    ASSERT_EQ(back.events.size(), sample_recording(4).events.size() + 1);
+    EXPECT_EQ(back.events.back().kind, InputEventKind::Setting);
+    EXPECT_EQ(back.events.back().x, 25.0f);
+    EXPECT_EQ(report.events_dropped, 3u);
+    EXPECT_TRUE(has_problem(report, "unknown setting id 9 skipped")) << problems(report);
+    EXPECT_TRUE(has_problem(report, "unknown setting id -2147483648 skipped")) << problems(report);
+    EXPECT_TRUE(has_problem(report, "missing value in setting event")) << problems(report);
+
+    // Binary: the same rule for a newer writer's id.
+    Recording rec = sample_recording(4);
+    InputEvent e;
+    e.time = 0.2;
+    e.kind = InputEventKind::Setting;
+    e.code = 42;
+    rec.events.push_back(e);
+    ReadReport binary_report;
+    back = parse_recording(encode_recording_binary(rec), "ids.lrec", &binary_report);
+    EXPECT_EQ(back.events.size(), rec.events.size() - 1);
+    EXPECT_TRUE(has_problem(binary_report, "unknown setting id 42 skipped")) << problems(binary_report);
+}
+
 TEST(RecordingValidation, AbsurdCoordinatesDropTheFrame)
 {
     Recording rec = sample_recording(4);
