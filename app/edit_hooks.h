@@ -4,6 +4,8 @@
 /// drags pick strokes and lobes where the person sees them (earlier stroke edits and lobe
 /// transforms applied) and an edit that would not apply is refused when it is made.
 
+#include "core/errors.h"
+#include "growth/species.h"
 #include "input/session_builder.h"
 #include "meshing/edit_ops.h"
 
@@ -15,6 +17,15 @@ inline EditHooks meshing_edit_hooks(const EditApplyOptions& options = {})
     hooks.current_strokes = [options](const Document& doc) { return effective_strokes(doc, options); };
     hooks.check = [options](const Document& doc, const EditOperation& op) {
         return check_edit_operation(doc, op, options);
+    };
+    // A tree-wide species setting applies the preset as `--species` does.
+    hooks.apply_species = [](Settings& s, const std::string& name) {
+        try {
+            apply_species(s, load_species(name));
+            return std::string();
+        } catch (const Error& e) {
+            return std::string(e.what());
+        }
     };
     return hooks;
 }

@@ -17,7 +17,7 @@ RegrowWorker::~RegrowWorker()
     thread_.join();
 }
 
-std::uint64_t RegrowWorker::submit(Document doc)
+std::uint64_t RegrowWorker::submit(Document doc, bool grow_tree)
 {
     std::uint64_t generation = 0;
     {
@@ -25,6 +25,7 @@ std::uint64_t RegrowWorker::submit(Document doc)
         generation = ++submitted_;
         pending_ = std::move(doc); // replaces a waiting submission: latest wins
         pending_generation_ = generation;
+        pending_grow_ = grow_tree;
     }
     wake_.notify_one();
     return generation;
@@ -52,6 +53,7 @@ void RegrowWorker::run()
     for (;;) {
         Document doc;
         std::uint64_t generation = 0;
+        bool grow = true;
         {
             std::unique_lock<std::mutex> lock(mutex_);
             wake_.wait(lock, [&] { return stop_ || pending_.has_value(); });
@@ -59,12 +61,18 @@ void RegrowWorker::run()
             doc = std::move(*pending_);
             pending_.reset();
             generation = pending_generation_;
+            grow = pending_grow_;
         }
         RegrowResult result;
         result.generation = generation;
         try {
-            result.tree = build_document_tree(doc);
-            result.geometry = document_tree_geometry(doc, result.tree);
+            if (grow) {
+                result.tree = build_document_tree(doc);
+                result.geometry = document_tree_geometry(doc, result.tree);
+                result.grown = true;
+            } else {
+                result.tree.lobes = build_document_lobes(doc, &result.tree.warnings);
+            }
         } catch (const Error& e) {
             result.error = e.what();
         } catch (const std::bad_alloc&) {

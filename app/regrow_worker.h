@@ -19,6 +19,7 @@ namespace lobe {
 
 struct RegrowResult {
     std::uint64_t generation = 0; ///< the submit() call this result answers
+    bool grown = false;           ///< the tree was grown (else only the lobes were built)
     BuiltTree tree;
     TreeGeometry geometry;
     std::string error; ///< non-empty when the document could not be grown (one line)
@@ -32,8 +33,9 @@ public:
     RegrowWorker& operator=(const RegrowWorker&) = delete;
 
     /// Queues `doc` for regrowth and returns its generation number (1, 2, …). Never blocks on
-    /// growth.
-    std::uint64_t submit(Document doc);
+    /// growth. With `grow_tree` false only the lobes are built (the result's tree has lobes,
+    /// no growth, and its geometry no LOD): the sketching stages before the tree is grown.
+    std::uint64_t submit(Document doc, bool grow_tree = true);
     /// The newest finished result newer than the last one taken, if any. Never blocks on growth.
     std::optional<RegrowResult> take();
     /// Waits until the result of `generation` (or a newer one) is ready; for tests and batch use.
@@ -45,6 +47,7 @@ private:
     std::mutex mutex_;
     std::condition_variable wake_, done_;
     std::optional<Document> pending_;
+    bool pending_grow_ = true;
     std::uint64_t submitted_ = 0, pending_generation_ = 0;
     std::optional<RegrowResult> ready_;
     bool stop_ = false;
