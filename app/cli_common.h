@@ -80,5 +80,6 @@ void add_lobes_command(CLI::App& app, int& exit_code);
 void add_grow_command(CLI::App& app, int& exit_code);
 void add_export_command(CLI::App& app, int& exit_code);
 void add_render_command(CLI::App& app, int& exit_code);
+void add_desktop_command(CLI::App& app, int& exit_code);
 
 } // namespace lobe::cli

@@ -26,6 +26,7 @@ int run_cli(int argc, char** argv)
     cli::add_grow_command(app, exit_code);
     cli::add_export_command(app, exit_code);
     cli::add_render_command(app, exit_code);
+    cli::add_desktop_command(app, exit_code);
     app.parse_complete_callback([&] { cli::set_quiet(quiet); });
     try {
         app.parse(argc, argv);

@@ -15,6 +15,7 @@ PACKAGES=(
   libnanoflann-dev libtinygltf-dev libstb-dev
   libvulkan-dev mesa-vulkan-drivers glslc
   clang libclang-rt-14-dev
+  libglfw3-dev libimgui-dev xvfb xauth
 )
 
 missing=()
