@@ -22,6 +22,7 @@
 #include "app/desktop_script.h"
 #include "app/desktop_session.h"
 #include "app/export_scene.h"
+#include "app/loaded_libraries.h"
 #include "app/renderer.h"
 #include "core/atomic_file.h"
 #include "core/errors.h"
@@ -347,10 +348,18 @@ void add_desktop_command(CLI::App& app, int& exit_code)
         }
 
         glfwSetErrorCallback(nullptr);
+        // GLFW loads X11 (and the Vulkan loader its drivers) at run time: keep them loaded
+        // past glfwTerminate so their leftovers are not reported as leaks of unknown modules.
+        const std::vector<std::string> libraries_before = loaded_libraries();
+        keep_vulkan_drivers_loaded(); // before GLFW enumerates Vulkan
         if (!glfwInit())
             throw RenderUnavailable("desktop: cannot open a window (" + last_glfw_error() +
                                     "); set DISPLAY, or run it under xvfb-run (package xvfb)");
         Window win;
+        struct PinLibraries { // destroyed before win, i.e. before glfwTerminate
+            const std::vector<std::string>& before;
+            ~PinLibraries() { keep_loaded_since(before); }
+        } pin{libraries_before};
         glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API);
         win.handle = glfwCreateWindow(width, height, ("Lobesketch - " + fs::path(session).filename().string()).c_str(),
                                       nullptr, nullptr);

@@ -12,6 +12,7 @@
 //    exactly as a picture is, then blitted into the acquired swapchain image and presented.
 // Every submit is waited for (one frame in flight), so buffers may be rewritten between frames.
 #include "app/renderer.h"
+#include "app/loaded_libraries.h"
 
 #include <algorithm>
 #include <chrono>
@@ -129,30 +130,6 @@ void ensure_runtime_dir()
     std::filesystem::create_directories(dir, ec);
     std::filesystem::permissions(dir, std::filesystem::perms::owner_all, std::filesystem::perm_options::replace, ec);
     if (!ec) ::setenv("XDG_RUNTIME_DIR", dir.c_str(), 0);
-}
-
-/// Paths of the shared libraries loaded in the process now.
-std::vector<std::string> loaded_libraries()
-{
-    std::vector<std::string> out;
-    dl_iterate_phdr(
-        [](dl_phdr_info* info, std::size_t, void* data) {
-            if (info->dlpi_name && info->dlpi_name[0]) static_cast<std::vector<std::string>*>(data)->push_back(info->dlpi_name);
-            return 0;
-        },
-        &out);
-    return out;
-}
-
-/// Keeps the libraries that creating an instance loaded (the Vulkan drivers and what they
-/// need, e.g. lavapipe and LLVM) loaded until the process ends. Mesa's drivers keep global
-/// state that they do not free when the loader unloads them with the last instance; loaded
-/// once, they are not loaded again for the next Renderer either.
-void keep_drivers_loaded(const std::vector<std::string>& before)
-{
-    for (const std::string& lib : loaded_libraries())
-        if (std::find(before.begin(), before.end(), lib) == before.end())
-            dlopen(lib.c_str(), RTLD_NOW | RTLD_NOLOAD | RTLD_NODELETE);
 }
 
 const char* const kInstallHint =
@@ -353,7 +330,7 @@ private:
             const VkResult listed = vkEnumerateInstanceExtensionProperties(nullptr, &n, nullptr);
             std::vector<VkExtensionProperties> available(n);
             if (listed == VK_SUCCESS && n) vkEnumerateInstanceExtensionProperties(nullptr, &n, available.data());
-            keep_drivers_loaded(libraries);
+            keep_loaded_since(libraries);
             for (const std::string& e : instance_extensions_) {
                 const bool found = std::any_of(available.begin(), available.end(),
                                                [&](const VkExtensionProperties& p) { return e == p.extensionName; });
@@ -373,7 +350,7 @@ private:
             info.ppEnabledLayerNames = &validation;
         }
         const VkResult created = vkCreateInstance(&info, nullptr, &instance_);
-        keep_drivers_loaded(libraries);
+        keep_loaded_since(libraries);
         if (VkResult r = created; r != VK_SUCCESS) {
             instance_ = VK_NULL_HANDLE;
             throw RenderUnavailable(std::string("render: no Vulkan driver (vkCreateInstance: ") + vk::result_name(r) +
@@ -1558,6 +1535,23 @@ Handle handle_from_integer(std::uint64_t v)
 }
 
 } // namespace
+
+void keep_vulkan_drivers_loaded()
+{
+    ensure_runtime_dir();
+    const std::vector<std::string> before = loaded_libraries();
+    auto app = vk_struct<VkApplicationInfo>(VK_STRUCTURE_TYPE_APPLICATION_INFO);
+    app.pApplicationName = "lobesketch";
+    app.apiVersion = VK_API_VERSION_1_1;
+    auto info = vk_struct<VkInstanceCreateInfo>(VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO);
+    info.pApplicationInfo = &app;
+    VkInstance instance = VK_NULL_HANDLE;
+    if (vkCreateInstance(&info, nullptr, &instance) != VK_SUCCESS) return;
+    std::uint32_t count = 0;
+    vkEnumeratePhysicalDevices(instance, &count, nullptr); // drivers finish loading here
+    keep_loaded_since(before);
+    vkDestroyInstance(instance, nullptr);
+}
 
 // ---------------------------------------------------------------------------------------------
 struct Renderer::Impl {

@@ -158,6 +158,13 @@ struct RenderStats {
     double gpu_ms = 0.0;             ///< submit to fence of the last frame (drawing, resolve, copy or blit)
 };
 
+/// Loads the Vulkan drivers once (a throwaway instance) and keeps them loaded until the
+/// process ends, as every Renderer does for the drivers it loads. Call it before other code
+/// enumerates Vulkan (GLFW's glfwGetRequiredInstanceExtensions loads and unloads every
+/// driver, and Mesa's drivers leave state behind each time they are unloaded). Does nothing
+/// when no Vulkan instance can be made.
+void keep_vulkan_drivers_loaded();
+
 /// A Vulkan renderer with an offscreen target. Not thread-safe: one thread uses it.
 class Renderer {
 public:

@@ -109,6 +109,17 @@ enum StreamTag : std::uint64_t {
 // Small helpers
 // ---------------------------------------------------------------------------------------
 
+/// Three clamped normal draws as (x, y, z), z drawn first. Function arguments are evaluated
+/// in an unspecified order (gcc right to left, clang left to right), so draws are never made
+/// inside one call's arguments; z, y, x is the order the shipped recordings were made in.
+dvec3 normal3(Rng& rng, double k)
+{
+    const double z = rng.normal_clamped(k);
+    const double y = rng.normal_clamped(k);
+    const double x = rng.normal_clamped(k);
+    return dvec3(x, y, z);
+}
+
 std::string num(double v)
 {
     std::ostringstream os;
@@ -758,7 +769,9 @@ Person make_person(std::uint64_t seed, double uniform_radius)
         const double side = h == static_cast<int>(Hand::Right) ? 1.0 : -1.0;
         HandPersona& hp = p.hand[static_cast<std::size_t>(h)];
         hp.shoulder = dvec3(0.18 * side, p.eye_height - 0.23, 0.02);
-        hp.rest = dvec3(side * rng.uniform(0.19, 0.24), p.eye_height - rng.uniform(0.60, 0.66), -rng.uniform(0.18, 0.26));
+        // z, y, x: the order the shipped recordings were made in (see normal3).
+        const double rest_z = -rng.uniform(0.18, 0.26), rest_y = p.eye_height - rng.uniform(0.60, 0.66);
+        hp.rest = dvec3(side * rng.uniform(0.19, 0.24), rest_y, rest_z);
         hp.roll = side * rng.uniform(0.5, 0.7);
         hp.rest_sway = Sway::random(rng, 0.006, 0.1, 0.35);
         hp.hover = Sway::random(rng, 0.003, 0.15, 0.45);
@@ -1306,17 +1319,17 @@ struct TremorState {
 void add_noise(HandState& hs, Rng& rng, const dvec3& tremor)
 {
     const double k = 2.5;
-    dvec3 common(rng.normal_clamped(k), rng.normal_clamped(k), rng.normal_clamped(k));
+    dvec3 common = normal3(rng, k);
     common *= 0.0005;
     std::array<dvec3, 5> finger{};
-    for (auto& f : finger) f = 0.00035 * dvec3(rng.normal_clamped(k), rng.normal_clamped(k), rng.normal_clamped(k));
+    for (auto& f : finger) f = 0.00035 * normal3(rng, k);
     for (int j = 0; j < kJointCount; ++j) {
-        dvec3 own = 0.0003 * dvec3(rng.normal_clamped(k), rng.normal_clamped(k), rng.normal_clamped(k));
+        dvec3 own = 0.0003 * normal3(rng, k);
         int f = finger_of(j);
         dvec3 off = common + own + tremor + (f >= 0 ? finger[static_cast<std::size_t>(f)] : dvec3(0.0));
         JointState& js = hs.joints[static_cast<std::size_t>(j)];
         js.pose.position += glm::vec3(off);
-        dvec3 r = 0.005 * dvec3(rng.normal_clamped(k), rng.normal_clamped(k), rng.normal_clamped(k));
+        dvec3 r = 0.005 * normal3(rng, k);
         double angle = glm::length(r);
         if (angle > 1e-12)
             js.pose.orientation = glm::normalize(js.pose.orientation * glm::quat(glm::angleAxis(angle, r / angle)));

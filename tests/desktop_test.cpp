@@ -71,7 +71,10 @@ struct Driver {
         move(x0, y0);
         s.mouse_button(button, true);
         step();
-        for (int i = 1; i <= frames; ++i) move(x0 + (x1 - x0) * i / frames, y0 + (y1 - y0) * i / frames);
+        for (int i = 1; i <= frames; ++i) {
+            const float u = float(i) / float(frames);
+            move(x0 + (x1 - x0) * u, y0 + (y1 - y0) * u);
+        }
         s.mouse_button(button, false);
         step(6);
     }
