@@ -50,7 +50,7 @@ public:
 /// How a mesh is shaded (app/shaders/mesh.frag).
 enum class RenderMaterial : std::uint8_t {
     Bark,   ///< opaque, lit, back faces culled
-    Leaf,   ///< alpha-tested from the leaf texture, two-sided
+    Leaf,   ///< alpha-tested from the leaf texture, two-sided; leaf quads drawn instanced (RendererOptions::instanced_leaves)
     Lobe,   ///< translucent (alpha blend, after the opaque meshes, no depth write), two-sided
     Stroke, ///< opaque, nearly unlit (stroke tubes)
 };
