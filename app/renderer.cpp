@@ -4,7 +4,8 @@
 //  - OffscreenTarget: the images a frame is drawn into (MSAA colour, depth, resolve) and the
 //    buffer it is read back through (made on first use);
 //  - SceneDrawer: pipelines, the leaf texture, the per-mesh GPU buffer cache (keyed by
-//    RenderItem::key, re-uploaded only when RenderItem::version changes) and recording the
+//    RenderItem::key, re-uploaded only when RenderItem::version changes; leaf meshes made of
+//    leaves.cpp's quads become one instance per leaf over a shared quad) and recording the
 //    draws of one frame into a command buffer inside any compatible render pass;
 //  - OverlayDrawer: the 2D overlay's pipeline, font texture and host-visible buffers, drawn
 //    after the scene in the same render pass;
@@ -21,6 +22,7 @@
 #include <cstring>
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <unordered_map>
 #include <type_traits>
 #include <unordered_set>
@@ -119,6 +121,57 @@ struct Vertex {
     float uv[2];
 };
 static_assert(sizeof(Vertex) == 32);
+
+/// One leaf quad drawn instanced (app/shaders/leaf.vert): corners 0, 1 and 3 of its four
+/// vertices (corner 2 is 1 + (3 − 0)) and its normal.
+struct LeafInstance {
+    float corner0[3];
+    float corner1[3];
+    float corner3[3];
+    float normal[3];
+};
+static_assert(sizeof(LeafInstance) == 48);
+
+/// A leaf mesh as one instance per quad, when it is made of quads as growth/leaves.cpp emits
+/// them: vertices 4q … 4q + 3 and triangles 2q = (4q, 4q + 1, 4q + 2) and 2q + 1 =
+/// (4q, 4q + 2, 4q + 3) for every quad q, the four vertices of a quad with one normal, every
+/// quad with the uvs of the first (or none), and each quad a parallelogram: vertex 2 is
+/// 1 + (3 − 0), as leaf.vert makes it, to rounding (1e-4 of the quad's longer edge plus a few
+/// float steps of its coordinates; more would move the leaf's corner on screen). Returns false
+/// (and `instances` is then meaningless) for any other mesh: it is drawn as a mesh.
+bool as_leaf_instances(const SurfaceGeometry& g, std::vector<LeafInstance>& instances, std::array<glm::vec2, 4>& uvs)
+{
+    const std::size_t n = g.positions.size();
+    if (n == 0 || n % 4 != 0 || g.triangles.size() != n / 2 || g.normals.size() != n) return false;
+    uvs = {};
+    if (!g.uvs.empty()) {
+        if (g.uvs.size() != n) return false;
+        std::copy(g.uvs.begin(), g.uvs.begin() + 4, uvs.begin());
+    }
+    instances.clear();
+    instances.reserve(n / 4);
+    for (std::size_t q = 0; q < n / 4; ++q) {
+        const auto f = static_cast<std::uint32_t>(4 * q);
+        const std::array<std::uint32_t, 3> first{f, f + 1, f + 2}, second{f, f + 2, f + 3};
+        if (g.triangles[2 * q] != first || g.triangles[2 * q + 1] != second) return false;
+        const glm::vec3& normal = g.normals[f];
+        for (std::uint32_t k = 1; k < 4; ++k)
+            if (g.normals[f + k] != normal) return false;
+        if (!g.uvs.empty())
+            for (std::uint32_t k = 0; k < 4; ++k)
+                if (g.uvs[f + k] != uvs[k]) return false;
+        const glm::vec3 &p0 = g.positions[f], &p1 = g.positions[f + 1], &p2 = g.positions[f + 2], &p3 = g.positions[f + 3];
+        const float edge = std::max(glm::length(p1 - p0), glm::length(p3 - p0));
+        float magnitude = 0.0f;
+        for (const glm::vec3* p : {&p0, &p1, &p2, &p3})
+            magnitude = std::max({magnitude, std::abs(p->x), std::abs(p->y), std::abs(p->z)});
+        const float error = glm::length(p1 + (p3 - p0) - p2);
+        // Written so that NaN and infinite coordinates fail it.
+        if (!(error <= 1e-4f * edge + 8.0f * std::numeric_limits<float>::epsilon() * magnitude)) return false;
+        instances.push_back({{p0.x, p0.y, p0.z}, {p1.x, p1.y, p1.z}, {p3.x, p3.y, p3.z}, {normal.x, normal.y, normal.z}});
+    }
+    return true;
+}
 
 // lavapipe warns on every start without XDG_RUNTIME_DIR; give it a private folder.
 void ensure_runtime_dir()
@@ -850,7 +903,8 @@ VkPipeline create_pipeline(VkDevice device, VkRenderPass pass, const FrameFormat
 /// Pipelines, the leaf texture, the mesh cache, and the draws of one frame.
 class SceneDrawer {
 public:
-    SceneDrawer(const VulkanContext& ctx, VkRenderPass pass, const FrameFormat& format) : ctx_(ctx)
+    SceneDrawer(const VulkanContext& ctx, VkRenderPass pass, const FrameFormat& format, bool instanced_leaves)
+        : ctx_(ctx), instanced_leaves_(instanced_leaves)
     {
         try {
             create(pass, format);
@@ -885,7 +939,7 @@ public:
         const RgbaImage& tex = scene.leaf_texture;
         const bool has_texture = check_rgba(tex, "a leaf texture");
 
-        stats.meshes_uploaded = stats.meshes_kept = stats.bytes_uploaded = 0;
+        stats.meshes_uploaded = stats.meshes_kept = stats.bytes_uploaded = stats.leaf_instances = 0;
         for (auto it = cache_.begin(); it != cache_.end();) {
             if (!keys.count(it->first)) {
                 ctx_.destroy(it->second.buffer);
@@ -897,7 +951,10 @@ public:
         draws_.clear();
         for (const RenderItem& item : scene.items) {
             auto it = cache_.find(item.key);
-            if (it != cache_.end() && it->second.version == item.version) {
+            // Instances are drawn by the leaf pipeline only: an instanced mesh given another
+            // material is uploaded again, as a mesh.
+            if (it != cache_.end() && it->second.version == item.version &&
+                (it->second.instance_count == 0 || item.material == RenderMaterial::Leaf)) {
                 ++stats.meshes_kept;
             } else {
                 if (it != cache_.end()) ctx_.destroy(it->second.buffer);
@@ -907,6 +964,7 @@ public:
             it->second.material = item.material;
             it->second.color = glm::vec4(item.color[0], item.color[1], item.color[2], item.color[3]);
             if (it->second.index_count > 0) draws_.push_back(item.key);
+            stats.leaf_instances += it->second.instance_count;
         }
         // The white texel stands for "no texture": a texture replacing it (or replaced by it)
         // is uploaded whatever its version.
@@ -962,19 +1020,28 @@ public:
         }
 
         auto draw = [&](const GpuMesh& m) {
-            const VkDeviceSize offset = 0;
-            vkCmdBindVertexBuffers(cmd, 0, 1, &m.buffer.buffer, &offset);
+            if (m.instance_count > 0) {
+                // The shared quad's uvs (binding 0) and the leaves (binding 1) in one buffer.
+                const VkBuffer buffers[2] = {m.buffer.buffer, m.buffer.buffer};
+                const VkDeviceSize offsets[2] = {0, m.instance_offset};
+                vkCmdBindVertexBuffers(cmd, 0, 2, buffers, offsets);
+            } else {
+                const VkDeviceSize offset = 0;
+                vkCmdBindVertexBuffers(cmd, 0, 1, &m.buffer.buffer, &offset);
+            }
             vkCmdBindIndexBuffer(cmd, m.buffer.buffer, m.index_offset, VK_INDEX_TYPE_UINT32);
             push({view_proj, m.color, eye, glm::vec4(float(static_cast<int>(m.material)), 0.0f, 0.0f, 0.0f)});
-            vkCmdDrawIndexed(cmd, m.index_count, 1, 0, 0, 0);
+            vkCmdDrawIndexed(cmd, m.index_count, std::max(m.instance_count, 1u), 0, 0, 0);
         };
+        // The meshes of `materials` in scene order; instanced leaves with leaf_instanced_.
         auto draw_all = [&](VkPipeline pipeline, std::initializer_list<RenderMaterial> materials) {
-            bool bound = false;
+            VkPipeline bound = VK_NULL_HANDLE;
             for (std::uint64_t key : draws_) {
                 const GpuMesh& m = cache_.at(key);
                 if (std::find(materials.begin(), materials.end(), m.material) == materials.end()) continue;
-                if (!bound) vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
-                bound = true;
+                const VkPipeline wanted = m.instance_count > 0 ? leaf_instanced_ : pipeline;
+                if (wanted != bound) vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, wanted);
+                bound = wanted;
                 draw(m);
             }
         };
@@ -994,9 +1061,14 @@ public:
 private:
     struct GpuMesh {
         std::uint64_t version = 0;
-        GpuBuffer buffer; // vertices (Vertex), then uint32 indices at index_offset
+        // Vertices (Vertex), then uint32 indices at index_offset. Instanced leaves: the shared
+        // quad's four uvs (vec2), its 6 indices at index_offset, the leaves (LeafInstance) at
+        // instance_offset.
+        GpuBuffer buffer;
         VkDeviceSize index_offset = 0;
         std::uint32_t index_count = 0;
+        VkDeviceSize instance_offset = 0;
+        std::uint32_t instance_count = 0; // 0: drawn as a mesh
         RenderMaterial material = RenderMaterial::Bark;
         glm::vec4 color{1.0f};
         glm::vec3 centre{0.0f};
@@ -1009,6 +1081,11 @@ private:
         m.version = item.version;
         m.index_count = static_cast<std::uint32_t>(g.triangles.size() * 3u);
         if (g.triangles.empty()) return m;
+        if (instanced_leaves_ && item.material == RenderMaterial::Leaf) {
+            std::vector<LeafInstance> instances;
+            std::array<glm::vec2, 4> uvs;
+            if (as_leaf_instances(g, instances, uvs)) return upload_leaf_instances(item, instances, uvs, stats);
+        }
         std::vector<Vertex> vertices(g.positions.size());
         Bounds b;
         for (std::size_t i = 0; i < vertices.size(); ++i) {
@@ -1033,6 +1110,39 @@ private:
             throw;
         }
         stats.bytes_uploaded += vertex_bytes + index_bytes;
+        return m;
+    }
+
+    /// A leaf mesh as instances (see as_leaf_instances): 32 bytes of uvs and 24 of indices
+    /// for the shared quad, 48 bytes per leaf, instead of 4 vertices (128 bytes) and 2
+    /// triangles (24 bytes) per leaf.
+    GpuMesh upload_leaf_instances(const RenderItem& item, const std::vector<LeafInstance>& instances,
+                                  const std::array<glm::vec2, 4>& uvs, RenderStats& stats) const
+    {
+        GpuMesh m;
+        m.version = item.version;
+        Bounds b;
+        for (const glm::vec3& p : item.geometry.positions) b.add(p);
+        m.centre = 0.5f * (b.lo + b.hi);
+        static constexpr std::uint32_t kQuad[6] = {0, 1, 2, 0, 2, 3}; // leaves.cpp's two triangles
+        static_assert(sizeof(uvs) == 32);
+        m.index_offset = sizeof(uvs);
+        m.index_count = 6;
+        m.instance_offset = 64;
+        m.instance_count = static_cast<std::uint32_t>(instances.size());
+        const std::size_t instance_bytes = instances.size() * sizeof(LeafInstance);
+        m.buffer = ctx_.create_buffer(m.instance_offset + instance_bytes,
+                                      VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_INDEX_BUFFER_BIT,
+                                      VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+        try {
+            ctx_.write(m.buffer, 0, uvs.data(), sizeof(uvs));
+            ctx_.write(m.buffer, m.index_offset, kQuad, sizeof(kQuad));
+            ctx_.write(m.buffer, m.instance_offset, instances.data(), instance_bytes);
+        } catch (...) {
+            ctx_.destroy(m.buffer);
+            throw;
+        }
+        stats.bytes_uploaded += sizeof(uvs) + sizeof(kQuad) + instance_bytes;
         return m;
     }
 
@@ -1095,6 +1205,24 @@ private:
         ground_pipeline_ = make({"ground.vert", "ground.frag", nullptr, VK_CULL_MODE_NONE, true, true, false});
         opaque_ = make({"mesh.vert", "mesh.frag", &mesh, VK_CULL_MODE_BACK_BIT, true, true, false});
         leaf_ = make({"mesh.vert", "mesh.frag", &mesh, VK_CULL_MODE_NONE, true, true, false});
+        // Instanced leaves: the shared quad's uvs per vertex, the leaves per instance.
+        const VkVertexInputBindingDescription leaf_bindings[2] = {
+            {0, sizeof(glm::vec2), VK_VERTEX_INPUT_RATE_VERTEX},
+            {1, sizeof(LeafInstance), VK_VERTEX_INPUT_RATE_INSTANCE},
+        };
+        const VkVertexInputAttributeDescription leaf_attributes[5] = {
+            {0, 0, VK_FORMAT_R32G32_SFLOAT, 0},
+            {1, 1, VK_FORMAT_R32G32B32_SFLOAT, offsetof(LeafInstance, corner0)},
+            {2, 1, VK_FORMAT_R32G32B32_SFLOAT, offsetof(LeafInstance, corner1)},
+            {3, 1, VK_FORMAT_R32G32B32_SFLOAT, offsetof(LeafInstance, corner3)},
+            {4, 1, VK_FORMAT_R32G32B32_SFLOAT, offsetof(LeafInstance, normal)},
+        };
+        auto leaf_input = vk_struct<VkPipelineVertexInputStateCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO);
+        leaf_input.vertexBindingDescriptionCount = 2;
+        leaf_input.pVertexBindingDescriptions = leaf_bindings;
+        leaf_input.vertexAttributeDescriptionCount = 5;
+        leaf_input.pVertexAttributeDescriptions = leaf_attributes;
+        leaf_instanced_ = make({"leaf.vert", "mesh.frag", &leaf_input, VK_CULL_MODE_NONE, true, true, false});
         lobe_ = make({"mesh.vert", "mesh.frag", &mesh, VK_CULL_MODE_NONE, true, false, true});
     }
 
@@ -1104,7 +1232,7 @@ private:
         for (auto& [key, mesh] : cache_) ctx_.destroy(mesh.buffer);
         cache_.clear();
         ctx_.destroy(texture_);
-        for (VkPipeline p : {sky_, ground_pipeline_, opaque_, leaf_, lobe_})
+        for (VkPipeline p : {sky_, ground_pipeline_, opaque_, leaf_, leaf_instanced_, lobe_})
             if (p) vkDestroyPipeline(dev, p, nullptr);
         if (sampler_) vkDestroySampler(dev, sampler_, nullptr);
         if (descriptor_pool_) vkDestroyDescriptorPool(dev, descriptor_pool_, nullptr);
@@ -1119,7 +1247,8 @@ private:
     VkDescriptorSet descriptor_set_ = VK_NULL_HANDLE;
     VkSampler sampler_ = VK_NULL_HANDLE;
     VkPipeline sky_ = VK_NULL_HANDLE, ground_pipeline_ = VK_NULL_HANDLE, opaque_ = VK_NULL_HANDLE, leaf_ = VK_NULL_HANDLE,
-               lobe_ = VK_NULL_HANDLE;
+               leaf_instanced_ = VK_NULL_HANDLE, lobe_ = VK_NULL_HANDLE;
+    bool instanced_leaves_ = true;
     GpuImage texture_;
     std::uint64_t texture_version_ = 0;
     bool texture_ready_ = false;
@@ -1560,7 +1689,7 @@ struct Renderer::Impl {
         format = choose_frame_format(ctx, options.samples);
         pass = create_offscreen_render_pass(ctx.device(), format);
         try {
-            drawer = std::make_unique<SceneDrawer>(ctx, pass, format);
+            drawer = std::make_unique<SceneDrawer>(ctx, pass, format, options.instanced_leaves);
             drawer->set_scene(RenderScene{}, stats);
             overlay = std::make_unique<OverlayDrawer>(ctx, pass, format, drawer->texture_set_layout(), drawer->sampler());
             overlay->set(Overlay{});

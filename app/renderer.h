@@ -50,7 +50,7 @@ public:
 /// How a mesh is shaded (app/shaders/mesh.frag).
 enum class RenderMaterial : std::uint8_t {
     Bark,   ///< opaque, lit, back faces culled
-    Leaf,   ///< alpha-tested from the leaf texture, two-sided
+    Leaf,   ///< alpha-tested from the leaf texture, two-sided; leaf quads drawn instanced (RendererOptions::instanced_leaves)
     Lobe,   ///< translucent (alpha blend, after the opaque meshes, no depth write), two-sided
     Stroke, ///< opaque, nearly unlit (stroke tubes)
 };
@@ -147,13 +147,19 @@ struct RendererOptions {
     std::vector<std::string> instance_extensions;
     /// Enable VK_KHR_swapchain: only devices that have it are chosen. Needed by attach_window.
     bool presentation = false;
+    /// Draw a RenderMaterial::Leaf mesh made of leaf quads as growth/leaves.cpp emits them
+    /// (4 vertices and 2 triangles per quad, parallelograms, one normal per quad, the same uvs
+    /// on every quad) instanced: one shared quad, one instance per leaf. Any other leaf mesh is
+    /// drawn as an ordinary mesh. false: every leaf mesh as an ordinary mesh (the reference).
+    bool instanced_leaves = true;
 };
 
 /// How much GPU upload the last set_scene did, and what the last render took.
 struct RenderStats {
     std::size_t meshes_uploaded = 0; ///< by the last set_scene
     std::size_t meshes_kept = 0;     ///< cached meshes the last set_scene did not touch
-    std::size_t bytes_uploaded = 0;  ///< by the last set_scene (vertices, indices, texture)
+    std::size_t bytes_uploaded = 0;  ///< by the last set_scene (vertices, indices, instances, texture)
+    std::size_t leaf_instances = 0;  ///< leaf quads of the scene set last that are drawn instanced
     double record_ms = 0.0;          ///< CPU time recording the last frame's command buffer
     double gpu_ms = 0.0;             ///< submit to fence of the last frame (drawing, resolve, copy or blit)
 };

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <memory>
 #include <type_traits>
 
@@ -16,6 +17,7 @@
 #include <sys/wait.h>
 
 #include "app/edit_hooks.h"
+#include "app/export_gltf.h"
 #include "app/export_scene.h"
 #include "app/render_scene.h"
 #include "app/renderer.h"
@@ -43,6 +45,7 @@ struct Shared {
     BuiltTree tree;
     TreeGeometry geometry;
     std::unique_ptr<Renderer> renderer;
+    std::unique_ptr<Renderer> reference; // leaves as plain triangles (made on first use)
 };
 
 Shared& shared()
@@ -74,6 +77,27 @@ RgbaImage draw(const RenderScene& scene, const Camera& camera, int w = kW, int h
 {
     Renderer& r = *shared().renderer;
     r.set_scene(scene);
+    return r.render(camera, w, h);
+}
+
+/// The renderer that draws every leaf mesh as plain triangles (RendererOptions::instanced_leaves
+/// off): the reference for the instanced leaves.
+Renderer& reference_renderer()
+{
+    Shared& s = shared();
+    if (!s.reference) {
+        RendererOptions options;
+        options.instanced_leaves = false;
+        s.reference = std::make_unique<Renderer>(options);
+    }
+    return *s.reference;
+}
+
+RgbaImage draw_reference(const RenderScene& scene, const Camera& camera, int w = kW, int h = kH)
+{
+    Renderer& r = reference_renderer();
+    r.set_scene(scene);
+    EXPECT_EQ(r.stats().leaf_instances, 0u);
     return r.render(camera, w, h);
 }
 
@@ -315,6 +339,195 @@ TEST(RenderScene, UnchangedMeshesStayOnTheGpuAndOnlyChangedOnesAreUploaded)
     r.set_scene(moved);
     EXPECT_EQ(r.stats().meshes_uploaded, 1u);
     EXPECT_EQ(r.stats().meshes_kept, 1u);
+}
+
+/// How two pictures of the same size differ: pixels with any channel different, and the
+/// largest channel difference.
+struct PictureDifference {
+    std::size_t pixels = 0;
+    int max_channel = 0;
+    std::string describe() const
+    {
+        return std::to_string(pixels) + " pixel(s) differ, by at most " + std::to_string(max_channel) + " of 255";
+    }
+};
+
+PictureDifference difference(const RgbaImage& a, const RgbaImage& b)
+{
+    PictureDifference d;
+    EXPECT_EQ(a.pixels.size(), b.pixels.size());
+    for (std::size_t i = 0; i + 3 < std::min(a.pixels.size(), b.pixels.size()); i += 4) {
+        int m = 0;
+        for (std::size_t k = 0; k < 3; ++k) m = std::max(m, std::abs(int(a.pixels[i + k]) - int(b.pixels[i + k])));
+        d.pixels += m > 0;
+        d.max_channel = std::max(d.max_channel, m);
+    }
+    return d;
+}
+
+/// The leaf item of a tree scene.
+const RenderItem& leaf_item(const RenderScene& scene)
+{
+    for (const RenderItem& item : scene.items)
+        if (item.material == RenderMaterial::Leaf) return item;
+    ADD_FAILURE() << "no leaf item";
+    return scene.items.front();
+}
+
+// The rendering issue's "leaves instanced": growth/leaves.cpp's quads are drawn as one
+// instance each over a shared quad, and the picture is the one the same leaves give drawn as
+// plain triangles. Only rounding differs: the quad's fourth corner is computed on the GPU.
+TEST(RenderLeaves, InstancedLeavesDrawTheSamePictureAsTheLeafTriangles)
+{
+    struct Case {
+        int lod;
+        ViewAngles view;
+        const char* name;
+    };
+    const Case cases[] = {{0, front_view(), "lod0_front"}, {0, side_view(), "lod0_side"}, {2, front_view(), "lod2_front"}};
+    for (const Case& c : cases) {
+        RenderContent content;
+        content.lod = c.lod;
+        const RenderScene scene = tree_scene(content);
+        const Camera camera = camera_for(scene, c.view);
+        const RgbaImage instanced = draw(scene, camera);
+        const std::size_t quads = leaf_item(scene).geometry.triangle_count() / 2;
+        ASSERT_GT(quads, 100u);
+        EXPECT_EQ(shared().renderer->stats().leaf_instances, quads) << c.name;
+        const RgbaImage reference = draw_reference(scene, camera);
+        const PictureDifference d = difference(instanced, reference);
+        // Near identity: a handful of edge samples may fall the other way.
+        EXPECT_LE(d.pixels, std::size_t(kW * kH) / 1000) << c.name << ": " << d.describe();
+        EXPECT_LE(d.max_channel, 64) << c.name << ": " << d.describe();
+        RecordProperty(std::string("difference_") + c.name, d.describe());
+        std::printf("instanced vs triangles, %s: %s (of %d)\n", c.name, d.describe().c_str(), kW * kH);
+    }
+}
+
+// GPU memory: 48 bytes per leaf (and 56 for the shared quad) instead of 4 vertices of 32
+// bytes and 2 triangles of 12.
+TEST(RenderLeaves, InstancedLeavesUploadAThirdOfTheBytes)
+{
+    RenderContent content;
+    content.tree = false;
+    const RenderScene leaves = tree_scene(content);
+    RenderScene texture_only = leaves;
+    texture_only.items.clear();
+    const std::size_t quads = leaf_item(leaves).geometry.triangle_count() / 2;
+    auto leaf_bytes = [&](Renderer& r) {
+        r.set_scene(texture_only); // the texture first: the next call uploads only the leaves
+        r.set_scene(leaves);
+        EXPECT_EQ(r.stats().meshes_uploaded, 1u);
+        return r.stats().bytes_uploaded;
+    };
+    const std::size_t instanced = leaf_bytes(*shared().renderer), triangles = leaf_bytes(reference_renderer());
+    EXPECT_EQ(instanced, 56 + 48 * quads);
+    EXPECT_EQ(triangles, 152 * quads);
+    RecordProperty("leaf_bytes", std::to_string(quads) + " leaves: " + std::to_string(triangles) + " bytes as triangles, " +
+                                     std::to_string(instanced) + " instanced");
+    std::printf("%zu leaves: %zu bytes as triangles, %zu instanced\n", quads, triangles, instanced);
+    // The same leaves again under the same version: nothing is uploaded.
+    shared().renderer->set_scene(leaves);
+    EXPECT_EQ(shared().renderer->stats().bytes_uploaded, 0u);
+    EXPECT_EQ(shared().renderer->stats().leaf_instances, quads);
+}
+
+// Leaf meshes that are not leaves.cpp's quads are drawn as meshes, as before: the pictures
+// are byte for byte those of the renderer that draws every leaf mesh as triangles.
+TEST(RenderLeaves, LeafMeshesThatAreNotLeafQuadsAreDrawnAsMeshes)
+{
+    const RenderScene tree = tree_scene();
+    const Camera camera = camera_for(tree, front_view());
+    const std::size_t leaf_index = std::size_t(&leaf_item(tree) - tree.items.data());
+    std::vector<std::pair<std::string, RenderScene>> variants;
+    auto variant = [&](const std::string& name, const std::function<void(SurfaceGeometry&)>& change) {
+        RenderScene s = tree;
+        s.items[leaf_index].version += 1 + variants.size(); // a version of its own: uploaded
+        change(s.items[leaf_index].geometry);
+        variants.emplace_back(name, std::move(s));
+    };
+    variant("an extra triangle", [](SurfaceGeometry& g) { g.triangles.push_back({0, 2, 3}); });
+    variant("a quad split along its other diagonal", [](SurfaceGeometry& g) {
+        g.triangles[10] = {20, 21, 23};
+        g.triangles[11] = {21, 22, 23};
+    });
+    variant("a quad that is not a parallelogram", [](SurfaceGeometry& g) { g.positions[42] += glm::vec3(0.0f, 0.01f, 0.0f); });
+    variant("a quad with other uvs", [](SurfaceGeometry& g) { g.uvs[9] = glm::vec2(0.5f, 0.5f); });
+    variant("a vertex with its own normal", [](SurfaceGeometry& g) { g.normals[6] = glm::normalize(g.normals[6] + glm::vec3(0.1f, 0.0f, 0.0f)); });
+    variant("the triangles in another order", [](SurfaceGeometry& g) { std::reverse(g.triangles.begin(), g.triangles.end()); });
+    // An arbitrary triangle mesh: the stroke tubes, with uvs inside the leaf's blade.
+    {
+        RenderScene s = tree;
+        SurfaceGeometry tubes;
+        for (const Stroke& stroke : effective_strokes(shared().doc)) {
+            std::vector<glm::vec3> points;
+            for (const StrokePoint& p : stroke.points) points.push_back(p.position);
+            const SurfaceGeometry tube = polyline_tube(points, 0.02f);
+            const auto first = static_cast<std::uint32_t>(tubes.positions.size());
+            tubes.positions.insert(tubes.positions.end(), tube.positions.begin(), tube.positions.end());
+            tubes.normals.insert(tubes.normals.end(), tube.normals.begin(), tube.normals.end());
+            for (const auto& t : tube.triangles) tubes.triangles.push_back({t[0] + first, t[1] + first, t[2] + first});
+        }
+        tubes.uvs.assign(tubes.positions.size(), glm::vec2(0.5f, 0.5f));
+        ASSERT_FALSE(tubes.empty());
+        s.items[leaf_index].geometry = tubes;
+        s.items[leaf_index].version += 1 + variants.size();
+        variants.emplace_back("stroke tubes as a leaf mesh", std::move(s));
+    }
+    const RgbaImage background = background_of(tree, camera);
+    shared().renderer->set_scene(tree); // the branches stay cached: each variant uploads its leaves only
+    for (const auto& [name, scene] : variants) {
+        const RgbaImage picture = draw(scene, camera);
+        EXPECT_EQ(shared().renderer->stats().leaf_instances, 0u) << name;
+        EXPECT_EQ(shared().renderer->stats().meshes_uploaded, 1u) << name;
+        const RgbaImage reference = draw_reference(scene, camera);
+        EXPECT_EQ(picture.pixels, reference.pixels) << name << ": " << difference(picture, reference).describe();
+        EXPECT_GT(coverage(picture, background), 0.05) << name;
+    }
+}
+
+// An instanced leaf mesh given another material under the same key and version is uploaded
+// again, as a mesh (instances are drawn by the leaf pipeline only), and looks as it does
+// from the reference renderer.
+TEST(RenderLeaves, AnInstancedMeshGivenAnotherMaterialIsUploadedAgainAsAMesh)
+{
+    RenderScene scene = tree_scene();
+    const Camera camera = camera_for(scene, front_view());
+    Renderer& r = *shared().renderer;
+    r.set_scene(scene);
+    EXPECT_GT(r.stats().leaf_instances, 0u);
+    RenderItem& leaves = scene.items[std::size_t(&leaf_item(scene) - scene.items.data())];
+    leaves.material = RenderMaterial::Bark;
+    r.set_scene(scene);
+    EXPECT_EQ(r.stats().leaf_instances, 0u);
+    EXPECT_EQ(r.stats().meshes_uploaded, 1u);
+    const RgbaImage picture = r.render(camera, kW, kH);
+    EXPECT_EQ(picture.pixels, draw_reference(scene, camera).pixels);
+    // Back to Leaf: instanced again.
+    leaves.material = RenderMaterial::Leaf;
+    leaves.version += 1;
+    r.set_scene(scene);
+    EXPECT_EQ(r.stats().leaf_instances, leaves.geometry.triangle_count() / 2);
+}
+
+// A tree exported to .glb and read back keeps its leaves as quads: they are drawn instanced.
+TEST(RenderLeaves, LeavesReadFromAnExportedGlbAreDrawnInstanced)
+{
+    Shared& s = shared();
+    const std::string dir = test::temp_dir("render-leaves-glb");
+    ExportScene e;
+    e.tree = &s.geometry;
+    e.base = s.tree.growth.tree.nodes[0].position;
+    write_glb(dir + "/tree.glb", e);
+    const RenderScene scene = glb_render_scene(dir + "/tree.glb", RenderContent{});
+    const std::size_t quads = leaf_item(scene).geometry.triangle_count() / 2;
+    ASSERT_GT(quads, 0u);
+    s.renderer->set_scene(scene);
+    EXPECT_EQ(s.renderer->stats().leaf_instances, quads);
+    const Camera camera = camera_for(scene, front_view());
+    const PictureDifference d = difference(s.renderer->render(camera, kW, kH), draw_reference(scene, camera));
+    EXPECT_LE(d.pixels, std::size_t(kW * kH) / 1000) << d.describe();
+    std::printf("instanced vs triangles, from a .glb: %s (of %d)\n", d.describe().c_str(), kW * kH);
 }
 
 TEST(RenderScene, BadMeshesAndSizesAreRefusedWithOneLine)

@@ -1,10 +1,13 @@
 // Pictures of the largest Table 1 tree (4 lobes, 22 strokes) at 1280×720 with tree and
 // leaves: the CPU time to record one frame's command buffer, and the whole frame (record,
 // draw with 4× MSAA and resolve, copy out, read back) on the device the renderer picks
-// (lavapipe on a machine without a GPU), at LOD0 and LOD2.
+// (lavapipe on a machine without a GPU), at LOD0 and LOD2. BM_RenderLeaves320x240: the same
+// frame, small, with the leaves instanced (the default) and as plain triangles
+// (RendererOptions::instanced_leaves off), and the bytes the leaves upload either way.
 // Run with --benchmark_filter=Render --benchmark_repetitions=5 and read the medians.
 #include <benchmark/benchmark.h>
 
+#include <ctime>
 #include <memory>
 #include <string>
 
@@ -26,6 +29,7 @@ struct Fixture {
     TreeGeometry geometry;
     float ground_y = 0.0f;
     std::unique_ptr<Renderer> renderer;
+    std::unique_ptr<Renderer> triangle_leaves; // instanced_leaves off (made on first use)
 };
 
 Fixture& fixture()
@@ -96,3 +100,54 @@ static void BM_RenderRecordCommandBuffer(benchmark::State& state)
 // Manual time is only the recording (microseconds): without a fixed count the library would
 // run thousands of whole frames to fill its minimum time.
 BENCHMARK(BM_RenderRecordCommandBuffer)->ArgName("lod")->Arg(0)->Arg(2)->Unit(benchmark::kMicrosecond)->UseManualTime()->Iterations(3);
+
+/// CPU time of the whole process (every thread: lavapipe rasterises in its own), in ms.
+static double process_cpu_ms()
+{
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
+}
+
+// Leaves instanced (arg 1) or as plain triangles (arg 0), LOD0, at 320×240: the frame (wall),
+// its recording and submit-to-fence times, the CPU time of all the process's threads per
+// frame (lavapipe's work, steadier than wall time on a loaded machine), and what uploading
+// the leaves costs in bytes.
+static void BM_RenderLeaves320x240(benchmark::State& state)
+{
+    Fixture& f = fixture();
+    const bool instanced = state.range(0) != 0;
+    if (!instanced && !f.triangle_leaves) {
+        RendererOptions options;
+        options.instanced_leaves = false;
+        f.triangle_leaves = std::make_unique<Renderer>(options);
+    }
+    Renderer& r = instanced ? *f.renderer : *f.triangle_leaves;
+    const RenderScene scene = tree_render_scene(f.geometry, {}, {}, f.ground_y, RenderContent{});
+    RenderScene texture_only = scene, leaves_only = scene;
+    texture_only.items.clear();
+    leaves_only.items.clear();
+    for (const RenderItem& item : scene.items)
+        if (item.material == RenderMaterial::Leaf) leaves_only.items.push_back(item);
+    r.set_scene(texture_only); // then only the leaf mesh is uploaded
+    r.set_scene(leaves_only);
+    state.counters["leaf_bytes"] = static_cast<double>(r.stats().bytes_uploaded);
+    state.counters["leaf_instances"] = static_cast<double>(r.stats().leaf_instances);
+    r.set_scene(scene);
+    state.SetLabel(r.device_name());
+    const Camera camera = frame_view(scene_bounds(scene), front_view(), 320.0f / 240.0f);
+    r.render(camera, 320, 240); // the target is made once, the shaders compiled
+    double record = 0.0, gpu = 0.0;
+    const double cpu0 = process_cpu_ms();
+    for (auto _ : state) {
+        RgbaImage image = r.render(camera, 320, 240);
+        benchmark::DoNotOptimize(image.pixels.data());
+        record += r.stats().record_ms;
+        gpu += r.stats().gpu_ms;
+    }
+    const auto n = static_cast<double>(state.iterations());
+    state.counters["process_cpu_ms"] = (process_cpu_ms() - cpu0) / n;
+    state.counters["record_ms"] = record / n;
+    state.counters["gpu_ms"] = gpu / n;
+}
+BENCHMARK(BM_RenderLeaves320x240)->ArgName("instanced")->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(5);
