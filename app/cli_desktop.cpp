@@ -337,6 +337,17 @@ void add_desktop_command(CLI::App& app, int& exit_code)
                                         : "";
                 throw Error(std::string(e.what()) + "; nothing was changed." + offer);
             }
+            // Work after the last save (a crash, a killed program) is in a newer autosave.
+            std::error_code e1, e2;
+            const auto saved_at = fs::last_write_time(session, e1), autosaved_at = fs::last_write_time(autosave, e2);
+            try {
+                if (!e1 && !e2 && autosaved_at > saved_at &&
+                    read_file_limited(autosave, kMaxDocumentBytes) != read_file_limited(session, kMaxDocumentBytes))
+                    warn(autosave + " is newer than " + session + " and differs: to continue from it, run "
+                         "`lobesketch desktop " + session + " --recover`");
+            } catch (const Error&) {
+                // An unreadable autosave offers nothing; the session opened.
+            }
         }
 
         std::vector<ScriptStep> script;

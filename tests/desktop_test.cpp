@@ -1,5 +1,6 @@
 // The desktop app: the simulated hand, the session logic without a window, and the real
 // window under Xvfb driven by a scripted mouse session (docs/desktop.md).
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -403,6 +404,24 @@ TEST(DesktopApp, CorruptSessionOffersTheAutosaveAndOverwritesNothing)
     const Document recovered = load_document(dir + "/tree.recovered.json");
     EXPECT_EQ(recovered.seed, 7u);
     EXPECT_EQ(read_file_limited(dir + "/tree.autosave.json", 1u << 20), autosave_before);
+}
+
+TEST(DesktopApp, NewerDifferentAutosaveIsPointedOutWhenTheSessionOpens)
+{
+    if (!have_xvfb()) GTEST_SKIP() << "xvfb-run is missing (scripts/setup.sh installs package xvfb)";
+    const std::string dir = temp_dir("desktop_newer_autosave");
+    const std::string session = dir + "/tree.json";
+    save_document(session, Document{});
+    Document later;
+    later.seed = 9;
+    save_document(dir + "/tree.autosave.json", later);
+    fs::last_write_time(dir + "/tree.autosave.json", fs::last_write_time(session) + std::chrono::seconds(5));
+    const std::string before = read_file_limited(session, 1u << 20);
+    const test::CliRun r = run_shell(xvfb(session + " --size 320x240 --software --frames 2"));
+    EXPECT_EQ(r.code, 0) << r.out;
+    EXPECT_NE(r.out.find("is newer than"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("--recover"), std::string::npos) << r.out;
+    EXPECT_EQ(read_file_limited(session, 1u << 20), before) << "opening never writes the session";
 }
 
 TEST(DesktopApp, WithoutADisplayItSaysHowToGetOneAndFails)
