@@ -919,11 +919,15 @@ public:
 
     void set_scene(const RenderScene& scene, RenderStats& stats)
     {
-        // Check everything before touching the GPU: a bad scene leaves the last one drawn.
+        // Check everything before touching the GPU: a bad scene leaves the last one drawn. A
+        // mesh the cache holds under the same key and version was checked when it was uploaded
+        // (the interactive apps pass their whole scene every frame).
         std::unordered_set<std::uint64_t> keys;
         for (const RenderItem& item : scene.items) {
             if (!keys.insert(item.key).second)
                 throw InvalidInput("render: mesh key " + std::to_string(item.key) + " appears twice in the scene");
+            if (auto cached = cache_.find(item.key); cached != cache_.end() && cached->second.version == item.version)
+                continue;
             const SurfaceGeometry& g = item.geometry;
             const std::size_t n = g.positions.size();
             if (g.normals.size() != n || (!g.uvs.empty() && g.uvs.size() != n))
