@@ -630,6 +630,35 @@ VkRenderPass create_offscreen_render_pass(VkDevice device, const FrameFormat& f)
     return pass;
 }
 
+/// A pipeline layout of one descriptor set and one push-constant range.
+VkPipelineLayout create_pipeline_layout(VkDevice dev, VkDescriptorSetLayout set_layout, VkPushConstantRange range)
+{
+    auto layout = vk_struct<VkPipelineLayoutCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO);
+    layout.setLayoutCount = 1;
+    layout.pSetLayouts = &set_layout;
+    layout.pushConstantRangeCount = 1;
+    layout.pPushConstantRanges = &range;
+    VkPipelineLayout out = VK_NULL_HANDLE;
+    CHECK_VKCMD(vkCreatePipelineLayout(dev, &layout, nullptr, &out));
+    return out;
+}
+
+/// A pool holding one combined-image-sampler set, and that set.
+void allocate_sampler_set(VkDevice dev, VkDescriptorSetLayout set_layout, VkDescriptorPool& pool_out, VkDescriptorSet& set_out)
+{
+    VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1};
+    auto pool = vk_struct<VkDescriptorPoolCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO);
+    pool.maxSets = 1;
+    pool.poolSizeCount = 1;
+    pool.pPoolSizes = &size;
+    CHECK_VKCMD(vkCreateDescriptorPool(dev, &pool, nullptr, &pool_out));
+    auto alloc = vk_struct<VkDescriptorSetAllocateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO);
+    alloc.descriptorPool = pool_out;
+    alloc.descriptorSetCount = 1;
+    alloc.pSetLayouts = &set_layout;
+    CHECK_VKCMD(vkAllocateDescriptorSets(dev, &alloc, &set_out));
+}
+
 // ---------------------------------------------------------------------------------------------
 /// The images one offscreen frame is drawn into and the host buffer it is read back through.
 class OffscreenTarget {
@@ -1167,24 +1196,9 @@ private:
         set_layout.bindingCount = 1;
         set_layout.pBindings = &binding;
         CHECK_VKCMD(vkCreateDescriptorSetLayout(dev, &set_layout, nullptr, &set_layout_));
-        VkPushConstantRange range{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(PushBlock)};
-        auto layout = vk_struct<VkPipelineLayoutCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO);
-        layout.setLayoutCount = 1;
-        layout.pSetLayouts = &set_layout_;
-        layout.pushConstantRangeCount = 1;
-        layout.pPushConstantRanges = &range;
-        CHECK_VKCMD(vkCreatePipelineLayout(dev, &layout, nullptr, &layout_));
-        VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1};
-        auto pool = vk_struct<VkDescriptorPoolCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO);
-        pool.maxSets = 1;
-        pool.poolSizeCount = 1;
-        pool.pPoolSizes = &size;
-        CHECK_VKCMD(vkCreateDescriptorPool(dev, &pool, nullptr, &descriptor_pool_));
-        auto alloc = vk_struct<VkDescriptorSetAllocateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO);
-        alloc.descriptorPool = descriptor_pool_;
-        alloc.descriptorSetCount = 1;
-        alloc.pSetLayouts = &set_layout_;
-        CHECK_VKCMD(vkAllocateDescriptorSets(dev, &alloc, &descriptor_set_));
+        layout_ = create_pipeline_layout(dev, set_layout_,
+                                         {VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(PushBlock)});
+        allocate_sampler_set(dev, set_layout_, descriptor_pool_, descriptor_set_);
         auto sampler = vk_struct<VkSamplerCreateInfo>(VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO);
         sampler.magFilter = VK_FILTER_LINEAR;
         sampler.minFilter = VK_FILTER_LINEAR;
@@ -1376,24 +1390,8 @@ private:
     void create(VkRenderPass pass, const FrameFormat& format, VkDescriptorSetLayout set_layout)
     {
         const VkDevice dev = ctx_.device();
-        VkPushConstantRange range{VK_SHADER_STAGE_VERTEX_BIT, 0, 4 * sizeof(float)};
-        auto layout = vk_struct<VkPipelineLayoutCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO);
-        layout.setLayoutCount = 1;
-        layout.pSetLayouts = &set_layout;
-        layout.pushConstantRangeCount = 1;
-        layout.pPushConstantRanges = &range;
-        CHECK_VKCMD(vkCreatePipelineLayout(dev, &layout, nullptr, &layout_));
-        VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1};
-        auto pool = vk_struct<VkDescriptorPoolCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO);
-        pool.maxSets = 1;
-        pool.poolSizeCount = 1;
-        pool.pPoolSizes = &size;
-        CHECK_VKCMD(vkCreateDescriptorPool(dev, &pool, nullptr, &descriptor_pool_));
-        auto alloc = vk_struct<VkDescriptorSetAllocateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO);
-        alloc.descriptorPool = descriptor_pool_;
-        alloc.descriptorSetCount = 1;
-        alloc.pSetLayouts = &set_layout;
-        CHECK_VKCMD(vkAllocateDescriptorSets(dev, &alloc, &descriptor_set_));
+        layout_ = create_pipeline_layout(dev, set_layout, {VK_SHADER_STAGE_VERTEX_BIT, 0, 4 * sizeof(float)});
+        allocate_sampler_set(dev, set_layout, descriptor_pool_, descriptor_set_);
 
         VkVertexInputBindingDescription binding{0, sizeof(OverlayVertex), VK_VERTEX_INPUT_RATE_VERTEX};
         const VkVertexInputAttributeDescription attributes[3] = {
