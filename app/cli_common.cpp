@@ -16,6 +16,7 @@
 #include "growth/species.h"
 #include "input/pipeline.h"
 #include "input/session_builder.h"
+#include "meshing/mesh_io.h"
 
 namespace lobe::cli {
 
@@ -115,7 +116,14 @@ Document replay_into_document(const std::string& path, Document doc, std::size_t
     for (const std::string& m : result.messages) warn(path + ": " + m);
     if (drags) *drags = result.drags.size();
     doc.source_recording = std::filesystem::absolute(path).lexically_normal().string();
-    SessionBuilder builder(std::move(doc), EditPickOptions{}, meshing_edit_hooks());
+    EditHooks hooks = meshing_edit_hooks();
+    // Meshes imported during the session lie beside the recording (import_mesh_path).
+    hooks.import_model = [path](int n) {
+        const std::string file = import_mesh_path(path, n);
+        return std::make_shared<const LobeModel>(
+            LobeModel{std::filesystem::path(file).filename().string(), read_mesh(file)});
+    };
+    SessionBuilder builder(std::move(doc), EditPickOptions{}, std::move(hooks));
     builder.apply(result.actions);
     for (const std::string& m : builder.messages()) warn(path + ": " + m);
     return builder.take_document();
@@ -141,7 +149,10 @@ GrownInput grow_input_tree(const std::string& input, const TreeInputOptions& o)
     if (o.seed) doc.seed = *o.seed;
     if (is_mesh_file(input)) {
         const BuiltLobe lobe = model_lobe(input, doc.settings, o.mesh_size);
-        doc.lobes.push_back({1, {}, "", std::nullopt, {}});
+        LobeRecord rec;
+        rec.id = 1;
+        rec.model = std::make_shared<const LobeModel>(LobeModel{input, lobe.mesh});
+        doc.lobes.push_back(std::move(rec));
         out.tree = grow_document_tree(doc, {lobe});
         return out;
     }

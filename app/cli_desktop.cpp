@@ -221,18 +221,29 @@ void draw_panel(DesktopSession& session, const std::string& session_name, int& t
             if (current == kSettingSpecies[i]) species = i;
         if (ImGui::Combo("species", &species, kSettingSpecies, kSettingSpeciesCount)) send(SettingId::Species, species);
         if (target_lobe == 0) {
+            // The attractor spacing is the same for every lobe (one density for the tree).
             float spacing = float(doc.settings.lobes.edge_length_m * 100.0);
             ImGui::SliderFloat("spacing", &spacing, 1.0f, 10.0f, "%.1f cm");
             if (ImGui::IsItemDeactivatedAfterEdit()) send(SettingId::AttractorSpacing, spacing / 100.0);
-            float leaf = float(doc.settings.leaves.length_m * 100.0);
-            ImGui::SliderFloat("leaf size", &leaf, 1.0f, 20.0f, "%.1f cm");
-            if (ImGui::IsItemDeactivatedAfterEdit()) send(SettingId::LeafLength, leaf / 100.0);
-            int leaves = doc.settings.leaves.per_node;
-            ImGui::SliderInt("leaves", &leaves, 0, 16);
-            if (ImGui::IsItemDeactivatedAfterEdit()) send(SettingId::LeavesPerNode, leaves);
-            int seed = int(std::min<std::uint64_t>(doc.seed, 16777215));
-            if (ImGui::InputInt("seed", &seed, 1, 10) && seed >= 1 && seed < (1 << 24)) send(SettingId::Seed, seed);
         }
+        // Leaves and seed: the tree's, or the lobe's own (shown: what the lobe grows with).
+        float leaf = float((lobe && lobe->leaf_length_m ? *lobe->leaf_length_m : doc.settings.leaves.length_m) * 100.0);
+        ImGui::SliderFloat("leaf size", &leaf, 1.0f, 20.0f, "%.1f cm");
+        if (ImGui::IsItemDeactivatedAfterEdit()) send(SettingId::LeafLength, leaf / 100.0);
+        int leaves = lobe && lobe->leaves_per_node ? *lobe->leaves_per_node : doc.settings.leaves.per_node;
+        ImGui::SliderInt("leaves", &leaves, 0, 16);
+        if (ImGui::IsItemDeactivatedAfterEdit()) send(SettingId::LeavesPerNode, leaves);
+        int seed = int(std::min<std::uint64_t>(lobe && lobe->seed ? *lobe->seed : doc.seed, 16777215));
+        if (ImGui::InputInt("seed", &seed, 1, 10) && seed >= 1 && seed < (1 << 24)) send(SettingId::Seed, seed);
+    }
+    if (ImGui::CollapsingHeader("Import a mesh as a lobe")) {
+        // OBJ, PLY or OFF; the lobe appears centred on the fingertip (the cursor's point on
+        // the depth plane when the button was pressed).
+        static char path[1024] = "";
+        static float size_m = 1.5f;
+        ImGui::InputText("file", path, sizeof path);
+        ImGui::SliderFloat("size", &size_m, 0.1f, 5.0f, "%.2f m");
+        if (ImGui::Button("Import", ImVec2(kHalf, 0)) && path[0] != 0) session.import_mesh(path, size_m);
     }
     if (ImGui::CollapsingHeader("File", ImGuiTreeNodeFlags_DefaultOpen)) {
         column = 0;
@@ -254,6 +265,10 @@ nlohmann::json summary(const DesktopSession& s, const std::string& label, int fr
     for (const LobeRecord& l : d.lobes) {
         nlohmann::json j{{"id", l.id}, {"strokes", l.stroke_ids}, {"species", l.species}};
         if (l.split_angle_deg) j["split_angle_deg"] = *l.split_angle_deg;
+        if (l.leaf_length_m) j["leaf_length_m"] = *l.leaf_length_m;
+        if (l.leaves_per_node) j["leaves_per_node"] = *l.leaves_per_node;
+        if (l.seed) j["seed"] = *l.seed;
+        if (l.model) j["model_triangles"] = l.model->mesh.triangles.size();
         lobes.push_back(j);
     }
     nlohmann::json strokes = nlohmann::json::array();
@@ -439,6 +454,7 @@ void add_desktop_command(CLI::App& app, int& exit_code)
                     break;
                 }
                 case ScriptStep::Kind::Set: ds.setting(s.code, s.lobe, s.value); break;
+                case ScriptStep::Kind::Import: ds.import_mesh(s.name, s.value); break;
                 case ScriptStep::Kind::Wait: wait = true; break;
                 case ScriptStep::Kind::Mark:
                     if (log) *log << summary(ds, s.name, frame).dump() << "\n" << std::flush;

@@ -50,7 +50,11 @@ void add_lobes_command(CLI::App& app, int& exit_code)
             std::filesystem::create_directories(a->out + "/lobes", ec);
             if (ec) throw FileError(a->out + "/lobes", "cannot create folder: " + ec.message());
             write_ply(a->out + "/lobes/lobe_1.ply", mesh);
-            doc.lobes.push_back({1, {}, "lobes/lobe_1.ply", std::nullopt, {}});
+            // The session holds the lobe itself, so it opens, regrows and exports without the file.
+            LobeRecord rec = LobeRecord::of_strokes(1, {}, "lobes/lobe_1.ply");
+            rec.model = std::make_shared<const LobeModel>(
+                LobeModel{std::filesystem::path(a->input).filename().string(), mesh});
+            doc.lobes.push_back(std::move(rec));
             save_document(a->out + "/session.json", doc);
             const MeshQuality q = measure_quality(mesh);
             progress("wrote " + a->out + "/lobes/lobe_1.ply (" + std::to_string(q.vertices) + " vertices, " +

@@ -64,7 +64,7 @@ void add_replay_command(CLI::App& app, int& exit_code)
                  std::to_string(drags) + " drag(s)");
         progress("wrote " + a->out + "/strokes.json, " + a->out + "/session.json, " + std::to_string(lobe_files) +
                  " lobe mesh(es) in " + a->out + "/lobes" + (tree_written ? " and " + a->out + "/tree.glb" : ""));
-        if (out_doc.strokes.empty() && drags == 0) {
+        if (out_doc.strokes.empty() && drags == 0 && out_doc.lobes.empty()) {
             error(a->rec + ": no strokes in this recording");
             exit_code = kExitFailure;
             return;

@@ -192,6 +192,13 @@ std::vector<ScriptStep> parse_desktop_script(const std::string& text, const std:
                 fail("expected 'set NAME VALUE [lobe ID]'");
             }
             push(s);
+        } else if (cmd == "import") {
+            expect_args(1, 2);
+            s.kind = ScriptStep::Kind::Import;
+            s.name = w[2];
+            s.value = w.size() == 4 ? number(3, "size") : 1.5;
+            if (!(s.value > 0.01 && s.value <= 100.0)) fail("the size must be in (0.01, 100] m");
+            push(s);
         } else if (cmd == "wait" || cmd == "quit") {
             expect_args(0, 0);
             s.kind = cmd == "wait" ? ScriptStep::Kind::Wait : ScriptStep::Kind::Quit;

@@ -13,13 +13,13 @@ namespace lobe {
 
 /// One primitive input step (the macros `circle` and `line` expand into these).
 struct ScriptStep {
-    enum class Kind { Move, Down, Up, Wheel, KeyPress, KeyRelease, Panel, Set, Wait, Mark, Quit } kind = Kind::Move;
+    enum class Kind { Move, Down, Up, Wheel, KeyPress, KeyRelease, Panel, Set, Import, Wait, Mark, Quit } kind = Kind::Move;
     int frame = 0;
     float x = 0.0f, y = 0.0f; ///< Move: pixels; Wheel: y = notches
     int code = 0;             ///< Down/Up: mouse button; Key*: GLFW key; Set: setting id
-    double value = 0.0;       ///< Set
+    double value = 0.0;       ///< Set: the value; Import: the size in metres
     std::int64_t lobe = 0;    ///< Set: lobe id (0 = the tree)
-    std::string name;         ///< Panel: action name; Mark: label
+    std::string name;         ///< Panel: action name; Mark: label; Import: the mesh file
     int line = 0;             ///< source line, for messages
 };
 

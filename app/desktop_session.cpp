@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 
+#include <glm/common.hpp>
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 
@@ -12,6 +14,8 @@
 #include "app/tree_output.h"
 #include "core/errors.h"
 #include "meshing/edit_ops.h"
+#include "meshing/mesh_io.h"
+#include "meshing/model_import.h"
 
 namespace lobe {
 
@@ -129,7 +133,14 @@ DesktopSession::DesktopSession(Document doc, DesktopOptions options)
         recording_ = std::make_unique<RecordingWriter>(options_.record_path, header, 6);
         doc.source_recording = std::filesystem::absolute(options_.record_path).lexically_normal().string();
     }
-    builder_ = std::make_unique<SessionBuilder>(std::move(doc), EditPickOptions{}, meshing_edit_hooks());
+    EditHooks hooks = meshing_edit_hooks();
+    // Imports of this session, by number (the recording's ImportMesh events).
+    hooks.import_model = [this](int n) {
+        const auto it = imports_.find(n);
+        if (it == imports_.end()) throw InvalidInput("import " + std::to_string(n) + " was not made in this session");
+        return it->second;
+    };
+    builder_ = std::make_unique<SessionBuilder>(std::move(doc), EditPickOptions{}, std::move(hooks));
     worker_ = std::make_unique<RegrowWorker>();
     if (!document().strokes.empty()) request_regrowth();
     rebuild_static_scene();
@@ -202,6 +213,45 @@ void DesktopSession::setting(int id, std::int64_t lobe_id, double value)
     e.value = static_cast<std::int32_t>(std::clamp<std::int64_t>(lobe_id, 0, 0x7fffffff));
     e.x = static_cast<float>(value);
     pending_.push_back(e);
+}
+
+bool DesktopSession::import_mesh(const std::string& path, double size_m)
+{
+    const Document& doc = document();
+    LobeFromModelOptions o;
+    o.size_m = size_m;
+    o.target_edge_length_m = doc.settings.lobes.edge_length_m;
+    o.iterations = static_cast<unsigned>(doc.settings.lobes.remesh_iterations);
+    const int n = static_cast<int>(imports_.size()) + 1;
+    try {
+        if (!(size_m > 0.01 && size_m <= 100.0)) throw InvalidInput("the size must be in (0.01, 100] m");
+        TriangleMesh mesh = lobe_from_model(path, o);
+        // Centred on the origin; the import event places it at the fingertip.
+        glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+        for (const glm::vec3& p : mesh.positions) {
+            lo = glm::min(lo, glm::dvec3(p));
+            hi = glm::max(hi, glm::dvec3(p));
+        }
+        const glm::dvec3 centre = 0.5 * (lo + hi);
+        for (glm::vec3& p : mesh.positions) p = glm::vec3(glm::dvec3(p) - centre);
+        std::string source = std::filesystem::path(path).filename().string();
+        if (recording_) {
+            // Beside the recording, so that replaying it imports the same mesh.
+            const std::string beside = import_mesh_path(options_.record_path, n);
+            write_ply(beside, mesh);
+            source = std::filesystem::path(beside).filename().string();
+        }
+        imports_[n] = std::make_shared<const LobeModel>(LobeModel{source, std::move(mesh)});
+    } catch (const Error& e) {
+        note(std::string("import: ") + e.what());
+        return false;
+    }
+    InputEvent e;
+    e.kind = InputEventKind::ImportMesh;
+    e.code = n;
+    pending_.push_back(e);
+    note("imported " + path + " as a lobe at the fingertip");
+    return true;
 }
 
 void DesktopSession::handle(const InputEvent& e, int width, int height)

@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -95,6 +96,12 @@ public:
     void key(int key, bool down);
     /// A setting from the panel (recorded as an InputEventKind::Setting event).
     void setting(int id, std::int64_t lobe_id, double value);
+    /// Imports a mesh file (OBJ, PLY, OFF) as a lobe: repaired, scaled so that its bounding
+    /// box's largest side is `size_m`, remeshed to the attractor spacing, then placed centred
+    /// on the fingertip by the next frame (one undo step). The mesh is written beside the
+    /// recording (import_mesh_path) and recorded as an ImportMesh event, so replay makes the
+    /// same lobe. False, with the reason in messages(), when the file cannot be made a lobe.
+    bool import_mesh(const std::string& path, double size_m = 1.5);
     /// The cursor is over the panel: the left button does not pinch while it is.
     void set_ui_capture(bool capture) { ui_capture_ = capture; }
     void set_cursor_inside(bool inside) { cursor_inside_ = inside; }
@@ -149,6 +156,7 @@ private:
     std::unique_ptr<RegrowWorker> worker_;
 
     std::vector<InputEvent> pending_;
+    std::map<int, std::shared_ptr<const LobeModel>> imports_; ///< this session's imports by number
     glm::vec2 cursor_{0.0f};
     bool cursor_seen_ = false, cursor_inside_ = true, ui_capture_ = false;
     bool left_down_ = false, right_down_ = false, middle_down_ = false, shift_ = false, pinch_ = false;

@@ -13,10 +13,24 @@
 
 namespace lobe {
 
+LobeLeafOverrides document_lobe_leaves(const Document& doc, const BuiltTree& tree)
+{
+    LobeLeafOverrides out(tree.lobes.size());
+    bool any = false;
+    for (std::size_t i = 0; i < tree.lobes.size(); ++i)
+        for (const LobeRecord& r : doc.lobes) {
+            if (r.id != tree.lobes[i].lobe_id) continue;
+            out[i] = {r.leaf_length_m, r.leaves_per_node, r.seed};
+            any = any || r.leaf_length_m || r.leaves_per_node || r.seed;
+        }
+    if (!any) out.clear();
+    return out;
+}
+
 TreeGeometry document_tree_geometry(const Document& doc, const BuiltTree& tree)
 {
     return build_tree_geometry(tree.growth.tree, doc.settings.branches, doc.settings.leaves, doc.seed,
-                               doc.settings.growth.species);
+                               doc.settings.growth.species, document_lobe_leaves(doc, tree));
 }
 
 std::size_t lod_triangles(const TreeLod& lod) { return lod.branches.triangle_count() + lod.leaves.triangle_count(); }

@@ -8,12 +8,17 @@
 
 #include "app/export_scene.h"
 #include "app/tree_pipeline.h"
+#include "growth/leaves.h"
 #include "growth/tree_geometry.h"
 
 namespace lobe {
 
+/// The lobes' own leaf length, count and seed (LobeRecord), in the order `tree` grew its
+/// lobes; empty when no lobe has one.
+LobeLeafOverrides document_lobe_leaves(const Document& doc, const BuiltTree& tree);
+
 /// Branch and leaf geometry of `tree` at every LOD, with the document's branch and leaf
-/// settings and seed.
+/// settings and seed, and each lobe's leaf overrides.
 TreeGeometry document_tree_geometry(const Document& doc, const BuiltTree& tree);
 
 /// Triangles of one LOD (branches + leaves).

@@ -31,6 +31,7 @@ std::vector<GrowthLobe> growth_lobes(const Document& doc, const std::vector<Buil
                 g.subtree_weights = subtree_weights(library, s.growth.subtree_weights);
             }
             if (r.split_angle_deg) g.split_angle_deg = *r.split_angle_deg;
+            g.seed = r.seed;
         }
         out.push_back(std::move(g));
     }

@@ -280,6 +280,59 @@ json stroke_to_json(const Stroke& s)
                 {"closed", s.closed}, {"points", std::move(pts)},       {"times", std::move(times)}};
 }
 
+json lobe_model_to_json(const LobeModel& m)
+{
+    json positions = json::array();
+    for (const glm::vec3& p : m.mesh.positions)
+        for (int k = 0; k < 3; ++k) positions.push_back(p[k]);
+    json triangles = json::array();
+    for (const std::array<int, 3>& t : m.mesh.triangles)
+        for (int k = 0; k < 3; ++k) triangles.push_back(t[static_cast<std::size_t>(k)]);
+    return json{{"source", m.source}, {"positions", std::move(positions)}, {"triangles", std::move(triangles)}};
+}
+
+LobeModel lobe_model_from_json(const json& j, const std::string& w)
+{
+    if (!j.is_object()) throw InvalidInput(w + ": expected an object");
+    check_keys(j, {"source", "positions", "triangles"}, w);
+    LobeModel m;
+    read_string(j, "source", m.source, w);
+    if (m.source.size() > 4096) throw InvalidInput(w + ".source: longer than 4096 characters");
+    const auto p = j.find("positions");
+    if (p == j.end() || !p->is_array() || p->size() % 3 != 0)
+        throw InvalidInput(w + ".positions: expected an array of x, y, z numbers");
+    if (p->size() / 3 > kMaxLobeModelVertices)
+        throw InvalidInput(w + ".positions: more than " + std::to_string(kMaxLobeModelVertices) + " vertices");
+    m.mesh.positions.resize(p->size() / 3);
+    for (std::size_t i = 0; i < p->size(); ++i) {
+        const json& v = (*p)[i];
+        if (!v.is_number()) throw InvalidInput(w + ".positions: expected numbers");
+        const double x = v.get<double>();
+        if (!std::isfinite(x) || std::abs(x) > 1000.0)
+            throw InvalidInput(w + ".positions: a coordinate is not finite or beyond 1 km");
+        m.mesh.positions[i / 3][static_cast<int>(i % 3)] = static_cast<float>(x);
+    }
+    const auto t = j.find("triangles");
+    if (t == j.end() || !t->is_array() || t->size() % 3 != 0)
+        throw InvalidInput(w + ".triangles: expected an array of vertex index triples");
+    if (t->size() / 3 > kMaxLobeModelTriangles)
+        throw InvalidInput(w + ".triangles: more than " + std::to_string(kMaxLobeModelTriangles) + " triangles");
+    if (t->size() / 3 < 4) throw InvalidInput(w + ".triangles: a closed mesh needs at least 4 triangles");
+    m.mesh.triangles.resize(t->size() / 3);
+    const auto n = static_cast<std::int64_t>(m.mesh.positions.size());
+    for (std::size_t i = 0; i < t->size(); ++i) {
+        const json& v = (*t)[i];
+        if (!v.is_number_integer()) throw InvalidInput(w + ".triangles: expected integer vertex indices");
+        const auto k = v.get<std::int64_t>();
+        if (k < 0 || k >= n) throw InvalidInput(w + ".triangles: vertex index " + std::to_string(k) + " out of range");
+        m.mesh.triangles[i / 3][i % 3] = static_cast<int>(k);
+    }
+    for (const std::array<int, 3>& tri : m.mesh.triangles)
+        if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2])
+            throw InvalidInput(w + ".triangles: a triangle repeats a vertex");
+    return m;
+}
+
 std::int64_t read_id(const json& j, const char* key, const std::string& where)
 {
     auto it = j.find(key);
@@ -430,6 +483,10 @@ json document_to_json(const Document& doc)
         json r{{"id", l.id}, {"strokes", l.stroke_ids}, {"mesh", l.mesh_file}};
         if (l.split_angle_deg) r["split_angle_deg"] = *l.split_angle_deg;
         if (!l.species.empty()) r["species"] = l.species;
+        if (l.leaf_length_m) r["leaf_length_m"] = *l.leaf_length_m;
+        if (l.leaves_per_node) r["leaves_per_node"] = *l.leaves_per_node;
+        if (l.seed) r["seed"] = *l.seed;
+        if (l.model) r["model"] = lobe_model_to_json(*l.model);
         lobes.push_back(std::move(r));
     }
     json edits = json::array();
@@ -511,6 +568,26 @@ Document document_from_json(const json& j)
                 if (!sp->is_string() || sp->get<std::string>().size() > 64)
                     throw InvalidInput(w + ".species: expected a name of at most 64 characters");
                 r.species = sp->get<std::string>();
+            }
+            if (auto t = l.find("leaf_length_m"); t != l.end()) {
+                if (!t->is_number()) throw InvalidInput(w + ".leaf_length_m: expected a number");
+                const double v = t->get<double>();
+                if (!(v >= 0.002 && v <= 1.0)) throw InvalidInput(w + ".leaf_length_m: must be in [0.002, 1]");
+                r.leaf_length_m = v;
+            }
+            if (auto t = l.find("leaves_per_node"); t != l.end()) {
+                if (!t->is_number_integer()) throw InvalidInput(w + ".leaves_per_node: expected an integer");
+                const auto v = t->get<std::int64_t>();
+                if (v < 0 || v > 64) throw InvalidInput(w + ".leaves_per_node: must be in [0, 64]");
+                r.leaves_per_node = static_cast<int>(v);
+            }
+            if (auto t = l.find("seed"); t != l.end()) {
+                if (!t->is_number_unsigned()) throw InvalidInput(w + ".seed: expected a non-negative integer");
+                r.seed = t->get<std::uint64_t>();
+            }
+            if (auto m = l.find("model"); m != l.end()) {
+                r.model = std::make_shared<const LobeModel>(lobe_model_from_json(*m, w + ".model"));
+                if (!r.stroke_ids.empty()) throw InvalidInput(w + ": a lobe made from a mesh has no strokes");
             }
             doc.lobes.push_back(std::move(r));
         }

@@ -5,6 +5,7 @@
 /// Format: docs/session-format.md.
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -12,6 +13,7 @@
 #include <glm/mat4x4.hpp>
 #include <nlohmann/json.hpp>
 
+#include "core/mesh.h"
 #include "core/settings.h"
 #include "core/stroke.h"
 
@@ -27,14 +29,42 @@ struct EditOperation {
     nlohmann::json params = nlohmann::json::object();
 };
 
+/// A lobe made from an imported mesh (OBJ, PLY, OFF) instead of strokes: the mesh as the
+/// import made it (repaired, scaled, remeshed), in the lobe's own frame. Kept in the session
+/// itself, so the session does not depend on the file it came from.
+struct LobeModel {
+    std::string source; ///< the file it was imported from (informational)
+    TriangleMesh mesh;  ///< closed, outward; no feature edges
+};
+
 struct LobeRecord {
     std::int64_t id = 0;
     std::vector<std::int64_t> stroke_ids;
     std::string mesh_file; ///< relative to the document, empty until meshed
-    /// Per-lobe growth settings that override the tree's (absent/empty: the tree's).
+    /// Per-lobe settings that override the tree's (absent/empty: the tree's).
     std::optional<double> split_angle_deg;
     std::string species;
+    std::optional<double> leaf_length_m;     ///< the leaf width keeps the tree's width/length ratio
+    std::optional<int> leaves_per_node;
+    std::optional<std::uint64_t> seed;       ///< keys the lobe's growth and leaf streams
+    /// Set for a lobe imported from a mesh (then stroke_ids is empty). Shared and immutable,
+    /// so copies of the document (undo snapshots) do not copy the mesh.
+    std::shared_ptr<const LobeModel> model;
+
+    /// A lobe of strokes with the tree's settings.
+    static LobeRecord of_strokes(std::int64_t id, std::vector<std::int64_t> strokes = {}, std::string mesh_file = {})
+    {
+        LobeRecord r;
+        r.id = id;
+        r.stroke_ids = std::move(strokes);
+        r.mesh_file = std::move(mesh_file);
+        return r;
+    }
 };
+
+/// Most vertices and triangles of an imported lobe mesh a session may hold.
+inline constexpr std::size_t kMaxLobeModelVertices = 500000;
+inline constexpr std::size_t kMaxLobeModelTriangles = 1000000;
 
 /// One tree of the scene: variants and forests are several of these.
 struct TreeInstance {

@@ -712,7 +712,8 @@ double lod_triangle_budget(int lod)
 }
 
 void build_tree_geometry_into(TreeGeometry& geo, const TreeGraph& graph, const BranchSettings& branches,
-                              const LeafSettings& leaves, std::uint64_t seed, const std::string& species)
+                              const LeafSettings& leaves, std::uint64_t seed, const std::string& species,
+                              const LobeLeafOverrides& lobe_leaves)
 {
     if (branches.lod_count < 1 || branches.lod_count > 6) throw InvalidInput("tree geometry: lod_count must be in [1, 6]");
     check_mesh_options(branch_lod_options(branches, 0));
@@ -721,7 +722,7 @@ void build_tree_geometry_into(TreeGeometry& geo, const TreeGraph& graph, const B
     const TreeGraph clean = merge_coincident_nodes(graph);
     const std::vector<BranchChain> chains = decompose_branch_chains(clean);
     const std::vector<BranchCurve> curves = smooth_branch_curves(clean, chains, std::max(0, branches.smoothing_iterations));
-    const LeafCloud cloud = make_leaf_cloud(graph, leaves, seed);
+    const LeafCloud cloud = make_leaf_cloud(graph, leaves, seed, lobe_leaves);
     const CurveMetrics metrics = curve_metrics(curves);
 
     // Nothing can throw past this point: `geo` is only changed when the whole build succeeds.
@@ -744,7 +745,7 @@ void build_tree_geometry_into(TreeGeometry& geo, const TreeGraph& graph, const B
         sample_all_rings(curves, metrics, o, samples, ranges);
         sweep_curves(curves, samples, ranges, std::vector<char>(curves.size(), 1), o.radial_segments, geo.lods[0].branches,
                      scratch, nullptr);
-        emit_leaf_quads(cloud, leaves, LeafLodOptions{}, geo.lods[0].leaves);
+        emit_leaf_quads(cloud, LeafLodOptions{}, geo.lods[0].leaves);
     }
     const double total0 = static_cast<double>(geo.lods[0].branches.triangle_count() + geo.lods[0].leaves.triangle_count());
     const double leaves0 = static_cast<double>(geo.lods[0].leaves.triangle_count());
@@ -759,7 +760,7 @@ void build_tree_geometry_into(TreeGeometry& geo, const TreeGraph& graph, const B
         // Leaves: fewer and larger; never more than 80 % of the budget.
         double keep = leaf_lod_keep_fraction(lod);
         if (leaves0 > 0.0 && leaves0 * keep > 0.8 * budget) keep = std::max(1e-4, 0.8 * budget / leaves0);
-        emit_leaf_quads(cloud, leaves, LeafLodOptions{keep}, out.leaves);
+        emit_leaf_quads(cloud, LeafLodOptions{keep}, out.leaves);
 
         // Branches: coarser rings, then the thickest chains that fit the rest of the budget.
         const BranchMeshOptions o = branch_lod_options(branches, lod);
@@ -804,10 +805,10 @@ void build_tree_geometry_into(TreeGeometry& geo, const TreeGraph& graph, const B
 }
 
 TreeGeometry build_tree_geometry(const TreeGraph& graph, const BranchSettings& branches, const LeafSettings& leaves,
-                                 std::uint64_t seed, const std::string& species)
+                                 std::uint64_t seed, const std::string& species, const LobeLeafOverrides& lobe_leaves)
 {
     TreeGeometry geo;
-    build_tree_geometry_into(geo, graph, branches, leaves, seed, species);
+    build_tree_geometry_into(geo, graph, branches, leaves, seed, species, lobe_leaves);
     return geo;
 }
 

@@ -20,6 +20,7 @@
 
 #include "core/settings.h"
 #include "core/tree.h"
+#include "growth/leaves.h"
 #include "growth/tree_geometry.h"
 
 namespace lobe {
@@ -135,8 +136,10 @@ double lod_triangle_budget(int lod);
 /// Deterministic: the same inputs give the same bytes.
 /// \throw InvalidInput on an invalid graph (see merge_coincident_nodes), lod_count outside
 /// [1, 6], radial_segments < 3, ring_spacing_m ≤ 0 or an unknown leaf shape.
+/// `lobe_leaves`: per-lobe leaf length, count and seed (make_leaf_cloud).
 TreeGeometry build_tree_geometry(const TreeGraph& graph, const BranchSettings& branches, const LeafSettings& leaves,
-                                 std::uint64_t seed, const std::string& species = {});
+                                 std::uint64_t seed, const std::string& species = {},
+                                 const LobeLeafOverrides& lobe_leaves = {});
 
 /// build_tree_geometry into an existing TreeGeometry, reusing the storage of its meshes: a
 /// caller that regrows the tree often (the editor, while the person sketches) keeps two
@@ -144,6 +147,7 @@ TreeGeometry build_tree_geometry(const TreeGraph& graph, const BranchSettings& b
 /// memory is allocated for the meshes. `out` is left unchanged when this throws.
 /// \throw InvalidInput as build_tree_geometry.
 void build_tree_geometry_into(TreeGeometry& out, const TreeGraph& graph, const BranchSettings& branches,
-                              const LeafSettings& leaves, std::uint64_t seed, const std::string& species = {});
+                              const LeafSettings& leaves, std::uint64_t seed, const std::string& species = {},
+                              const LobeLeafOverrides& lobe_leaves = {});
 
 } // namespace lobe

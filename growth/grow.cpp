@@ -350,7 +350,7 @@ std::vector<TreeNode> grow_in_lobe(const Skeleton& skeleton, int lobe_index, con
                     continue;
                 }
                 const float length = static_cast<float>(settings.growth_ratio) * s;
-                Stream rng(seed, lobe.id, n, growths[n], p);
+                Stream rng(lobe.seed.value_or(seed), lobe.id, n, growths[n], p);
                 const std::size_t sub = pick_weighted(weights, rng.uniform());
                 const Subtree& st = library.subtrees[sub];
                 const Frame f = frame_along(dir_used, rng.uniform() * 2 * kPi);

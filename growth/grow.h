@@ -13,6 +13,7 @@
 /// the others bit-identical.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -34,6 +35,7 @@ struct GrowthLobe {
     TriangleMesh mesh;      ///< closed, outward, stage space; its vertices are the attractors
     double split_angle_deg = 30.0;       ///< t for this lobe (the tree's, or the lobe's override)
     std::vector<double> subtree_weights; ///< per library subtree (subtree_weights()); empty = all equal
+    std::optional<std::uint64_t> seed;  ///< keys this lobe's random streams instead of the tree's seed
 };
 
 struct LobeGrowthStats {

@@ -198,12 +198,22 @@ std::vector<int> leaf_tip_nodes(const TreeGraph& graph)
 
 double leaf_lod_keep_fraction(int lod) { return std::pow(0.5, std::max(0, lod)); }
 
-LeafCloud make_leaf_cloud(const TreeGraph& graph, const LeafSettings& leaves, std::uint64_t seed)
+LeafCloud make_leaf_cloud(const TreeGraph& graph, const LeafSettings& leaves, std::uint64_t seed,
+                          const LobeLeafOverrides& per_lobe)
 {
+    for (std::size_t i = 0; i < per_lobe.size(); ++i) {
+        const LobeLeafOverride& o = per_lobe[i];
+        if (o.length_m && !(*o.length_m > 0.0 && *o.length_m <= 1.0))
+            throw InvalidInput("leaves: lobe " + std::to_string(i) + " leaf length must be in (0, 1] m");
+        if (o.per_node && (*o.per_node < 0 || *o.per_node > 64))
+            throw InvalidInput("leaves: lobe " + std::to_string(i) + " leaves per node must be in [0, 64]");
+    }
     LeafCloud cloud;
     const int per_node = std::max(0, leaves.per_node);
     cloud.per_node = per_node;
-    if (per_node == 0 || graph.nodes.size() < 2) return cloud;
+    int most = per_node;
+    for (const LobeLeafOverride& o : per_lobe) most = std::max(most, o.per_node.value_or(0));
+    if (most == 0 || graph.nodes.size() < 2) return cloud;
     const std::vector<int> tips = leaf_tip_nodes(graph);
     const std::vector<std::uint32_t> ordinal = ordinals_within_lobes(graph);
     const double cos_dev = std::cos(std::clamp(leaves.deviation_deg, 0.0, 180.0) * kPi / 180.0);
@@ -230,12 +240,26 @@ LeafCloud make_leaf_cloud(const TreeGraph& graph, const LeafSettings& leaves, st
                 break;
             }
         }
-        SplitMix64 rng = leaf_stream(seed, node.lobe, ordinal[static_cast<std::size_t>(tip)]);
+        // The tree's leaves, or the lobe's own.
+        int tip_count = per_node;
+        std::uint64_t tip_seed = seed;
+        double length = leaves.length_m, width = leaves.width_m;
+        if (node.lobe >= 0 && static_cast<std::size_t>(node.lobe) < per_lobe.size()) {
+            const LobeLeafOverride& o = per_lobe[static_cast<std::size_t>(node.lobe)];
+            tip_count = o.per_node.value_or(per_node);
+            tip_seed = o.seed.value_or(seed);
+            if (o.length_m) {
+                width = leaves.length_m > 0.0 ? *o.length_m * (leaves.width_m / leaves.length_m) : leaves.width_m;
+                length = *o.length_m;
+            }
+        }
+        if (tip_count == 0) continue;
+        SplitMix64 rng = leaf_stream(tip_seed, node.lobe, ordinal[static_cast<std::size_t>(tip)]);
         // Always drawn first, so every LOD sees the same leaf draws after it.
         const auto keep_offset = static_cast<float>(rng.uniform());
         glm::dvec3 e1, e2;
         perpendicular_basis(dir, e1, e2);
-        for (int j = 0; j < per_node; ++j) {
+        for (int j = 0; j < tip_count; ++j) {
             // Axis: uniform over the spherical cap of half-angle deviation_deg around dir.
             const double cos_t = 1.0 - rng.uniform() * (1.0 - cos_dev);
             const double sin_t = std::sqrt(std::max(0.0, 1.0 - cos_t * cos_t));
@@ -244,7 +268,8 @@ LeafCloud make_leaf_cloud(const TreeGraph& graph, const LeafSettings& leaves, st
             glm::dvec3 a1, a2;
             perpendicular_basis(axis, a1, a2);
             const glm::dvec3 across = unit_in_plane(rng, a1, a2);
-            cloud.leaves.push_back({glm::vec3(base), glm::vec3(axis), glm::vec3(across), tip, j, keep_offset});
+            cloud.leaves.push_back(
+                {glm::vec3(base), glm::vec3(axis), glm::vec3(across), tip, j, tip_count, keep_offset, length, width});
         }
     }
     return cloud;
@@ -266,12 +291,11 @@ std::size_t count_leaf_quads(const LeafCloud& cloud, double keep_fraction)
     check_keep(keep_fraction);
     std::size_t n = 0;
     for (const LeafCloud::Leaf& leaf : cloud.leaves)
-        n += leaf.rank < kept_per_tip(cloud.per_node, keep_fraction, leaf.keep_offset);
+        n += leaf.rank < kept_per_tip(leaf.per_node, keep_fraction, leaf.keep_offset);
     return n;
 }
 
-void emit_leaf_quads(const LeafCloud& cloud, const LeafSettings& leaves, const LeafLodOptions& lod, SurfaceGeometry& out,
-                     std::vector<int>* quad_nodes)
+void emit_leaf_quads(const LeafCloud& cloud, const LeafLodOptions& lod, SurfaceGeometry& out, std::vector<int>* quad_nodes)
 {
     check_keep(lod.keep_fraction);
     const double keep = lod.keep_fraction;
@@ -293,11 +317,11 @@ void emit_leaf_quads(const LeafCloud& cloud, const LeafSettings& leaves, const L
     // leaves would reach out of it).
     const double grow = 1.0 / keep;
     const double length_scale = std::pow(grow, 0.125), width_scale = grow / length_scale;
-    const auto length = static_cast<float>(leaves.length_m * length_scale);
-    const auto half_width = static_cast<float>(0.5 * leaves.width_m * width_scale);
-    const auto back = static_cast<float>(0.5 * leaves.length_m * (length_scale - 1.0));
     for (const LeafCloud::Leaf& leaf : cloud.leaves) {
-        if (leaf.rank >= kept_per_tip(cloud.per_node, keep, leaf.keep_offset)) continue;
+        if (leaf.rank >= kept_per_tip(leaf.per_node, keep, leaf.keep_offset)) continue;
+        const auto length = static_cast<float>(leaf.length_m * length_scale);
+        const auto half_width = static_cast<float>(0.5 * leaf.width_m * width_scale);
+        const auto back = static_cast<float>(0.5 * leaf.length_m * (length_scale - 1.0));
         const glm::vec3 normal = glm::normalize(glm::cross(leaf.across, leaf.axis));
         const auto first = static_cast<std::uint32_t>(out.positions.size());
         const glm::vec3 side = half_width * leaf.across, up = length * leaf.axis;
@@ -322,7 +346,7 @@ SurfaceGeometry build_leaf_quads(const TreeGraph& graph, const LeafSettings& lea
 {
     check_keep(lod.keep_fraction);
     SurfaceGeometry out;
-    emit_leaf_quads(make_leaf_cloud(graph, leaves, seed), leaves, lod, out, quad_nodes);
+    emit_leaf_quads(make_leaf_cloud(graph, leaves, seed), lod, out, quad_nodes);
     return out;
 }
 

@@ -12,6 +12,7 @@
 /// every other lobe bit-identical.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -49,11 +50,22 @@ std::vector<int> leaf_tip_nodes(const TreeGraph& graph);
 /// length_m × width_m. Four vertices per quad (no vertex shared between quads), normals the
 /// quad's face normal (render two-sided). A tip whose parent is at the same position takes
 /// the direction of the nearest ancestor that is not; if none, +Y.
-/// Same as emit_leaf_quads(make_leaf_cloud(graph, leaves, seed), leaves, lod, out, quad_nodes).
+/// Same as emit_leaf_quads(make_leaf_cloud(graph, leaves, seed), lod, out, quad_nodes).
 /// \param quad_nodes when not null, receives the tip node of each quad.
 /// \throw InvalidInput when keep_fraction is not in (0, 1].
 SurfaceGeometry build_leaf_quads(const TreeGraph& graph, const LeafSettings& leaves, std::uint64_t seed,
                                  const LeafLodOptions& lod = {}, std::vector<int>* quad_nodes = nullptr);
+
+/// One lobe's own leaves: what it sets replaces the tree's LeafSettings and seed for the tips
+/// grown in that lobe (the session's per-lobe overrides, LobeRecord).
+struct LobeLeafOverride {
+    std::optional<double> length_m;    ///< leaf length; the width keeps the tree's width/length ratio
+    std::optional<int> per_node;       ///< leaves per tip, ≥ 0
+    std::optional<std::uint64_t> seed; ///< keys the lobe's leaf streams instead of the tree's seed
+};
+/// Per lobe, indexed by TreeNode::lobe (the lobe's index in growth order); lobes past its end
+/// use the tree's settings.
+using LobeLeafOverrides = std::vector<LobeLeafOverride>;
 
 /// The random placement of every LOD0 leaf, drawn once and shared by all levels of detail.
 struct LeafCloud {
@@ -63,22 +75,29 @@ struct LeafCloud {
         glm::vec3 across{0.0f}; ///< unit, normal to axis: the base edge's direction
         int node = 0;           ///< the tip node
         int rank = 0;           ///< 0 … per_node − 1 among the leaves of its tip
+        int per_node = 0;       ///< leaves of its tip at LOD0 (the tree's, or its lobe's override)
         float keep_offset = 0;  ///< the tip's r in ⌊per_node · keep + r⌋, in [0, 1)
+        double length_m = 0;    ///< LOD0 size (the tree's, or its lobe's override)
+        double width_m = 0;
     };
     std::vector<Leaf> leaves; ///< tips in node order, each tip's leaves by rank
-    int per_node = 0;
+    int per_node = 0;         ///< the tree's leaves per tip
 };
 
-/// Draws the LOD0 leaves of `graph` (see build_leaf_quads).
-LeafCloud make_leaf_cloud(const TreeGraph& graph, const LeafSettings& leaves, std::uint64_t seed);
+/// Draws the LOD0 leaves of `graph` (see build_leaf_quads). A lobe with an entry in
+/// `per_lobe` takes its leaf length, count and seed from there.
+/// 	hrow InvalidInput when an override's length is not in (0, 1] m or its count not in [0, 64].
+LeafCloud make_leaf_cloud(const TreeGraph& graph, const LeafSettings& leaves, std::uint64_t seed,
+                          const LobeLeafOverrides& per_lobe = {});
 
 /// Number of quads emit_leaf_quads writes for `keep_fraction`.
 std::size_t count_leaf_quads(const LeafCloud& cloud, double keep_fraction);
 
 /// Writes the quads of `cloud` at `lod` into `out`, replacing its content but reusing its
-/// storage. Sizes from `leaves` (length_m, width_m), scaled by √(1 / keep_fraction).
+/// storage. Sizes are each leaf's (LeafCloud::Leaf::length_m, width_m), their area scaled by
+/// 1 / keep_fraction.
 /// \throw InvalidInput when keep_fraction is not in (0, 1].
-void emit_leaf_quads(const LeafCloud& cloud, const LeafSettings& leaves, const LeafLodOptions& lod, SurfaceGeometry& out,
+void emit_leaf_quads(const LeafCloud& cloud, const LeafLodOptions& lod, SurfaceGeometry& out,
                      std::vector<int>* quad_nodes = nullptr);
 
 /// Share of the LOD0 leaves kept at level `lod`: 0.5^lod.

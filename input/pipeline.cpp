@@ -25,6 +25,7 @@ const char* action_name(InputAction::Type t)
     case InputAction::Type::Duplicate: return "duplicate";
     case InputAction::Type::Mirror: return "mirror";
     case InputAction::Type::SettingChanged: return "setting";
+    case InputAction::Type::ImportMesh: return "import-mesh";
     }
     return "unknown";
 }
@@ -66,6 +67,13 @@ void InputPipeline::push_event(const InputEvent& event)
         a.setting.id = static_cast<SettingId>(event.code);
         a.setting.lobe = event.value;
         a.setting.value = shortest_double(event.x);
+        actions_.push_back(std::move(a));
+        return;
+    }
+    if (event.kind == InputEventKind::ImportMesh) {
+        a.type = InputAction::Type::ImportMesh;
+        a.import_number = event.code;
+        attach_tip(a);
         actions_.push_back(std::move(a));
         return;
     }

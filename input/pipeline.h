@@ -53,18 +53,20 @@ struct InputAction {
         Duplicate,       ///< copy the lobe (else the trunk stroke) at `tip` beside itself
         Mirror,          ///< mirror the lobe (else the trunk stroke) at `tip` across the trunk's plane
         SettingChanged,  ///< `setting`
+        ImportMesh,      ///< import mesh `import_number` as a lobe centred on `tip` (recording.h, InputEventKind::ImportMesh)
     } type = Type::StrokeCompleted;
     double time = 0.0;
     Stroke stroke;
     Drag drag;
     Tool tool = Tool::DrawLobe;
     std::string message;
-    /// DeleteStroke, DeleteLobe, Duplicate, Mirror: the filtered index tip of the right hand
+    /// DeleteStroke, DeleteLobe, Duplicate, Mirror, ImportMesh: the filtered index tip of the right hand
     /// when the key was pressed, else the left hand's (`tip_hand` says which); absent when
     /// neither hand was tracked.
     std::optional<glm::vec3> tip;
     Hand tip_hand = Hand::Right;
     SettingChange setting;
+    int import_number = 0;
 };
 
 const char* action_name(InputAction::Type t);

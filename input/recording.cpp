@@ -378,7 +378,7 @@ std::size_t json_nesting(std::string_view s)
 }
 
 
-bool known_event_kind(std::uint8_t k) { return k >= 1 && k <= 5; }
+bool known_event_kind(std::uint8_t k) { return k >= 1 && k <= 6; }
 
 // ---------------------------------------------------------------------------------------
 // Collector: validation and bounded report shared by both readers
@@ -1057,6 +1057,11 @@ void append_event_line(std::string& out, const InputEvent& e)
         out += ' ';
         append_number(out, e.x);
         break;
+    case InputEventKind::ImportMesh:
+        out += kind;
+        out += ' ';
+        append_number(out, e.code);
+        break;
     default: // a kind this build does not know: written so that readers skip it
         out += "kind_" + std::to_string(static_cast<int>(e.kind));
         break;
@@ -1265,6 +1270,9 @@ void parse_text_line(Collector& c, std::string_view line, Where w)
             ok = take_number(t, e.code, "setting id", error) && take_number(t, e.value, "lobe id", error) &&
                  take_number(t, e.x, "value", error);
             if (ok && t.peek().empty() && !known_setting_id(e.code)) return c.skip_unknown_setting(w, e.code);
+        } else if (ek == "import_mesh") {
+            e.kind = InputEventKind::ImportMesh;
+            ok = take_number(t, e.code, "import number", error);
         } else if (ek.empty()) {
             return c.drop_event(w, "missing event kind");
         } else {
@@ -1493,6 +1501,11 @@ void RecordingWriter::close()
     if (!ok) throw FileError(path_, std::string("close failed: ") + std::strerror(err));
 }
 
+std::string import_mesh_path(const std::string& recording_path, int n)
+{
+    return recording_path + ".import-" + std::to_string(n) + ".ply";
+}
+
 const char* event_kind_name(InputEventKind k)
 {
     switch (k) {
@@ -1501,6 +1514,7 @@ const char* event_kind_name(InputEventKind k)
     case InputEventKind::MouseMove: return "mouse_move";
     case InputEventKind::MouseWheel: return "wheel";
     case InputEventKind::Setting: return "setting";
+    case InputEventKind::ImportMesh: return "import_mesh";
     }
     return nullptr;
 }

@@ -42,7 +42,14 @@ enum class InputEventKind : std::uint8_t {
     MouseMove = 3,   ///< x, y = cursor position in window pixels
     MouseWheel = 4,  ///< y = wheel delta
     Setting = 5,     ///< an appearance setting: code = SettingId, value = lobe id (0 = the whole tree), x = the number
+    ImportMesh = 6,  ///< a mesh imported as a lobe at the fingertip: code = N ≥ 1, the mesh is the file
+                     ///< import_mesh_path(recording, N) beside the recording
 };
+
+/// The mesh of ImportMesh event N of the recording at `recording_path`: a PLY file beside it,
+/// "REC.import-N.ply" (the lobe mesh as imported: repaired, scaled, remeshed, centred on the
+/// origin).
+std::string import_mesh_path(const std::string& recording_path, int n);
 
 /// What a Setting event sets (InputEvent::code). A reader skips an id it does not know with
 /// a warning, like an unknown event kind. Ranges and units: docs/recording-format.md.
@@ -64,7 +71,7 @@ inline bool known_setting_id(std::int32_t id) { return id >= 1 && id <= 6; }
 inline constexpr const char* kSettingSpecies[] = {"broadleaf", "conifer", "willow", "birch"};
 inline constexpr int kSettingSpeciesCount = 4;
 
-/// "key", "mouse_button", "mouse_move", "wheel", "setting"; nullptr for a kind this build does not know.
+/// "key", "mouse_button", "mouse_move", "wheel", "setting", "import_mesh"; nullptr for a kind this build does not know.
 const char* event_kind_name(InputEventKind kind);
 
 struct InputEvent {

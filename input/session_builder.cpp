@@ -1,11 +1,13 @@
 #include "input/session_builder.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <set>
 
+#include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
 #include "core/errors.h"
@@ -68,6 +70,17 @@ const Stroke* nearest_stroke(const std::vector<Stroke>& view, const glm::dvec3& 
     return best;
 }
 
+/// Centre of a lobe made from a mesh: the middle of its bounding box.
+glm::dvec3 model_centre(const TriangleMesh& mesh)
+{
+    glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+    for (const glm::vec3& q : mesh.positions) {
+        lo = glm::min(lo, glm::dvec3(q));
+        hi = glm::max(hi, glm::dvec3(q));
+    }
+    return mesh.positions.empty() ? glm::dvec3(0.0) : 0.5 * (lo + hi);
+}
+
 /// What a lobe pick found: `lobe` is null when it picked nothing; `nearest_any` is the
 /// distance to the nearest lobe stroke (infinity when no lobe has strokes to see).
 struct LobePick {
@@ -79,20 +92,33 @@ struct LobePick {
 
 /// Among the lobes whose strokes (as seen in `view`) come within `pick_distance` of `p`,
 /// or whose bounding sphere (centre: lobe_centre, radius: its farthest stroke point) holds
-/// it, the one whose strokes are nearest.
-LobePick pick_lobe(const Document& doc, const std::vector<Stroke>& view, const glm::dvec3& p, double pick_distance)
+/// it, the one whose strokes are nearest. A lobe made from a mesh counts its vertices as
+/// its stroke points and the middle of their bounding box as its centre.
+LobePick pick_lobe(const Document& doc, const std::vector<Stroke>& view, const glm::dvec3& p, double pick_distance,
+                   const EditHooks& hooks)
 {
     LobePick pick;
     double best_d = std::numeric_limits<double>::infinity();
     for (const LobeRecord& lobe : doc.lobes) {
         glm::dvec3 c;
-        if (!lobe_centre(lobe, view, c)) continue;
         double d = std::numeric_limits<double>::infinity(), radius = 0.0;
-        for (std::int64_t id : lobe.stroke_ids)
-            if (const Stroke* s = find_stroke(view, id)) {
-                d = std::min(d, distance_to_stroke(*s, p));
-                for (const StrokePoint& q : s->points) radius = std::max(radius, glm::distance(glm::dvec3(q.position), c));
+        if (lobe.model) {
+            // A lobe made from a mesh: its vertices where the person sees them.
+            const TriangleMesh mesh = hooks.model_in_stage ? hooks.model_in_stage(doc, lobe) : lobe.model->mesh;
+            if (mesh.positions.empty()) continue;
+            c = model_centre(mesh);
+            for (const glm::vec3& q : mesh.positions) {
+                d = std::min(d, glm::distance(glm::dvec3(q), p));
+                radius = std::max(radius, glm::distance(glm::dvec3(q), c));
             }
+        } else {
+            if (!lobe_centre(lobe, view, c)) continue;
+            for (std::int64_t id : lobe.stroke_ids)
+                if (const Stroke* s = find_stroke(view, id)) {
+                    d = std::min(d, distance_to_stroke(*s, p));
+                    for (const StrokePoint& q : s->points) radius = std::max(radius, glm::distance(glm::dvec3(q.position), c));
+                }
+        }
         pick.nearest_any = std::min(pick.nearest_any, d);
         const bool near = d <= pick_distance || glm::distance(p, c) <= radius;
         if (near && d < best_d) {
@@ -259,6 +285,7 @@ void SessionBuilder::add_stroke(const Stroke& drawn)
     LobeRecord* target = nullptr;
     if (!new_lobe_pending_ && !doc_.lobes.empty()) {
         auto near = [&](const LobeRecord& l, double& d) {
+            if (l.model) return false; // a lobe made from a mesh takes no strokes
             double radius = 0;
             lobe_distance(doc_, l, stroke, d, radius);
             return d <= std::max(kJoinDistanceM, 0.5 * radius);
@@ -276,7 +303,7 @@ void SessionBuilder::add_stroke(const Stroke& drawn)
         }
     }
     if (!target) {
-        doc_.lobes.push_back(LobeRecord{next_lobe_id_++, {}, {}, std::nullopt, {}});
+        doc_.lobes.push_back(LobeRecord::of_strokes(next_lobe_id_++));
         target = &doc_.lobes.back();
     }
     new_lobe_pending_ = false;
@@ -334,7 +361,7 @@ bool SessionBuilder::add_drag(const InputAction& a)
     } else {
         // Lobe tools: the lobe whose strokes are nearest the drag start, among those it is
         // near or inside.
-        const LobePick pick = pick_lobe(doc_, view, start, pick_.lobe_pick_distance_m);
+        const LobePick pick = pick_lobe(doc_, view, start, pick_.lobe_pick_distance_m, hooks_);
         if (!pick.lobe) {
             if (!std::isfinite(pick.nearest_any)) return nothing("there are no lobes");
             return nothing("its start is outside every lobe and " + cm(pick.nearest_any) +
@@ -386,6 +413,7 @@ bool SessionBuilder::apply(const InputAction& a)
     case InputAction::Type::Duplicate:
     case InputAction::Type::Mirror: return copy_at_tip(a);
     case InputAction::Type::SettingChanged: return apply_setting(a);
+    case InputAction::Type::ImportMesh: return import_mesh(a);
     case InputAction::Type::StrokeDiscarded:
     case InputAction::Type::ToolChanged:
     case InputAction::Type::Grow:
@@ -406,7 +434,7 @@ bool SessionBuilder::delete_at_tip(const InputAction& a)
     const glm::dvec3 tip(*a.tip);
     const std::vector<Stroke> view = this->view();
     if (lobe_wanted) {
-        const LobePick pick = pick_lobe(doc_, view, tip, pick_.lobe_pick_distance_m);
+        const LobePick pick = pick_lobe(doc_, view, tip, pick_.lobe_pick_distance_m, hooks_);
         if (!pick.lobe) {
             if (!std::isfinite(pick.nearest_any)) return nothing("there are no lobes");
             return nothing("the fingertip is outside every lobe and " + cm(pick.nearest_any) +
@@ -545,17 +573,26 @@ bool SessionBuilder::copy_at_tip(const InputAction& a)
         return c;
     };
 
-    const LobePick pick = pick_lobe(doc_, view, tip, pick_.lobe_pick_distance_m);
+    const LobePick pick = pick_lobe(doc_, view, tip, pick_.lobe_pick_distance_m, hooks_);
     if (pick.lobe) {
         const LobeRecord source = *pick.lobe;
         const glm::dvec3 shift(2.0 * pick.radius + kDuplicateGapM, 0.0, 0.0);
         std::string note;
         std::vector<EditOperation> deforms = placed_deforms(source, mirror, shift, mirror_x, note);
         snapshot();
-        LobeRecord copy;
+        LobeRecord copy = source;
         copy.id = next_lobe_id_++;
-        copy.split_angle_deg = source.split_angle_deg;
-        copy.species = source.species;
+        copy.stroke_ids.clear();
+        copy.mesh_file.clear();
+        if (source.model) {
+            // The mesh where the person sees it, placed; a mirror image turns its triangles
+            // over so that they still face outwards.
+            TriangleMesh m = hooks_.model_in_stage ? hooks_.model_in_stage(doc_, source) : source.model->mesh;
+            for (glm::vec3& p : m.positions) p = place_point(p, mirror, shift, mirror_x);
+            if (mirror)
+                for (std::array<int, 3>& t : m.triangles) std::swap(t[1], t[2]);
+            copy.model = std::make_shared<const LobeModel>(LobeModel{source.model->source, std::move(m)});
+        }
         for (std::int64_t id : source.stroke_ids)
             if (const Stroke* s = find_stroke(view, id)) {
                 doc_.strokes.push_back(copy_of(*s, shift));
@@ -608,17 +645,15 @@ bool SessionBuilder::apply_setting(const InputAction& a)
     Settings s = doc_.settings;
     std::uint64_t seed = doc_.seed;
     LobeRecord* lobe = nullptr;
-    std::optional<double> split;
-    std::string species;
+    LobeRecord lobe_after; // the lobe's overrides after this setting
     if (c.lobe != 0) {
-        if (c.id != SettingId::SplitAngle && c.id != SettingId::Species)
+        if (c.id == SettingId::AttractorSpacing)
             return refuse(std::string(name) + " is a tree-wide setting (lobe " + std::to_string(c.lobe) +
-                          " given; only split-angle and species can be set per lobe)");
+                          " given): every lobe carries the same attractor density");
         for (LobeRecord& l : doc_.lobes)
             if (l.id == c.lobe) lobe = &l;
         if (!lobe) return refuse("there is no lobe " + std::to_string(c.lobe));
-        split = lobe->split_angle_deg;
-        species = lobe->species;
+        lobe_after = *lobe;
     }
     try {
         switch (c.id) {
@@ -627,7 +662,7 @@ bool SessionBuilder::apply_setting(const InputAction& a)
                 GrowthSettings g = s.growth;
                 g.split_angle_deg = v;
                 validate_growth_settings(g);
-                split = v;
+                lobe_after.split_angle_deg = v;
             } else {
                 s.growth.split_angle_deg = v;
                 validate_growth_settings(s.growth);
@@ -638,23 +673,30 @@ bool SessionBuilder::apply_setting(const InputAction& a)
             validate_settings(s);
             break;
         case SettingId::LeafLength: {
-            const double ratio = s.leaves.width_m / s.leaves.length_m;
-            s.leaves.length_m = v;
-            s.leaves.width_m = v * ratio;
-            validate_leaf_settings(s.leaves);
+            LeafSettings l = s.leaves;
+            const double ratio = l.width_m / l.length_m;
+            l.length_m = v;
+            l.width_m = v * ratio;
+            validate_leaf_settings(l);
+            if (lobe) lobe_after.leaf_length_m = v;
+            else s.leaves = l;
             break;
         }
-        case SettingId::LeavesPerNode:
+        case SettingId::LeavesPerNode: {
             if (!whole(-1e9, 1e9)) return refuse("leaves per node must be a whole number");
-            s.leaves.per_node = static_cast<int>(v);
-            validate_leaf_settings(s.leaves);
+            LeafSettings l = s.leaves;
+            l.per_node = static_cast<int>(v);
+            validate_leaf_settings(l);
+            if (lobe) lobe_after.leaves_per_node = l.per_node;
+            else s.leaves = l;
             break;
+        }
         case SettingId::Species: {
             if (!whole(0, kSettingSpeciesCount - 1))
                 return refuse("the species index must be 0 to 3 (broadleaf, conifer, willow, birch)");
             const std::string chosen = kSettingSpecies[static_cast<int>(v)];
             if (lobe) {
-                species = chosen;
+                lobe_after.species = chosen;
             } else if (hooks_.apply_species) {
                 const std::string why = hooks_.apply_species(s, chosen);
                 if (!why.empty()) return refuse(why);
@@ -665,25 +707,65 @@ bool SessionBuilder::apply_setting(const InputAction& a)
         }
         case SettingId::Seed:
             if (!whole(1, 16777215)) return refuse("the seed must be a whole number from 1 to 16777215");
-            seed = static_cast<std::uint64_t>(v);
+            if (lobe) lobe_after.seed = static_cast<std::uint64_t>(v);
+            else seed = static_cast<std::uint64_t>(v);
             break;
         }
     } catch (const InvalidInput& e) {
         return refuse(e.what());
     }
-    const bool changed = seed != doc_.seed || settings_json(s) != settings_json(doc_.settings) ||
-                         (lobe && (split != lobe->split_angle_deg || species != lobe->species));
+    const bool lobe_changed = lobe && (lobe_after.split_angle_deg != lobe->split_angle_deg ||
+                                       lobe_after.species != lobe->species ||
+                                       lobe_after.leaf_length_m != lobe->leaf_length_m ||
+                                       lobe_after.leaves_per_node != lobe->leaves_per_node || lobe_after.seed != lobe->seed);
+    const bool changed = seed != doc_.seed || settings_json(s) != settings_json(doc_.settings) || lobe_changed;
     if (!changed) return false;
     // A slider being dragged: one undo step for the whole run.
     const bool merge = setting_run_ && setting_run_->first == c.id && setting_run_->second == c.lobe && !undo_.empty();
     if (!merge) snapshot();
     doc_.settings = std::move(s);
     doc_.seed = seed;
-    if (lobe) {
-        lobe->split_angle_deg = split;
-        lobe->species = species;
-    }
+    if (lobe) *lobe = std::move(lobe_after);
     setting_run_ = std::make_pair(c.id, c.lobe);
+    return true;
+}
+
+bool SessionBuilder::import_mesh(const InputAction& a)
+{
+    const std::string prefix = when(action_name(a.type), a.time);
+    auto nothing = [&](const std::string& why) {
+        messages_.push_back(prefix + why);
+        return false;
+    };
+    if (!hooks_.import_model) return nothing("this session cannot read imported meshes");
+    std::shared_ptr<const LobeModel> model;
+    try {
+        model = hooks_.import_model(a.import_number);
+    } catch (const Error& e) {
+        return nothing(e.what());
+    }
+    if (!model || model->mesh.triangles.empty() || model->mesh.positions.empty())
+        return nothing("import " + std::to_string(a.import_number) + " holds no mesh");
+    // Centred on the fingertip; with no hand tracked, standing on the trunk's side of the
+    // origin as `grow MESH` places it: lowest point half its height above the ground.
+    TriangleMesh mesh = model->mesh;
+    const glm::dvec3 centre = model_centre(mesh);
+    glm::dvec3 target;
+    if (a.tip) {
+        target = glm::dvec3(*a.tip);
+    } else {
+        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+        for (const glm::vec3& p : mesh.positions) {
+            lo = std::min(lo, static_cast<double>(p.y));
+            hi = std::max(hi, static_cast<double>(p.y));
+        }
+        target = glm::dvec3(0.0, (hi - lo), 0.0);
+    }
+    for (glm::vec3& p : mesh.positions) p = glm::vec3(glm::dvec3(p) - centre + target);
+    snapshot();
+    LobeRecord r = LobeRecord::of_strokes(next_lobe_id_++);
+    r.model = std::make_shared<const LobeModel>(LobeModel{model->source, std::move(mesh)});
+    doc_.lobes.push_back(std::move(r));
     return true;
 }
 

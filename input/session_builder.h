@@ -45,6 +45,14 @@ struct EditHooks {
     /// load_species(name))); empty when it did, else why not, `settings` unchanged. Absent:
     /// only settings.growth.species is set to the name.
     std::function<std::string(Settings&, const std::string&)> apply_species;
+    /// A lobe made from a mesh (LobeRecord::model) where the person sees it now: its mesh
+    /// moved, rotated and scaled by the lobe's transform operations, stage space. Absent:
+    /// the model's mesh as stored.
+    std::function<TriangleMesh(const Document&, const LobeRecord&)> model_in_stage;
+    /// The mesh of import number N (InputAction::ImportMesh), as the import made it
+    /// (centred on the origin). Throws Error (one line) when it cannot be had. Absent:
+    /// imports are refused with a warning.
+    std::function<std::shared_ptr<const LobeModel>(int)> import_model;
 };
 
 /// Centre of a lobe used by rotate and scale: the length-weighted barycentre of its strokes
@@ -91,6 +99,7 @@ private:
     bool delete_at_tip(const InputAction& action);
     bool copy_at_tip(const InputAction& action);
     bool apply_setting(const InputAction& action);
+    bool import_mesh(const InputAction& action);
     /// The lobe's pinch deforms as copies for a lobe copied by `place` (see docs/editing.md):
     /// their paths where the person sees them now, placed. Empty, with `note` saying why,
     /// when they cannot be carried over faithfully.

@@ -82,6 +82,45 @@ bool apply_pinch(const Document& doc, const EditOperation& op, TriangleMesh& mes
     return true;
 }
 
+/// Mean edge length of `mesh` (each interior edge counted twice, which leaves the mean as is).
+double mean_edge_length(const TriangleMesh& mesh)
+{
+    double sum = 0.0;
+    std::size_t n = 0;
+    for (const std::array<int, 3>& t : mesh.triangles)
+        for (int k = 0; k < 3; ++k) {
+            sum += glm::distance(mesh.positions[static_cast<std::size_t>(t[static_cast<std::size_t>(k)])],
+                                 mesh.positions[static_cast<std::size_t>(t[static_cast<std::size_t>((k + 1) % 3)])]);
+            ++n;
+        }
+    return n ? sum / static_cast<double>(n) : 0.0;
+}
+
+/// A lobe imported from a mesh (LobeRecord::model): the mesh as stored, remeshed again only
+/// when the attractor spacing has since moved more than 25 % away from its edge length.
+/// \throw InvalidInput when the stored mesh cannot be remeshed (not a 2-manifold).
+BuiltLobe model_document_lobe(const LobeRecord& rec, const RemeshOptions& remesh)
+{
+    BuiltLobe built;
+    built.lobe_id = rec.id;
+    built.surface.mesh = rec.model->mesh;
+    built.surface.mesh.feature_edges.clear();
+    glm::dvec3 centre(0.0);
+    for (const glm::vec3& p : built.surface.mesh.positions) centre += glm::dvec3(p);
+    built.surface.centre = centre / std::max<double>(1.0, static_cast<double>(built.surface.mesh.positions.size()));
+    const double edge = mean_edge_length(built.surface.mesh);
+    const double target = remesh.target_edge_length_m;
+    if (remesh.iterations > 0 && (edge < 0.75 * target || edge > 1.25 * target)) {
+        RemeshOptions o = remesh;
+        o.protect_feature_edges = false;
+        o.relax_feature_edges = false;
+        built.mesh = remesh_isotropic(built.surface.mesh, o);
+    } else {
+        built.mesh = built.surface.mesh;
+    }
+    return built;
+}
+
 } // namespace
 
 LobeOptions lobe_options_from(const Settings& settings)
@@ -108,6 +147,14 @@ std::vector<BuiltLobe> build_document_lobes(const Document& doc, std::vector<std
         if (warnings) warnings->push_back(e.message);
     std::vector<BuiltLobe> out;
     for (const LobeRecord& rec : doc.lobes) {
+        if (rec.model) {
+            try {
+                out.push_back(model_document_lobe(rec, remesh));
+            } catch (const InvalidInput& e) {
+                if (warnings) warnings->push_back("lobe " + std::to_string(rec.id) + ": " + e.what() + "; the lobe is left out");
+            }
+            continue;
+        }
         Lobe lobe(options);
         BuiltLobe built;
         built.lobe_id = rec.id;

@@ -109,6 +109,16 @@ TEST(Cli, LobesCommandBuildsLobesFromARecordingASessionAndAMesh)
     bounding_box(spot, lo, hi);
     EXPECT_NEAR(std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z}), 0.8, 0.02);
     EXPECT_TRUE(measure_quality(spot).closed);
+    // Its session holds the lobe itself: rebuilding the lobes from it gives the same mesh.
+    const Document mesh_session = load_document(dir + "/mesh/session.json");
+    ASSERT_EQ(mesh_session.lobes.size(), 1u);
+    ASSERT_TRUE(mesh_session.lobes[0].model);
+    EXPECT_EQ(mesh_session.lobes[0].model->source, "spot.obj");
+    r = run("lobes " + dir + "/mesh/session.json --out " + dir + "/mesh-again");
+    ASSERT_EQ(r.code, 0) << r.out;
+    const TriangleMesh again = read_mesh(dir + "/mesh-again/lobes/lobe_1.ply");
+    EXPECT_EQ(again.positions, spot.positions);
+    EXPECT_EQ(again.triangles, spot.triangles);
     // A malformed mesh: one line naming the file, exit 1, nothing written.
     const std::string bad = dir + "/bad.obj";
     {

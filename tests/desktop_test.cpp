@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include <gtest/gtest.h>
+#include <glm/common.hpp>
 #include <nlohmann/json.hpp>
 
 #include "app/desktop_script.h"
@@ -124,7 +125,9 @@ TEST(DesktopHand, GestureRecogniserSeesPinchesAndNeverAGrab)
         const HandGesture& r = hands[static_cast<int>(Hand::Right)];
         if (r.pinch_started) ++pinching;
         if (r.grabbing) ++grabbing;
-        if (i % 30 == 29) EXPECT_EQ(r.pinching, pinched) << "frame " << i;
+        if (i % 30 == 29) {
+            EXPECT_EQ(r.pinching, pinched) << "frame " << i;
+        }
     }
     EXPECT_EQ(pinching, 2);
     EXPECT_EQ(grabbing, 0);
@@ -258,6 +261,55 @@ TEST(DesktopSession, RecordingReplaysToTheSameDocument)
     EXPECT_EQ(live.edits.size(), 1u) << "the undo took back the move";
 }
 
+TEST(DesktopSession, ImportedMeshIsALobeAtTheFingertipAndTheRecordingReplaysIt)
+{
+    const std::string dir = temp_dir("desktop_import");
+    Document live;
+    glm::vec3 tip(0.0f);
+    {
+        DesktopSession s(Document{}, quiet_options(dir));
+        Driver d{s};
+        d.move(320, 180);
+        d.step(3);
+        EXPECT_FALSE(s.import_mesh(dir + "/missing.obj"));
+        EXPECT_EQ(s.status().last_message.rfind("import: ", 0), 0u) << s.status().last_message;
+        ASSERT_TRUE(s.import_mesh(test::shared_path("data/models/spot.obj"), 0.5)) << s.status().last_message;
+        tip = s.status().tip;
+        d.step();
+        ASSERT_EQ(s.document().lobes.size(), 1u) << s.status().last_message;
+        const LobeRecord& l = s.document().lobes[0];
+        ASSERT_TRUE(l.model);
+        EXPECT_EQ(l.model->source, "session.lrec.import-1.ply");
+        glm::vec3 lo(1e9f), hi(-1e9f);
+        for (const glm::vec3& p : l.model->mesh.positions) {
+            lo = glm::min(lo, p);
+            hi = glm::max(hi, p);
+        }
+        EXPECT_LT(glm::distance(0.5f * (lo + hi), tip), 0.005f) << "centred on the fingertip";
+        EXPECT_NEAR(std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z}), 0.5f, 0.02f);
+        EXPECT_TRUE(fs::exists(dir + "/session.lrec.import-1.ply"));
+        // It grows a tree like a lobe of strokes, and undo takes the import back.
+        d.press(keys::kGrow);
+        s.wait_for_regrowth();
+        d.step();
+        EXPECT_TRUE(s.status().tree_error.empty()) << s.status().tree_error;
+        EXPECT_GT(s.status().tree_triangles, 1000u);
+        d.press(keys::kUndo);
+        EXPECT_TRUE(s.document().lobes.empty());
+        d.press(keys::kRedo);
+        EXPECT_EQ(s.document().lobes.size(), 1u);
+        s.finish(d.frame / 60.0 + 0.1);
+        live = s.document();
+    }
+    const test::CliRun run = run_cli("replay " + dir + "/session.lrec --out " + dir + "/replayed");
+    ASSERT_EQ(run.code, 0) << run.out;
+    Document replayed = load_document(dir + "/replayed/session.json");
+    ASSERT_EQ(replayed.lobes.size(), 1u);
+    EXPECT_EQ(replayed.lobes[0].mesh_file, "lobes/lobe_1.ply"); // replay writes the lobe's mesh
+    replayed.lobes[0].mesh_file.clear();
+    EXPECT_EQ(document_to_json(replayed)["lobes"], document_to_json(live)["lobes"]);
+}
+
 // ---------------------------------------------------------------------------------------------
 TEST(DesktopScript, ParsesMacrosAndRefusesBadLinesWithTheirLineNumber)
 {
@@ -269,8 +321,15 @@ TEST(DesktopScript, ParsesMacrosAndRefusesBadLinesWithTheirLineNumber)
     EXPECT_EQ(steps[7].kind, ScriptStep::Kind::Up);
     EXPECT_EQ(steps[7].frame, 9);
     EXPECT_EQ(steps[8].kind, ScriptStep::Kind::Panel);
+    const auto imports = parse_desktop_script("1 import models/cow.obj 0.8\n2 import spot.off\n", "s.script");
+    ASSERT_EQ(imports.size(), 2u);
+    EXPECT_EQ(imports[0].kind, ScriptStep::Kind::Import);
+    EXPECT_EQ(imports[0].name, "models/cow.obj");
+    EXPECT_EQ(imports[0].value, 0.8);
+    EXPECT_EQ(imports[1].value, 1.5);
     for (const char* bad : {"0 fly 1 2", "x move 1 2", "5 move 1 2\n4 move 1 2", "0 move 1", "0 key nosuchkey",
-                            "0 set split-angle nan", "0 circle 1 2 3 1", "0 ui nothing", "0 move 1e999 2"}) {
+                            "0 set split-angle nan", "0 circle 1 2 3 1", "0 ui nothing", "0 move 1e999 2", "0 import",
+                            "0 import a.obj 0", "0 import a.obj 2 3"}) {
         try {
             parse_desktop_script(bad, "s.script");
             ADD_FAILURE() << "accepted: " << bad;

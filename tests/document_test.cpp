@@ -22,7 +22,10 @@ Document sample_document()
     s.closed = true;
     s.points = {{{0.1f, 1.2f, -0.3f}, 0.5}, {{0.11f, 1.25f, -0.31f}, 0.51}};
     d.strokes.push_back(s);
-    d.lobes.push_back({7, {3}, "lobes/lobe_7.ply", 22.5, "willow"});
+    LobeRecord lobe7 = LobeRecord::of_strokes(7, {3}, "lobes/lobe_7.ply");
+    lobe7.split_angle_deg = 22.5;
+    lobe7.species = "willow";
+    d.lobes.push_back(lobe7);
     d.settings.growth.split_angle_deg = 40;
     d.settings.growth.subtree_weights = {{"fork", 2.0}, {"whorl", 0.5}};
     d.settings.branches.radial_segments = 11;

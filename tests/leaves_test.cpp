@@ -1,6 +1,8 @@
 // Leaf quads, their levels of detail and the procedural leaf textures (growth/leaves.h).
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstring>
 #include <map>
 
 #include "core/errors.h"
@@ -352,7 +354,7 @@ TEST(Leaves, CloudCountsAndEmitsTheSameQuadsAsBuildLeafQuads)
     EXPECT_EQ(cloud.leaves.size(), 256u * 3u);
     SurfaceGeometry out;
     for (double keep : {1.0, 0.5, 0.3, 0.1}) {
-        emit_leaf_quads(cloud, l, {keep}, out);
+        emit_leaf_quads(cloud, {keep}, out);
         EXPECT_EQ(out.triangle_count(), 2 * count_leaf_quads(cloud, keep)) << keep;
         EXPECT_TRUE(same_bytes(out, build_leaf_quads(g, l, 21, {keep}))) << keep;
     }
@@ -363,4 +365,99 @@ TEST(Leaves, CloudCountsAndEmitsTheSameQuadsAsBuildLeafQuads)
         EXPECT_GE(leaf.keep_offset, 0.0f);
         EXPECT_LT(leaf.keep_offset, 1.0f);
     }
+}
+
+namespace {
+/// The quads of `cloud` at `keep`, with their tip nodes.
+SurfaceGeometry emitted(const LeafCloud& cloud, double keep, std::vector<int>& nodes)
+{
+    SurfaceGeometry out;
+    emit_leaf_quads(cloud, {keep}, out, &nodes);
+    return out;
+}
+} // namespace
+
+TEST(Leaves, LobeOverrideSetsLeafSizeAndCountOfItsLobeAndLeavesTheOtherLobeBitIdentical)
+{
+    const TreeGraph g = binary_test_tree();
+    const LeafSettings l;
+    LobeLeafOverrides over(2);
+    over[1].length_m = 2.0 * l.length_m;
+    over[1].per_node = l.per_node + 2;
+    for (double keep : {1.0, 0.5}) {
+        std::vector<int> na, nb;
+        const SurfaceGeometry a = emitted(make_leaf_cloud(g, l, 5), keep, na);
+        const LeafCloud cloud = make_leaf_cloud(g, l, 5, over);
+        const SurfaceGeometry b = emitted(cloud, keep, nb);
+        EXPECT_EQ(b.triangle_count(), 2 * count_leaf_quads(cloud, keep)) << keep;
+        const auto a0 = lobe_quads(g, a, na, 0), b0 = lobe_quads(g, b, nb, 0);
+        ASSERT_EQ(a0.size(), b0.size()) << keep;
+        EXPECT_EQ(std::memcmp(a0.data(), b0.data(), a0.size() * sizeof(a0[0])), 0) << "lobe 0 keeps the tree's leaves";
+        if (keep == 1.0) {
+            EXPECT_EQ(lobe_quads(g, b, nb, 1).size(), 128u * static_cast<std::size_t>(l.per_node + 2));
+        }
+        std::size_t lobe1 = 0;
+        const double grow = 1.0 / keep, length_scale = std::pow(grow, 0.125);
+        for (std::size_t q = 0; q < nb.size(); ++q) {
+            if (g.nodes[static_cast<std::size_t>(nb[q])].lobe != 1) continue;
+            ++lobe1;
+            EXPECT_NEAR(quad(b, q).length(), 2.0 * l.length_m * length_scale, 1e-6) << keep;
+            EXPECT_NEAR(quad(b, q).width(), 2.0 * l.width_m * grow / length_scale, 1e-6) << keep;
+        }
+        EXPECT_GT(lobe1, 0u);
+    }
+}
+
+TEST(Leaves, LobeSeedOverrideRedrawsOnlyThatLobesLeavesAsTheTreeSeedWould)
+{
+    const TreeGraph g = binary_test_tree();
+    const LeafSettings l;
+    LobeLeafOverrides over(2);
+    over[1].seed = 99;
+    std::vector<int> n5, n99, nover;
+    const SurfaceGeometry s5 = emitted(make_leaf_cloud(g, l, 5), 1.0, n5);
+    const SurfaceGeometry s99 = emitted(make_leaf_cloud(g, l, 99), 1.0, n99);
+    const SurfaceGeometry so = emitted(make_leaf_cloud(g, l, 5, over), 1.0, nover);
+    const auto a0 = lobe_quads(g, s5, n5, 0), o0 = lobe_quads(g, so, nover, 0);
+    const auto a1 = lobe_quads(g, s99, n99, 1), o1 = lobe_quads(g, so, nover, 1);
+    ASSERT_EQ(a0.size(), o0.size());
+    ASSERT_EQ(a1.size(), o1.size());
+    EXPECT_EQ(std::memcmp(a0.data(), o0.data(), a0.size() * sizeof(a0[0])), 0);
+    EXPECT_EQ(std::memcmp(a1.data(), o1.data(), a1.size() * sizeof(a1[0])), 0);
+    const auto b1 = lobe_quads(g, s5, n5, 1);
+    EXPECT_NE(std::memcmp(b1.data(), o1.data(), b1.size() * sizeof(b1[0])), 0);
+}
+
+TEST(Leaves, EmptyOverridesGiveTheTreesBytesAndAZeroCountLobeHasNoLeaves)
+{
+    const TreeGraph g = binary_test_tree();
+    const LeafSettings l;
+    std::vector<int> n;
+    EXPECT_TRUE(same_bytes(emitted(make_leaf_cloud(g, l, 5, LobeLeafOverrides(2)), 1.0, n), build_leaf_quads(g, l, 5)));
+    LobeLeafOverrides none(1);
+    none[0].per_node = 0;
+    const SurfaceGeometry s = emitted(make_leaf_cloud(g, l, 5, none), 1.0, n);
+    EXPECT_TRUE(lobe_quads(g, s, n, 0).empty());
+    EXPECT_EQ(lobe_quads(g, s, n, 1).size(), 128u * static_cast<std::size_t>(l.per_node));
+    // A lobe may have leaves where the tree has none.
+    LeafSettings bare = l;
+    bare.per_node = 0;
+    LobeLeafOverrides some(2);
+    some[1].per_node = 2;
+    const SurfaceGeometry t = emitted(make_leaf_cloud(g, bare, 5, some), 1.0, n);
+    EXPECT_TRUE(lobe_quads(g, t, n, 0).empty());
+    EXPECT_EQ(lobe_quads(g, t, n, 1).size(), 256u);
+}
+
+TEST(Leaves, OverridesOutOfRangeThrowInvalidInput)
+{
+    const TreeGraph g = binary_test_tree();
+    LobeLeafOverrides bad(1);
+    bad[0].length_m = 0.0;
+    EXPECT_THROW(make_leaf_cloud(g, LeafSettings{}, 1, bad), InvalidInput);
+    bad[0].length_m = std::nullopt;
+    bad[0].per_node = 65;
+    EXPECT_THROW(make_leaf_cloud(g, LeafSettings{}, 1, bad), InvalidInput);
+    bad[0].per_node = -1;
+    EXPECT_THROW(make_leaf_cloud(g, LeafSettings{}, 1, bad), InvalidInput);
 }

@@ -571,6 +571,21 @@ TEST(SessionSettings, EachSettingChangesTheDocumentAndUndoRestoresItExactly)
         EXPECT_EQ(lobe_by_id(d, 1).species, "birch");
         EXPECT_EQ(d.settings.growth.species, "broadleaf");
     });
+    // A lobe's own leaves and seed; the tree's stay as they are.
+    step(setting(SettingId::LeafLength, 0.12, 2), [](const Document& d) {
+        EXPECT_EQ(lobe_by_id(d, 2).leaf_length_m, std::optional<double>(0.12));
+        EXPECT_EQ(d.settings.leaves.length_m, 0.08);
+        EXPECT_FALSE(lobe_by_id(d, 1).leaf_length_m.has_value());
+    });
+    step(setting(SettingId::LeavesPerNode, 9, 2), [](const Document& d) {
+        EXPECT_EQ(lobe_by_id(d, 2).leaves_per_node, std::optional<int>(9));
+        EXPECT_EQ(d.settings.leaves.per_node, 7);
+    });
+    step(setting(SettingId::Seed, 4242, 1), [](const Document& d) {
+        EXPECT_EQ(lobe_by_id(d, 1).seed, std::optional<std::uint64_t>(4242));
+        EXPECT_EQ(d.seed, 1234567u);
+        EXPECT_FALSE(lobe_by_id(d, 2).seed.has_value());
+    });
     // Tree-wide species: what `--species conifer` does to the same settings.
     Settings want = b.document().settings;
     apply_species(want, load_species("conifer"));
@@ -600,7 +615,8 @@ TEST(SessionSettings, OutOfRangeUnknownOrPerLobeTreeWideSettingsAreRefusedWithAW
         setting(SettingId::Species, 0.5, 2),         setting(SettingId::Seed, 0),
         setting(SettingId::Seed, 16777216),          setting(SettingId::Seed, 3.5),
         setting(SettingId::SplitAngle, 30, 9),       setting(static_cast<SettingId>(9), 1),
-        setting(SettingId::SplitAngle, std::nan("")),
+        setting(SettingId::SplitAngle, std::nan("")),  setting(SettingId::LeafLength, 0.0001, 1),
+        setting(SettingId::LeavesPerNode, 65, 2),      setting(SettingId::Seed, 0, 1),
     };
     for (const InputAction& a : refused) EXPECT_FALSE(b.apply(a));
     EXPECT_EQ(text(b.document()), before);
@@ -610,7 +626,7 @@ TEST(SessionSettings, OutOfRangeUnknownOrPerLobeTreeWideSettingsAreRefusedWithAW
     EXPECT_EQ(m[2], "setting attractor-spacing at t=50.00s changes nothing: settings.lobes.edge_length_m must be in "
                     "[0.005, 0.5]");
     EXPECT_EQ(m[3], "setting attractor-spacing at t=50.00s changes nothing: attractor-spacing is a tree-wide setting "
-                    "(lobe 1 given; only split-angle and species can be set per lobe)");
+                    "(lobe 1 given): every lobe carries the same attractor density");
     EXPECT_EQ(m[7], "setting species at t=50.00s changes nothing: the species index must be 0 to 3 (broadleaf, "
                     "conifer, willow, birch)");
     EXPECT_EQ(m[12], "setting split-angle at t=50.00s changes nothing: there is no lobe 9");

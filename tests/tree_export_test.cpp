@@ -182,7 +182,7 @@ TEST_P(TreeInModel, ReferenceMeshGrowsOneConnectedTreeFillingIt)
 {
     Document doc;
     const BuiltLobe lobe = model_lobe(test::shared_path(std::string("data/models/") + GetParam() + ".obj"), doc.settings);
-    doc.lobes.push_back({1, {}, "", std::nullopt, {}});
+    doc.lobes.push_back(LobeRecord::of_strokes(1));
     const BuiltTree t = grow_document_tree(doc, {lobe});
     const TreeGraph& g = t.growth.tree;
     ASSERT_GT(g.size(), 1000u);

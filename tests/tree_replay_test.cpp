@@ -2,11 +2,14 @@
 // frames: one connected tree rooted at the trunk base, attractors reached, branches inside
 // the lobes, radii from the pipe model, determinism, and lobes independent of each other.
 #include <cmath>
+#include <map>
 
 #include <gtest/gtest.h>
 #include <glm/geometric.hpp>
 
+#include "app/tree_output.h"
 #include "app/tree_pipeline.h"
+#include "growth/leaves.h"
 #include "growth/mesh_raycast.h"
 #include "tests/replay_fixture.h"
 
@@ -147,6 +150,52 @@ TEST(TreeOnRecording, PerLobeSplitAngleOverridesTheTrees)
     EXPECT_GT(fine.growth.lobes[0].subtrees, base.growth.lobes[0].subtrees);
     EXPECT_EQ(fine.growth.lobes[1].subtrees, base.growth.lobes[1].subtrees);
     EXPECT_EQ(fine.growth.lobes[2].subtrees, base.growth.lobes[2].subtrees);
+}
+
+TEST(TreeOnRecording, PerLobeSeedLeafSizeAndLeafCountChangeThatLobeOnly)
+{
+    const Scene& s = scene("table1-3lobes-16strokes");
+    Document doc = s.doc;
+    const BuiltTree base = grow_document_tree(doc, s.lobes);
+    doc.lobes.at(0).seed = 777;
+    doc.lobes.at(0).leaf_length_m = 0.1;
+    doc.lobes.at(0).leaves_per_node = 7;
+    const BuiltTree own = grow_document_tree(doc, s.lobes);
+    auto of_lobe = [](const BuiltTree& t, int lobe) {
+        std::vector<TreeNode> out;
+        for (const TreeNode& n : t.growth.tree.nodes)
+            if (n.lobe == lobe) out.push_back(n);
+        return out;
+    };
+    const auto a0 = of_lobe(base, 0), b0 = of_lobe(own, 0);
+    ASSERT_FALSE(a0.empty());
+    ASSERT_FALSE(b0.empty());
+    EXPECT_TRUE(a0.size() != b0.size() || a0.back().position != b0.back().position) << "lobe 0 grows from its own seed";
+    for (int l = 1; l < 3; ++l) {
+        const auto a = of_lobe(base, l), b = of_lobe(own, l);
+        ASSERT_EQ(a.size(), b.size()) << "lobe " << l;
+        for (std::size_t i = 0; i < a.size(); ++i) ASSERT_EQ(a[i].position, b[i].position) << "lobe " << l;
+    }
+    // The leaves: lobe 0's are 10 cm long, seven per tip; the others' are the tree's.
+    const LobeLeafOverrides leaves = document_lobe_leaves(doc, own);
+    ASSERT_EQ(leaves.size(), 3u);
+    const LeafCloud cloud = make_leaf_cloud(own.growth.tree, doc.settings.leaves, doc.seed, leaves);
+    std::map<int, int> per_tip;
+    for (const LeafCloud::Leaf& leaf : cloud.leaves) {
+        const int lobe = own.growth.tree.nodes[static_cast<std::size_t>(leaf.node)].lobe;
+        EXPECT_EQ(leaf.per_node, lobe == 0 ? 7 : doc.settings.leaves.per_node);
+        EXPECT_DOUBLE_EQ(leaf.length_m, lobe == 0 ? 0.1 : doc.settings.leaves.length_m);
+        ++per_tip[leaf.node];
+    }
+    for (const auto& [node, n] : per_tip)
+        EXPECT_EQ(n, own.growth.tree.nodes[static_cast<std::size_t>(node)].lobe == 0 ? 7 : doc.settings.leaves.per_node);
+    // What the exported geometry holds.
+    const TreeGeometry geo = document_tree_geometry(doc, own);
+    SurfaceGeometry lod0;
+    emit_leaf_quads(cloud, {1.0}, lod0);
+    EXPECT_EQ(geo.lods[0].leaves.positions, lod0.positions);
+    // Without overrides the geometry is the tree-wide one, bit for bit.
+    EXPECT_TRUE(document_lobe_leaves(s.doc, base).empty());
 }
 
 } // namespace
