@@ -13,7 +13,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libcgal-dev libopenmesh-dev libgmp-dev libmpfr-dev
   libnanoflann-dev libtinygltf-dev libstb-dev
-  libvulkan-dev mesa-vulkan-drivers glslc
+  libvulkan-dev mesa-vulkan-drivers glslc libopenxr-dev libopenxr-loader1
   clang libclang-rt-14-dev
   libglfw3-dev libimgui-dev xvfb xauth
 )

@@ -432,7 +432,7 @@ TEST(Lobes, APinchEditSurvivesALaterStrokeAndAReload)
         double t = 0;
         for (const glm::vec3& p : pts) s.points.push_back({p, t += 0.01});
         doc.strokes.push_back(s);
-        if (doc.lobes.empty()) doc.lobes.push_back({1, {}, "", std::nullopt, {}});
+        if (doc.lobes.empty()) doc.lobes.push_back(LobeRecord::of_strokes(1));
         doc.lobes[0].stroke_ids.push_back(id);
     };
     add(1, loop(c, {1, 0, 0}, {0, 0, 1}, 0.15, 0.15));
