@@ -30,7 +30,10 @@ SpeciesPreset parse_species(const std::string& text, const std::string& where)
 {
     const json j = json::parse(text, nullptr, /*allow_exceptions=*/false);
     if (j.is_discarded()) throw InvalidInput(where + ": not valid JSON");
-    if (!j.is_object() || j.value("format", std::string()) != "lobesketch-species")
+    // Not j.value("format", …): it throws a json type_error when "format" is not a string.
+    const auto format = j.find("format");
+    if (!j.is_object() || format == j.end() || !format->is_string() ||
+        format->get<std::string>() != "lobesketch-species")
         throw InvalidInput(where + ": not a species preset (missing \"format\": \"lobesketch-species\")");
     if (!j.contains("version") || !j["version"].is_number_integer() || j["version"].get<int>() != 1)
         throw InvalidInput(where + ": unsupported species preset version (this program reads version 1)");

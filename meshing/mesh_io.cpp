@@ -622,7 +622,14 @@ std::string lower_extension(const std::string& path)
 
 TriangleMesh read_mesh(const std::string& path)
 {
-    const std::string data = read_file_limited(path, Limits::max_file_bytes);
+    return parse_mesh(read_file_limited(path, Limits::max_file_bytes), path);
+}
+
+TriangleMesh parse_mesh(const std::string& data, const std::string& path)
+{
+    if (data.size() > Limits::max_file_bytes)
+        throw FileError(path, "file too large (" + std::to_string(data.size()) + " bytes, limit " +
+                                  std::to_string(Limits::max_file_bytes) + ")");
     if (data.empty()) throw FileError(path, "empty file");
     std::string ext = lower_extension(path);
     if (ext != "obj" && ext != "ply" && ext != "off") {

@@ -41,6 +41,11 @@ struct MeshIoLimits {
 /// than 3 vertices or an index out of range, or has no vertex or no face.
 TriangleMesh read_mesh(const std::string& path);
 
+/// Parses a mesh held in memory, exactly as read_mesh parses a file's bytes: the format comes
+/// from `name`'s extension or, failing that, from the first bytes; `name` starts the messages.
+/// \throw FileError as read_mesh.
+TriangleMesh parse_mesh(const std::string& bytes, const std::string& name);
+
 /// Writes binary little-endian PLY (float x, y, z; uchar-int vertex_indices; an `edge`
 /// element with int vertex1, vertex2 when the mesh has feature edges), atomically
 /// (write_file_atomic).

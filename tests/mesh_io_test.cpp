@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -218,4 +219,22 @@ TEST(MeshIo, WritingABrokenMeshIsRefused)
     const std::string path = test::temp_dir("mesh_io_write_bad") + "/x.ply";
     EXPECT_THROW(write_ply(path, m), InvalidInput);
     EXPECT_THROW(write_obj(path, m), InvalidInput);
+}
+
+TEST(MeshIo, ParsesBytesInMemoryAsReadMeshReadsAFile)
+{
+    const std::string path = test::temp_dir("mesh_io_parse") + "/tet.ply";
+    write_ply(path, tetrahedron());
+    std::ifstream in(path, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    expect_same(parse_mesh(bytes, "tet.ply"), tetrahedron());
+    // Without a known extension the first bytes decide, as for read_mesh.
+    expect_same(parse_mesh(bytes, "mesh.bin"), tetrahedron());
+    EXPECT_EQ(parse_mesh("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "x").triangles.size(), 1u);
+    try {
+        parse_mesh("", "empty.obj");
+        ADD_FAILURE() << "no error";
+    } catch (const FileError& e) {
+        EXPECT_STREQ(e.what(), "empty.obj: empty file");
+    }
 }

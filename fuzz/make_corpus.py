@@ -1,0 +1,242 @@
+#!/usr/bin/env python3
+"""Regenerates the committed seed corpora in fuzz/corpus/<target>/ from the shipped files
+(docs/fuzzing.md). Seeds stay small (a few KiB) so that libFuzzer's mutations run fast; the
+big shipped files are cut down to their first frames, faces or records.
+
+    fuzz/make_corpus.py [--lobesketch build/release/app/lobesketch]
+
+With --lobesketch, the text-recording and session seeds are remade too (import-leap to the
+text form, replay of a shipped recording); without it they are left as they are.
+"""
+import argparse
+import json
+import os
+import pathlib
+import shutil
+import struct
+import subprocess
+import tempfile
+import zlib
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+SHARED = ROOT.parent / "shared" / "data"
+OUT = ROOT / "fuzz" / "corpus"
+
+
+def put(target, name, data):
+    d = OUT / target
+    d.mkdir(parents=True, exist_ok=True)
+    (d / name).write_bytes(data if isinstance(data, bytes) else data.encode())
+
+
+def js_value_end(s, i):
+    """End of the JS/JSON value starting at s[i] (brackets, quoted strings)."""
+    depth, quote = 0, None
+    j = i
+    while j < len(s):
+        c = s[j]
+        if quote:
+            if c == "\\":
+                j += 1
+            elif c == quote:
+                quote = None
+        elif c in "'\"":
+            quote = c
+        elif c in "[{":
+            depth += 1
+        elif c in "]}":
+            depth -= 1
+            if depth == 0:
+                return j + 1
+        elif depth == 0 and c in ",":
+            return j
+        j += 1
+    return j
+
+
+def leap_seeds():
+    for name in ["leap-grab", "leap-pinch"]:
+        d = json.loads((SHARED / "real" / f"{name}.json").read_text())
+        with_hands = [f for f in d["frames"] if f.get("hands")]
+        for n in (1, 3):
+            seed = {"frames": with_hands[len(with_hands) // 2:len(with_hands) // 2 + n], "metadata": d["metadata"]}
+            put("import_leap", f"{name}-{n}.json", json.dumps(seed, separators=(",", ":")))
+    put("import_leap", "empty-hands.json", '{"frames":[{"id":1,"timestamp":1000,"hands":[],"pointables":[]}],"metadata":{}}')
+
+
+def webxr_seeds():
+    s = (SHARED / "real" / "quest3-webxr-capture.min.js").read_text()
+    i = s.index("frames:[") + len("frames:[")
+    head = s[:i]
+    rows = []
+    while i < len(s) and s[i] != "]":
+        j = js_value_end(s, i)
+        rows.append(s[i:j])
+        i = j + 1 if s[j:j + 1] == "," else j
+    tail = "]};export{a as capture};"
+    hands = [r for r in rows if len(r) > 1500]
+    put("import_webxr", "controllers-2.js", head + ",".join(rows[:2]) + tail)
+    put("import_webxr", "hands-1.js", head + ",".join(hands[:1]) + tail)
+    put("import_webxr", "hands-3.js", head + ",".join(hands[len(hands) // 2:len(hands) // 2 + 3]) + tail)
+
+
+def recording_binary_seeds():
+    for name in ["pinch-edit", "table1-1lobe-5strokes"]:
+        data = (ROOT / "recordings" / f"{name}.lrec").read_bytes()
+        # header, then whole records only (a cut record is a seed of its own below)
+        hlen = struct.unpack_from("<I", data, 12)[0]
+        pos = 16 + hlen + 4
+        records = 0
+        while records < 3 and pos + 9 <= len(data):
+            plen = struct.unpack_from("<I", data, pos + 5)[0]
+            pos += 9 + plen + 4
+            records += 1
+        put("recording_binary", f"{name}-3records.lrec", data[:pos])
+        put("recording_binary", f"{name}-cut.lrec", data[:pos - 100])
+    # one frame, every event record of a recording with events, and an annotation
+    data = (ROOT / "recordings" / "edit-stroke-transform.lrec").read_bytes()
+    hlen = struct.unpack_from("<I", data, 12)[0]
+    pos = 16 + hlen + 4
+    out = data[:pos]
+    frames = 0
+    while pos + 9 <= len(data):
+        rtype, plen = data[pos + 4], struct.unpack_from("<I", data, pos + 5)[0]
+        if rtype != 1 or frames < 1:
+            out += data[pos:pos + 9 + plen + 4]
+            frames += rtype == 1
+        pos += 9 + plen + 4
+    note = struct.pack("<dH", 0.5, 12) + b"stroke_end 3"
+    body = struct.pack("<BI", 3, len(note)) + note
+    out += struct.pack("<I", 0x1E524CFE) + body + struct.pack("<I", zlib.crc32(body))
+    put("recording_binary", "events-annotation.lrec", out)
+
+
+def mesh_seeds():
+    tet_v = [(0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1)]
+    tet_f = [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3)]
+    # OBJ: the first faces of a shipped model, with the vertices they use, and the forms of
+    # obj statements the reader knows
+    for model, nf in [("spot", 40), ("cow", 40)]:
+        lines = (SHARED / "models" / f"{model}.obj").read_text().splitlines()
+        verts = [l for l in lines if l.startswith("v ")]
+        faces = [l.split()[1:] for l in lines if l.startswith("f ")][:nf]
+        used = sorted({int(t.split("/")[0]) for f in faces for t in f})
+        remap = {v: k + 1 for k, v in enumerate(used)}
+        out = [verts[v - 1] for v in used]
+        out += ["f " + " ".join(str(remap[int(t.split("/")[0])]) for t in f) for f in faces]
+        put("mesh_obj", f"{model}-{nf}faces.obj", "\n".join(out) + "\n")
+    put("mesh_obj", "forms.obj",
+        "# comment\no tet\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvt 0 0\nvn 0 0 1\n"
+        "f 1/1/1 3/1/1 2/1/1\nf -4//1 -3//1 -1//1\nf 1/1 4/1 3/1\nf 2 3 4\nl 1 2 3\ng x\ns off\nusemtl m\n")
+    put("mesh_obj", "quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 0.5 1\nf 1 2 3 4\nf 1 2 5\r\n")
+    # PLY
+    hdr = "ply\nformat {fmt} 1.0\ncomment seed\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n" \
+          "element face 4\nproperty list uchar int vertex_indices\nelement edge 1\nproperty int vertex1\nproperty int vertex2\nend_header\n"
+    body = "".join(f"{x} {y} {z}\n" for x, y, z in tet_v) + "".join(f"3 {a} {b} {c}\n" for a, b, c in tet_f) + "0 1\n"
+    put("mesh_ply", "tet-ascii.ply", hdr.format(fmt="ascii") + body)
+    for fmt, e in [("binary_little_endian", "<"), ("binary_big_endian", ">")]:
+        b = b"".join(struct.pack(e + "fff", *v) for v in tet_v)
+        b += b"".join(struct.pack(e + "Biii", 3, *f) for f in tet_f) + struct.pack(e + "ii", 0, 1)
+        put("mesh_ply", f"tet-{fmt}.ply", hdr.format(fmt=fmt).encode() + b)
+    hdr2 = "ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty double x\nproperty double y\n" \
+           "property double z\nproperty uchar red\nelement face 2\nproperty list ushort uint vertex_index\n" \
+           "property float quality\nelement other 1\nproperty list int short stuff\nend_header\n"
+    b = b"".join(struct.pack("<dddB", *v, 7) for v in tet_v)
+    b += struct.pack("<HIIIf", 3, 0, 1, 2, 0.5) + struct.pack("<HIIIIf", 4, 0, 1, 2, 3, 0.5)
+    b += struct.pack("<ihh", 2, 1, 2)
+    put("mesh_ply", "types.ply", hdr2.encode() + b)
+    # OFF
+    off = "OFF\n4 4 6\n" + "".join(f"{x} {y} {z}\n" for x, y, z in tet_v) + "".join(f"3 {a} {b} {c}\n" for a, b, c in tet_f)
+    put("mesh_off", "tet.off", off)
+    put("mesh_off", "quad-color.off", "COFF\n# comment\n5 2 0\n0 0 0 255 0 0 255\n1 0 0 0 0 0 255\n1 1 0 0 0 0 255\n"
+        "0 1 0 0 0 0 255\n0.5 0.5 1 0 0 0 255\n4 0 1 2 3 255 0 0\n3 0 1 4\n")
+    put("mesh_off", "one-line.off", "OFF 3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n")
+
+
+def species_seeds():
+    for p in sorted((ROOT / "growth" / "data" / "species").glob("*.json")):
+        put("species", p.name, p.read_bytes())
+
+
+def text_recording_seeds(lobesketch):
+    hand = " ".join("0.%d 1.%d -0.3 1 0 0 0 0.01 15" % (j, j) for j in range(26))
+    put("recording_text", "handwritten.txt",
+        "lobesketch-recording-text 1\n"
+        'header {"created":"","device":"none","nominal_rate_hz":90.0,"source":"hand-written","space":"stage","units":"m"}\n'
+        "# comment\n\n"
+        f"frame 0 head - left - right {hand}\n"
+        f"frame 0.011 head 0 1.6 0 1 0 0 0 left {hand} right -\n"
+        "event 0.25 key 32 1\nevent 0.3 mouse_button 0 1\nevent 0.3 mouse_move 412.5 300\nevent 0.4 wheel -1\n"
+        "event 0.45 setting 1 0 25\nevent 0.46 setting 5 2 1\nnote 0.5 stroke_end id=3 \\n\\x41\\\\\n")
+    put("recording_text", "events-only.txt", "lobesketch-recording-text 1.0\r\nevent 0 key 65 1\r\nevent 0.1 key 65 0\r\n")
+    if not lobesketch:
+        return
+    with tempfile.TemporaryDirectory() as tmp:
+        src = OUT / "import_leap" / "leap-pinch-3.json"
+        subprocess.run([lobesketch, "import-leap", str(src), "-o", f"{tmp}/leap.txt"], check=True, capture_output=True)
+        put("recording_text", "import-leap-3frames.txt", pathlib.Path(f"{tmp}/leap.txt").read_bytes())
+
+
+HANDWRITTEN_SESSION = {
+    "format": "lobesketch-session", "version": 1, "source_recording": "demo.lrec", "seed": 7,
+    "settings": {"input": {"pinch_start_m": 0.008}, "lobes": {"edge_length_m": 0.03, "remesh_iterations": 3},
+                 "growth": {"species": "conifer", "split_angle_deg": 25}, "branches": {}, "leaves": {}},
+    "strokes": [{"id": 1, "kind": "lobe", "hand": "right", "closed": False,
+                 "points": [[0.1, 1.2, -0.5], [0.12, 1.25, -0.5], [0.15, 1.3, -0.48], [0.1, 1.2, -0.5]],
+                 "times": [3.5, 3.6, 3.7, 3.8]},
+                {"id": 2, "kind": "trunk", "hand": "left", "closed": False,
+                 "points": [[0, 0, -0.5], [0, 0.5, -0.5]], "times": [5.0, 5.5]}],
+    "lobes": [{"id": 1, "strokes": [1], "mesh": "lobes/lobe_1.ply", "split_angle_deg": 40, "species": "willow"}],
+    "edits": [{"id": 1, "type": "drag:edit-stroke", "target": 1,
+               "params": {"hand": "right", "path": [[0.1, 1.2, -0.5, 4.0], [0.1, 1.3, -0.5, 4.2]],
+                          "pick_distance_m": 0.03, "half_length_m": 0.08, "other_tip": [0.2, 1.2, -0.5]}},
+              {"id": 2, "type": "drag:rotate-lobe", "target": 1,
+               "params": {"hand": "right", "path": [[0.1, 1.2, -0.5, 6.0], [0.2, 1.2, -0.5, 6.5]],
+                          "centre": [0.05, 1.4, -0.42], "strokes": [1]}}],
+    "trees": [{"id": 1, "transform": [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0.5, 0, 0, 1], "seed": 3, "lobes": []}],
+}
+
+
+def session_seeds(lobesketch):
+    put("document", "handwritten.json", json.dumps(HANDWRITTEN_SESSION, indent=1))
+    put("settings", "handwritten-session.json", json.dumps(HANDWRITTEN_SESSION, indent=1))
+    put("settings", "partial.json", '{"growth": {"split_angle_deg": 20}, "lobes": {"edge_length_m": 0.02}}')
+    if not lobesketch:
+        return
+    with tempfile.TemporaryDirectory() as tmp:
+        subprocess.run([lobesketch, "replay", str(ROOT / "recordings" / "edit-stroke-transform.lrec"), "-o", tmp],
+                       check=True, capture_output=True)
+        doc = json.loads(pathlib.Path(f"{tmp}/session.json").read_text())
+    # few strokes, few points: the structure is what matters
+    for s in doc["strokes"]:
+        s["points"], s["times"] = s["points"][:4], s["times"][:4]
+    doc["strokes"] = doc["strokes"][:3]
+    for e in doc["edits"]:
+        if "path" in e["params"]:
+            e["params"]["path"] = e["params"]["path"][:3]
+    doc["source_recording"] = "recordings/edit-stroke-transform.lrec"
+    put("document", "replay-edit-stroke-transform.json", json.dumps(doc, indent=1))
+    put("settings", "session.json", json.dumps(doc, indent=1))
+    put("settings", "settings.json", json.dumps(doc["settings"], indent=1))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--lobesketch", help="a built lobesketch, to remake the text-recording and session seeds")
+    a = ap.parse_args()
+    for t in ["import_leap", "import_webxr", "recording_binary", "mesh_obj", "mesh_ply", "mesh_off", "species"]:
+        shutil.rmtree(OUT / t, ignore_errors=True)
+    leap_seeds()
+    webxr_seeds()
+    recording_binary_seeds()
+    mesh_seeds()
+    species_seeds()
+    text_recording_seeds(a.lobesketch)
+    session_seeds(a.lobesketch)
+    for d in sorted(OUT.iterdir()):
+        files = list(d.iterdir())
+        print(f"{d.name}: {len(files)} seeds, {sum(f.stat().st_size for f in files)} bytes")
+
+
+if __name__ == "__main__":
+    main()
