@@ -1,6 +1,7 @@
 #include "core/document.h"
 
 #include <cmath>
+#include <cstdio>
 #include <type_traits>
 
 #include "core/atomic_file.h"
@@ -278,6 +279,22 @@ json stroke_to_json(const Stroke& s)
     for (const StrokePoint& p : s.points) times.push_back(p.time);
     return json{{"id", s.id},     {"kind", stroke_kind_name(s.kind)}, {"hand", hand_name(s.hand)},
                 {"closed", s.closed}, {"points", std::move(pts)},       {"times", std::move(times)}};
+}
+
+/// An optional number of a record that must lie in [lo, hi]; a missing key leaves `out` empty.
+void read_number_in_range(const json& obj, const char* key, double lo, double hi, std::optional<double>& out,
+                          const std::string& where)
+{
+    const auto t = obj.find(key);
+    if (t == obj.end()) return;
+    if (!t->is_number()) throw InvalidInput(where + "." + key + ": expected a number");
+    const double v = t->get<double>();
+    if (!(v >= lo && v <= hi)) {
+        char range[64];
+        std::snprintf(range, sizeof range, "[%g, %g]", lo, hi);
+        throw InvalidInput(where + "." + key + ": must be in " + range);
+    }
+    out = v;
 }
 
 json lobe_model_to_json(const LobeModel& m)
@@ -558,23 +575,13 @@ Document document_from_json(const json& j)
                 }
             }
             if (auto m = l.find("mesh"); m != l.end() && m->is_string()) r.mesh_file = m->get<std::string>();
-            if (auto t = l.find("split_angle_deg"); t != l.end()) {
-                if (!t->is_number()) throw InvalidInput(w + ".split_angle_deg: expected a number");
-                const double v = t->get<double>();
-                if (!(v >= 5 && v <= 180)) throw InvalidInput(w + ".split_angle_deg: must be in [5, 180]");
-                r.split_angle_deg = v;
-            }
+            read_number_in_range(l, "split_angle_deg", 5.0, 180.0, r.split_angle_deg, w);
             if (auto sp = l.find("species"); sp != l.end()) {
                 if (!sp->is_string() || sp->get<std::string>().size() > 64)
                     throw InvalidInput(w + ".species: expected a name of at most 64 characters");
                 r.species = sp->get<std::string>();
             }
-            if (auto t = l.find("leaf_length_m"); t != l.end()) {
-                if (!t->is_number()) throw InvalidInput(w + ".leaf_length_m: expected a number");
-                const double v = t->get<double>();
-                if (!(v >= 0.002 && v <= 1.0)) throw InvalidInput(w + ".leaf_length_m: must be in [0.002, 1]");
-                r.leaf_length_m = v;
-            }
+            read_number_in_range(l, "leaf_length_m", 0.002, 1.0, r.leaf_length_m, w);
             if (auto t = l.find("leaves_per_node"); t != l.end()) {
                 if (!t->is_number_integer()) throw InvalidInput(w + ".leaves_per_node: expected an integer");
                 const auto v = t->get<std::int64_t>();

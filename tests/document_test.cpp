@@ -25,6 +25,9 @@ Document sample_document()
     LobeRecord lobe7 = LobeRecord::of_strokes(7, {3}, "lobes/lobe_7.ply");
     lobe7.split_angle_deg = 22.5;
     lobe7.species = "willow";
+    lobe7.leaf_length_m = 0.07;
+    lobe7.leaves_per_node = 6;
+    lobe7.seed = 12345678901ull;
     d.lobes.push_back(lobe7);
     d.settings.growth.split_angle_deg = 40;
     d.settings.growth.subtree_weights = {{"fork", 2.0}, {"whorl", 0.5}};
@@ -53,6 +56,9 @@ TEST(Document, SaveLoadRoundTripKeepsEveryField)
     EXPECT_EQ(e.strokes.at(0).hand, Hand::Left);
     EXPECT_FLOAT_EQ(e.trees.at(0).transform[3][0], 2.0f);
     EXPECT_DOUBLE_EQ(e.settings.input.pinch_start_m, 0.007);
+    EXPECT_EQ(e.lobes.at(0).leaf_length_m, std::optional<double>(0.07));
+    EXPECT_EQ(e.lobes.at(0).leaves_per_node, std::optional<int>(6));
+    EXPECT_EQ(e.lobes.at(0).seed, std::optional<std::uint64_t>(12345678901ull));
 }
 
 TEST(Document, AtomicSaveLeavesNoTemporaryFilesAndReplacesOldVersion)
@@ -107,6 +113,14 @@ TEST(Document, BadDocumentsGiveOneLineMessagesNamingTheFile)
          "settings.branches.bark_color: expected [r, g, b]"},
         {"{\"format\":\"lobesketch-session\",\"version\":1,\"lobes\":[{\"id\":1,\"split_angle_deg\":500}]}",
          "lobes[0].split_angle_deg: must be in [5, 180]"},
+        {"{\"format\":\"lobesketch-session\",\"version\":1,\"lobes\":[{\"id\":1,\"leaf_length_m\":2}]}",
+         "lobes[0].leaf_length_m: must be in [0.002, 1]"},
+        {"{\"format\":\"lobesketch-session\",\"version\":1,\"lobes\":[{\"id\":1,\"leaves_per_node\":2.5}]}",
+         "lobes[0].leaves_per_node: expected an integer"},
+        {"{\"format\":\"lobesketch-session\",\"version\":1,\"lobes\":[{\"id\":1,\"leaves_per_node\":65}]}",
+         "lobes[0].leaves_per_node: must be in [0, 64]"},
+        {"{\"format\":\"lobesketch-session\",\"version\":1,\"lobes\":[{\"id\":1,\"seed\":-3}]}",
+         "lobes[0].seed: expected a non-negative integer"},
     };
     for (const Case& c : cases) {
         std::string path = dir + "/bad.json";
