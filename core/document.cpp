@@ -344,9 +344,7 @@ LobeModel lobe_model_from_json(const json& j, const std::string& w)
         if (k < 0 || k >= n) throw InvalidInput(w + ".triangles: vertex index " + std::to_string(k) + " out of range");
         m.mesh.triangles[i / 3][i % 3] = static_cast<int>(k);
     }
-    for (const std::array<int, 3>& tri : m.mesh.triangles)
-        if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2])
-            throw InvalidInput(w + ".triangles: a triangle repeats a vertex");
+    validate_lobe_model(m, w);
     return m;
 }
 
@@ -489,6 +487,26 @@ void validate_leaf_settings(const LeafSettings& l)
 
 nlohmann::json settings_json(const Settings& s) { return settings_to_json(s); }
 Settings settings_from_json_checked(const nlohmann::json& j) { return settings_from_json(j); }
+
+void validate_lobe_model(const LobeModel& m, const std::string& w)
+{
+    if (m.mesh.positions.size() > kMaxLobeModelVertices)
+        throw InvalidInput(w + ".positions: more than " + std::to_string(kMaxLobeModelVertices) + " vertices");
+    if (m.mesh.triangles.size() > kMaxLobeModelTriangles)
+        throw InvalidInput(w + ".triangles: more than " + std::to_string(kMaxLobeModelTriangles) + " triangles");
+    if (m.mesh.triangles.size() < 4) throw InvalidInput(w + ".triangles: a closed mesh needs at least 4 triangles");
+    for (const glm::vec3& p : m.mesh.positions)
+        for (int k = 0; k < 3; ++k)
+            if (!std::isfinite(p[k]) || std::abs(p[k]) > 1000.0f)
+                throw InvalidInput(w + ".positions: a coordinate is not finite or beyond 1 km");
+    const auto n = static_cast<std::int64_t>(m.mesh.positions.size());
+    for (const std::array<int, 3>& tri : m.mesh.triangles) {
+        for (int k : tri)
+            if (k < 0 || k >= n) throw InvalidInput(w + ".triangles: vertex index " + std::to_string(k) + " out of range");
+        if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2])
+            throw InvalidInput(w + ".triangles: a triangle repeats a vertex");
+    }
+}
 
 json document_to_json(const Document& doc)
 {

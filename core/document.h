@@ -66,6 +66,12 @@ struct LobeRecord {
 inline constexpr std::size_t kMaxLobeModelVertices = 500000;
 inline constexpr std::size_t kMaxLobeModelTriangles = 1000000;
 
+/// Checks what a session may hold as a lobe's mesh: at most kMaxLobeModelVertices and
+/// kMaxLobeModelTriangles, at least 4 triangles, every coordinate finite and within 1 km,
+/// every index in range and no triangle repeating a vertex.
+/// \throw InvalidInput (one line, starting with `where`) naming the first problem.
+void validate_lobe_model(const LobeModel& model, const std::string& where);
+
 /// One tree of the scene: variants and forests are several of these.
 struct TreeInstance {
     std::int64_t id = 0;

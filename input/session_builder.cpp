@@ -762,9 +762,16 @@ bool SessionBuilder::import_mesh(const InputAction& a)
         target = glm::dvec3(0.0, (hi - lo), 0.0);
     }
     for (glm::vec3& p : mesh.positions) p = glm::vec3(glm::dvec3(p) - centre + target);
+    // What the session could not save and load again is not taken in.
+    LobeModel placed{model->source, std::move(mesh)};
+    try {
+        validate_lobe_model(placed, "import " + std::to_string(a.import_number));
+    } catch (const InvalidInput& e) {
+        return nothing(e.what());
+    }
     snapshot();
     LobeRecord r = LobeRecord::of_strokes(next_lobe_id_++);
-    r.model = std::make_shared<const LobeModel>(LobeModel{model->source, std::move(mesh)});
+    r.model = std::make_shared<const LobeModel>(std::move(placed));
     doc_.lobes.push_back(std::move(r));
     return true;
 }

@@ -12,6 +12,7 @@
 #include "meshing/edit_ops.h"
 #include "meshing/laplacian_edit.h"
 #include "meshing/lobe_transform.h"
+#include "meshing/mesh_quality.h"
 #include "meshing/remesh.h"
 
 namespace lobe {
@@ -108,6 +109,10 @@ BuiltLobe model_document_lobe(const LobeRecord& rec, const RemeshOptions& remesh
     glm::dvec3 centre(0.0);
     for (const glm::vec3& p : built.surface.mesh.positions) centre += glm::dvec3(p);
     built.surface.centre = centre / std::max<double>(1.0, static_cast<double>(built.surface.mesh.positions.size()));
+    // A session file may hold any triangles: growth needs a closed, consistently oriented surface.
+    const MeshQuality q = measure_quality(built.surface.mesh);
+    if (!q.closed || !q.manifold || !q.outward)
+        throw InvalidInput("its mesh is not a closed, outward-oriented 2-manifold");
     const double edge = mean_edge_length(built.surface.mesh);
     const double target = remesh.target_edge_length_m;
     if (remesh.iterations > 0 && (edge < 0.75 * target || edge > 1.25 * target)) {

@@ -142,6 +142,33 @@ TEST(ModelLobe, ImportsThatCannotBeHadChangeNothingAndSayWhyInOneLine)
     EXPECT_EQ(b.messages()[0], "import-mesh at t=10.00s changes nothing: import 2 does not exist");
 }
 
+TEST(ModelLobe, AnImportTheSessionCouldNotSaveAndLoadIsRefused)
+{
+    EditHooks h = meshing_edit_hooks();
+    h.import_model = [](int) {
+        LobeModel m = spot();
+        m.mesh.triangles[3][1] = m.mesh.triangles[3][0];
+        return std::make_shared<const LobeModel>(m);
+    };
+    SessionBuilder b(Document{}, EditPickOptions{}, h);
+    EXPECT_FALSE(b.apply(action(InputAction::Type::ImportMesh, kTip)));
+    EXPECT_TRUE(b.document().lobes.empty());
+    ASSERT_EQ(b.messages().size(), 1u);
+    EXPECT_EQ(b.messages()[0], "import-mesh at t=10.00s changes nothing: import 1.triangles: a triangle repeats a vertex");
+}
+
+TEST(ModelLobe, AStoredMeshThatIsNotClosedIsLeftOutWithAWarning)
+{
+    Document d = imported().document();
+    LobeModel open = *d.lobes[0].model;
+    open.mesh.triangles.pop_back();
+    d.lobes[0].model = std::make_shared<const LobeModel>(open);
+    std::vector<std::string> warnings;
+    EXPECT_TRUE(build_document_lobes(d, &warnings).empty());
+    ASSERT_EQ(warnings.size(), 1u);
+    EXPECT_EQ(warnings[0], "lobe 1: its mesh is not a closed, outward-oriented 2-manifold; the lobe is left out");
+}
+
 TEST(ModelLobe, AStrokeDrawnIntoAMeshLobeStartsALobeOfItsOwn)
 {
     SessionBuilder b = imported();
