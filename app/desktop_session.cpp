@@ -3,9 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <limits>
 
-#include <glm/common.hpp>
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 
@@ -15,6 +13,7 @@
 #include "core/errors.h"
 #include "meshing/edit_ops.h"
 #include "meshing/mesh_io.h"
+#include "meshing/mesh_quality.h"
 #include "meshing/model_import.h"
 
 namespace lobe {
@@ -227,11 +226,8 @@ bool DesktopSession::import_mesh(const std::string& path, double size_m)
         if (!(size_m > 0.01 && size_m <= 100.0)) throw InvalidInput("the size must be in (0.01, 100] m");
         TriangleMesh mesh = lobe_from_model(path, o);
         // Centred on the origin; the import event places it at the fingertip.
-        glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
-        for (const glm::vec3& p : mesh.positions) {
-            lo = glm::min(lo, glm::dvec3(p));
-            hi = glm::max(hi, glm::dvec3(p));
-        }
+        glm::dvec3 lo, hi;
+        bounding_box(mesh, lo, hi);
         const glm::dvec3 centre = 0.5 * (lo + hi);
         for (glm::vec3& p : mesh.positions) p = glm::vec3(glm::dvec3(p) - centre);
         std::string source = std::filesystem::path(path).filename().string();

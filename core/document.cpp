@@ -324,23 +324,20 @@ LobeModel lobe_model_from_json(const json& j, const std::string& w)
     for (std::size_t i = 0; i < p->size(); ++i) {
         const json& v = (*p)[i];
         if (!v.is_number()) throw InvalidInput(w + ".positions: expected numbers");
-        const double x = v.get<double>();
-        if (!std::isfinite(x) || std::abs(x) > 1000.0)
-            throw InvalidInput(w + ".positions: a coordinate is not finite or beyond 1 km");
-        m.mesh.positions[i / 3][static_cast<int>(i % 3)] = static_cast<float>(x);
+        m.mesh.positions[i / 3][static_cast<int>(i % 3)] = static_cast<float>(v.get<double>());
     }
     const auto t = j.find("triangles");
     if (t == j.end() || !t->is_array() || t->size() % 3 != 0)
         throw InvalidInput(w + ".triangles: expected an array of vertex index triples");
     if (t->size() / 3 > kMaxLobeModelTriangles)
         throw InvalidInput(w + ".triangles: more than " + std::to_string(kMaxLobeModelTriangles) + " triangles");
-    if (t->size() / 3 < 4) throw InvalidInput(w + ".triangles: a closed mesh needs at least 4 triangles");
     m.mesh.triangles.resize(t->size() / 3);
     const auto n = static_cast<std::int64_t>(m.mesh.positions.size());
     for (std::size_t i = 0; i < t->size(); ++i) {
         const json& v = (*t)[i];
         if (!v.is_number_integer()) throw InvalidInput(w + ".triangles: expected integer vertex indices");
         const auto k = v.get<std::int64_t>();
+        // Checked before narrowing to int; validate_lobe_model checks the rest.
         if (k < 0 || k >= n) throw InvalidInput(w + ".triangles: vertex index " + std::to_string(k) + " out of range");
         m.mesh.triangles[i / 3][i % 3] = static_cast<int>(k);
     }
