@@ -1,16 +1,20 @@
 // The Vulkan renderer behind app/renderer.h. Five parts, each a small class:
 //  - VulkanContext: instance (with the caller's instance extensions), device choice (with
-//    VK_KHR_swapchain when presenting), queue, memory helpers, one-shot submits;
+//    VK_KHR_swapchain when presenting), queue, memory helpers, one-shot submits; or the
+//    instance, physical device and device from RendererOptions::vulkan_hooks (OpenXR);
 //  - OffscreenTarget: the images a frame is drawn into (MSAA colour, depth, resolve) and the
 //    buffer it is read back through (made on first use);
-//  - SceneDrawer: pipelines, the leaf texture, the per-mesh GPU buffer cache (keyed by
-//    RenderItem::key, re-uploaded only when RenderItem::version changes; leaf meshes made of
-//    leaves.cpp's quads become one instance per leaf over a shared quad) and recording the
-//    draws of one frame into a command buffer inside any compatible render pass;
+//  - SceneDrawer: pipelines, the leaf and photo textures, the per-mesh GPU buffer cache (keyed
+//    by RenderItem::key, re-uploaded only when RenderItem::version changes; leaf meshes made
+//    of leaves.cpp's quads become one instance per leaf over a shared quad) and recording the
+//    draws of one frame, seen from a FrameView (a Camera's or an OpenXR EyeView's), into a
+//    command buffer inside any compatible render pass;
 //  - OverlayDrawer: the 2D overlay's pipeline, font texture and host-visible buffers, drawn
 //    after the scene in the same render pass;
 //  - WindowTarget: a window's surface and swapchain. A window's frame is drawn offscreen
 //    exactly as a picture is, then blitted into the acquired swapchain image and presented.
+// render_to draws an eye's frame the same way into an offscreen target kept per size and copies
+// or blits it into the caller's image (an OpenXR swapchain image).
 // Every submit is waited for (one frame in flight), so buffers may be rewritten between frames.
 #include "app/renderer.h"
 #include "app/loaded_libraries.h"
@@ -30,6 +34,8 @@
 #include <glm/ext/matrix_clip_space.hpp>
 #include <glm/ext/matrix_transform.hpp>
 #include <glm/geometric.hpp>
+#include <glm/gtc/constants.hpp>
+#include <glm/gtc/quaternion.hpp>
 #include <glm/mat4x4.hpp>
 #include <glm/matrix.hpp>
 #include <glm/vec4.hpp>
@@ -105,6 +111,44 @@ T vk_struct(VkStructureType type)
 }
 
 constexpr VkFormat kColorFormat = VK_FORMAT_R8G8B8A8_SRGB;
+
+/// A Vulkan handle from an integer, e.g. the VkSurfaceKHR attach_window's callback returns or
+/// the VkInstance a RendererOptions::vulkan_hooks function returns (handles are pointers on
+/// 64-bit builds; non-dispatchable ones are 64-bit integers on 32-bit ones).
+template <class Handle>
+Handle handle_from_integer(std::uint64_t v)
+{
+    if constexpr (std::is_pointer_v<Handle>)
+        return reinterpret_cast<Handle>(static_cast<std::uintptr_t>(v));
+    else
+        return static_cast<Handle>(v);
+}
+
+/// The integer of a Vulkan handle (the inverse of handle_from_integer).
+template <class Handle>
+std::uint64_t handle_to_integer(Handle h)
+{
+    if constexpr (std::is_pointer_v<Handle>)
+        return static_cast<std::uint64_t>(reinterpret_cast<std::uintptr_t>(h));
+    else
+        return static_cast<std::uint64_t>(h);
+}
+
+/// A VkResult a hook reported, by name ("VkResult -1000" when it has none here).
+std::string hook_result_text(int result)
+{
+    const auto r = static_cast<VkResult>(result);
+    const std::string name = vk::result_name(r);
+    if (name == "VK_ERROR_UNKNOWN" && r != VK_ERROR_UNKNOWN) return "VkResult " + std::to_string(result);
+    return name;
+}
+
+/// Why a hook returned no handle: "VK_ERROR_…", or a note that it gave no VkResult.
+std::string hook_failure(const char* hook, int result)
+{
+    return std::string("RendererOptions::vulkan_hooks.") + hook + " returned 0 (" +
+           (result == VK_SUCCESS ? std::string("with no VkResult") : hook_result_text(result)) + ")";
+}
 
 /// What every pipeline gets (app/shaders/*: the same 112-byte block, read per shader).
 struct PushBlock {
@@ -365,6 +409,13 @@ public:
 private:
     void create(const RendererOptions& options)
     {
+        // With hooks (an OpenXR runtime's XR_KHR_vulkan_enable2), the instance, the physical
+        // device and the device come from them, made from the create infos filled here.
+        const RendererOptions::VulkanHooks& hooks = options.vulkan_hooks;
+        const bool hooked = !hooks.empty();
+        if (bool(hooks.create_instance) != bool(hooks.physical_device) || bool(hooks.create_instance) != bool(hooks.create_device))
+            throw RenderError("render: RendererOptions::vulkan_hooks needs all three of create_instance, physical_device and "
+                              "create_device, or none");
         ensure_runtime_dir();
         auto app = vk_struct<VkApplicationInfo>(VK_STRUCTURE_TYPE_APPLICATION_INFO);
         app.pApplicationName = "lobesketch";
@@ -402,13 +453,77 @@ private:
             info.enabledLayerCount = 1;
             info.ppEnabledLayerNames = &validation;
         }
-        const VkResult created = vkCreateInstance(&info, nullptr, &instance_);
-        keep_loaded_since(libraries);
-        if (VkResult r = created; r != VK_SUCCESS) {
-            instance_ = VK_NULL_HANDLE;
-            throw RenderUnavailable(std::string("render: no Vulkan driver (vkCreateInstance: ") + vk::result_name(r) +
-                                    "); " + kInstallHint);
+        if (hooked) {
+            int result = VK_SUCCESS;
+            const std::uint64_t made = hooks.create_instance(&info, result);
+            keep_loaded_since(libraries);
+            instance_ = handle_from_integer<VkInstance>(made);
+            if (!instance_)
+                throw RenderUnavailable("render: no Vulkan instance from the OpenXR runtime: " +
+                                        hook_failure("create_instance", result));
+            physical_ = handle_from_integer<VkPhysicalDevice>(hooks.physical_device(handle_to_integer(instance_)));
+            if (!physical_)
+                throw RenderUnavailable("render: no Vulkan device from the OpenXR runtime: "
+                                        "RendererOptions::vulkan_hooks.physical_device returned 0");
+            choose_hooked_queue(options.presentation);
+        } else {
+            const VkResult created = vkCreateInstance(&info, nullptr, &instance_);
+            keep_loaded_since(libraries);
+            if (VkResult r = created; r != VK_SUCCESS) {
+                instance_ = VK_NULL_HANDLE;
+                throw RenderUnavailable(std::string("render: no Vulkan driver (vkCreateInstance: ") + vk::result_name(r) +
+                                        "); " + kInstallHint);
+            }
+            choose_device(options);
         }
+        presentation_ = options.presentation;
+        vkGetPhysicalDeviceProperties(physical_, &properties_);
+        vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
+        name_ = properties_.deviceName;
+        software_ = properties_.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+
+        const float priority = 1.0f;
+        auto queue = vk_struct<VkDeviceQueueCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO);
+        queue.queueFamilyIndex = queue_family_;
+        queue.queueCount = 1;
+        queue.pQueuePriorities = &priority;
+        auto dev = vk_struct<VkDeviceCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO);
+        dev.queueCreateInfoCount = 1;
+        dev.pQueueCreateInfos = &queue;
+        const char* swapchain = VK_KHR_SWAPCHAIN_EXTENSION_NAME;
+        if (presentation_) {
+            dev.enabledExtensionCount = 1;
+            dev.ppEnabledExtensionNames = &swapchain;
+        }
+        if (hooked) {
+            int result = VK_SUCCESS;
+            device_ = handle_from_integer<VkDevice>(hooks.create_device(handle_to_integer(physical_), &dev, result));
+            if (!device_)
+                throw RenderUnavailable("render: cannot open the Vulkan device '" + name_ + "' through the OpenXR runtime: " +
+                                        hook_failure("create_device", result));
+        } else if (VkResult r = vkCreateDevice(physical_, &dev, nullptr, &device_); r != VK_SUCCESS) {
+            device_ = VK_NULL_HANDLE;
+            throw RenderUnavailable("render: cannot open the Vulkan device '" + name_ + "' (vkCreateDevice: " +
+                                    vk::result_name(r) + "); " + kInstallHint);
+        }
+        vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
+        auto pool = vk_struct<VkCommandPoolCreateInfo>(VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO);
+        pool.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+        pool.queueFamilyIndex = queue_family_;
+        CHECK_VKCMD(vkCreateCommandPool(device_, &pool, nullptr, &command_pool_));
+        auto cb = vk_struct<VkCommandBufferAllocateInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO);
+        cb.commandPool = command_pool_;
+        cb.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+        cb.commandBufferCount = 1;
+        CHECK_VKCMD(vkAllocateCommandBuffers(device_, &cb, &command_buffer_));
+        auto fence = vk_struct<VkFenceCreateInfo>(VK_STRUCTURE_TYPE_FENCE_CREATE_INFO);
+        CHECK_VKCMD(vkCreateFence(device_, &fence, nullptr, &fence_));
+    }
+
+    /// The first discrete GPU, else integrated, virtual, other, CPU (CPU first with
+    /// prefer_software), with a graphics queue (and VK_KHR_swapchain when presenting).
+    void choose_device(const RendererOptions& options)
+    {
         std::uint32_t count = 0;
         vkEnumeratePhysicalDevices(instance_, &count, nullptr);
         std::vector<VkPhysicalDevice> devices(count);
@@ -449,42 +564,29 @@ private:
             throw RenderUnavailable(std::string("render: no Vulkan device with graphics") +
                                     (options.presentation ? " and VK_KHR_swapchain (presentation to a window)" : "") + " (" +
                                     std::to_string(count) + " device(s) found); " + kInstallHint);
-        presentation_ = options.presentation;
-        vkGetPhysicalDeviceProperties(physical_, &properties_);
-        vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
-        name_ = properties_.deviceName;
-        software_ = properties_.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+    }
 
-        const float priority = 1.0f;
-        auto queue = vk_struct<VkDeviceQueueCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO);
-        queue.queueFamilyIndex = queue_family_;
-        queue.queueCount = 1;
-        queue.pQueuePriorities = &priority;
-        auto dev = vk_struct<VkDeviceCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO);
-        dev.queueCreateInfoCount = 1;
-        dev.pQueueCreateInfos = &queue;
-        const char* swapchain = VK_KHR_SWAPCHAIN_EXTENSION_NAME;
-        if (presentation_) {
-            dev.enabledExtensionCount = 1;
-            dev.ppEnabledExtensionNames = &swapchain;
-        }
-        if (VkResult r = vkCreateDevice(physical_, &dev, nullptr, &device_); r != VK_SUCCESS) {
-            device_ = VK_NULL_HANDLE;
-            throw RenderUnavailable("render: cannot open the Vulkan device '" + name_ + "' (vkCreateDevice: " +
-                                    vk::result_name(r) + "); " + kInstallHint);
-        }
-        vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
-        auto pool = vk_struct<VkCommandPoolCreateInfo>(VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO);
-        pool.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-        pool.queueFamilyIndex = queue_family_;
-        CHECK_VKCMD(vkCreateCommandPool(device_, &pool, nullptr, &command_pool_));
-        auto cb = vk_struct<VkCommandBufferAllocateInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO);
-        cb.commandPool = command_pool_;
-        cb.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-        cb.commandBufferCount = 1;
-        CHECK_VKCMD(vkAllocateCommandBuffers(device_, &cb, &command_buffer_));
-        auto fence = vk_struct<VkFenceCreateInfo>(VK_STRUCTURE_TYPE_FENCE_CREATE_INFO);
-        CHECK_VKCMD(vkCreateFence(device_, &fence, nullptr, &fence_));
+    /// The device the hooks gave: its first queue family with graphics (and, when presenting,
+    /// VK_KHR_swapchain), or RenderUnavailable.
+    void choose_hooked_queue(bool presentation)
+    {
+        VkPhysicalDeviceProperties p;
+        vkGetPhysicalDeviceProperties(physical_, &p);
+        const std::string name = p.deviceName;
+        if (presentation && !has_device_extension(physical_, VK_KHR_SWAPCHAIN_EXTENSION_NAME))
+            throw RenderUnavailable("render: the Vulkan device '" + name +
+                                    "' the OpenXR runtime chose has no VK_KHR_swapchain (presentation to a window)");
+        std::uint32_t families = 0;
+        vkGetPhysicalDeviceQueueFamilyProperties(physical_, &families, nullptr);
+        std::vector<VkQueueFamilyProperties> props(families);
+        vkGetPhysicalDeviceQueueFamilyProperties(physical_, &families, props.data());
+        props.resize(families);
+        for (std::uint32_t f = 0; f < families; ++f)
+            if (props[f].queueFlags & VK_QUEUE_GRAPHICS_BIT) {
+                queue_family_ = f;
+                return;
+            }
+        throw RenderUnavailable("render: the Vulkan device '" + name + "' the OpenXR runtime chose has no graphics queue");
     }
 
     static bool has_device_extension(VkPhysicalDevice d, const char* name)
@@ -643,10 +745,11 @@ VkPipelineLayout create_pipeline_layout(VkDevice dev, VkDescriptorSetLayout set_
     return out;
 }
 
-/// A pool holding one combined-image-sampler set, and that set.
-void allocate_sampler_set(VkDevice dev, VkDescriptorSetLayout set_layout, VkDescriptorPool& pool_out, VkDescriptorSet& set_out)
+/// A pool holding one set of `samplers` combined image samplers, and that set.
+void allocate_sampler_set(VkDevice dev, VkDescriptorSetLayout set_layout, VkDescriptorPool& pool_out, VkDescriptorSet& set_out,
+                          std::uint32_t samplers = 1)
 {
-    VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1};
+    VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, samplers};
     auto pool = vk_struct<VkDescriptorPoolCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO);
     pool.maxSets = 1;
     pool.poolSizeCount = 1;
@@ -801,13 +904,14 @@ GpuImage upload_rgba_texture(const VulkanContext& ctx, const RgbaImage& tex)
     return texture;
 }
 
-/// Points binding 0 of `set` at `texture` through `sampler`.
-void write_texture_descriptor(VkDevice device, VkDescriptorSet set, VkSampler sampler, const GpuImage& texture)
+/// Points `binding` of `set` at `texture` through `sampler`.
+void write_texture_descriptor(VkDevice device, VkDescriptorSet set, VkSampler sampler, const GpuImage& texture,
+                              std::uint32_t binding = 0)
 {
     VkDescriptorImageInfo image{sampler, texture.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     auto write = vk_struct<VkWriteDescriptorSet>(VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET);
     write.dstSet = set;
-    write.dstBinding = 0;
+    write.dstBinding = binding;
     write.descriptorCount = 1;
     write.descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
     write.pImageInfo = &image;
@@ -929,6 +1033,48 @@ VkPipeline create_pipeline(VkDevice device, VkRenderPass pass, const FrameFormat
 }
 
 // ---------------------------------------------------------------------------------------------
+/// Where a frame is seen from: world to Vulkan clip space (x right, y down, depth 0 at the
+/// near plane to 1 at the far one) and the eye's position.
+struct FrameView {
+    glm::mat4 view_proj{1.0f};
+    glm::vec3 eye{0.0f};
+};
+
+/// A Camera's view of a frame of `extent` (its vertical field of view; the horizontal one
+/// follows the aspect ratio).
+FrameView camera_frame_view(const Camera& camera, VkExtent2D extent)
+{
+    const float aspect = float(extent.width) / float(extent.height);
+    glm::mat4 proj = glm::perspectiveRH_ZO(glm::radians(camera.fov_y_deg), aspect, camera.near_m, camera.far_m);
+    proj[1][1] *= -1.0f; // Vulkan's framebuffer y points down
+    const glm::mat4 view = glm::lookAtRH(camera.eye, camera.target, camera.up);
+    return {proj * view, camera.eye};
+}
+
+/// An OpenXR eye's view (checked by the caller): the view matrix is the inverse of its pose
+/// (−Z forward, +Y up, as lookAtRH's), and the projection glm::perspectiveRH_ZO's with the
+/// frustum's sides at the tangents of the four angles, y flipped as camera_frame_view's. With
+/// left = −right and down = −up it is camera_frame_view's for a vertical field of view of
+/// 2 · up and an aspect ratio of tan(right) / tan(up).
+FrameView eye_frame_view(const EyeView& eye)
+{
+    const float l = std::tan(eye.angle_left), r = std::tan(eye.angle_right);
+    const float d = std::tan(eye.angle_down), u = std::tan(eye.angle_up);
+    const float n = eye.near_m, f = eye.far_m;
+    glm::mat4 proj(0.0f);
+    proj[0][0] = 2.0f / (r - l);
+    proj[2][0] = (r + l) / (r - l);
+    proj[1][1] = -2.0f / (u - d);       // y flipped: Vulkan's framebuffer y points down
+    proj[2][1] = -(u + d) / (u - d);
+    proj[2][2] = f / (n - f);           // depth 0 at the near plane, 1 at the far one
+    proj[2][3] = -1.0f;
+    proj[3][2] = -(f * n) / (f - n);
+    const glm::quat q = glm::normalize(eye.orientation);
+    const glm::mat4 view = glm::mat4_cast(glm::conjugate(q)) * glm::translate(glm::mat4(1.0f), -eye.position);
+    return {proj * view, eye.position};
+}
+
+// ---------------------------------------------------------------------------------------------
 /// Pipelines, the leaf texture, the mesh cache, and the draws of one frame.
 class SceneDrawer {
 public:
@@ -969,8 +1115,8 @@ public:
                         throw InvalidInput("render: mesh " + std::to_string(item.key) + " has a triangle index " +
                                            std::to_string(i) + " out of range (" + std::to_string(n) + " vertices)");
         }
-        const RgbaImage& tex = scene.leaf_texture;
-        const bool has_texture = check_rgba(tex, "a leaf texture");
+        const bool has_leaf_texture = check_rgba(scene.leaf_texture, "a leaf texture");
+        const bool has_photo_texture = check_rgba(scene.photo_texture, "a photo texture");
 
         stats.meshes_uploaded = stats.meshes_kept = stats.bytes_uploaded = stats.leaf_instances = 0;
         for (auto it = cache_.begin(); it != cache_.end();) {
@@ -999,32 +1145,24 @@ public:
             if (it->second.index_count > 0) draws_.push_back(item.key);
             stats.leaf_instances += it->second.instance_count;
         }
-        // The white texel stands for "no texture": a texture replacing it (or replaced by it)
-        // is uploaded whatever its version.
-        const std::uint64_t texture_version = has_texture ? scene.leaf_texture_version : 0;
-        if (!texture_ready_ || has_texture != texture_is_real_ || texture_version != texture_version_) {
-            upload_texture(has_texture ? tex : kWhiteTexel, stats);
-            texture_version_ = texture_version;
-            texture_is_real_ = has_texture;
-            texture_ready_ = true;
-        }
+        update_texture(leaf_texture_, kLeafTextureBinding, has_leaf_texture ? scene.leaf_texture : kWhiteTexel, has_leaf_texture,
+                       scene.leaf_texture_version, stats);
+        update_texture(photo_texture_, kPhotoTextureBinding, has_photo_texture ? scene.photo_texture : kWhiteTexel,
+                       has_photo_texture, scene.photo_texture_version, stats);
         ground_ = scene.ground;
         bounds_ = scene.ground_area.empty() ? scene_bounds(scene) : scene.ground_area;
         ground_y_ = scene.ground_y;
     }
 
+    /// A set layout of one texture at binding 0 (the overlay's font).
     VkDescriptorSetLayout texture_set_layout() const { return set_layout_; }
     VkSampler sampler() const { return sampler_; }
 
     /// The draws of one frame, inside a begun render pass of `extent`.
-    void record(VkCommandBuffer cmd, const Camera& camera, VkExtent2D extent) const
+    void record(VkCommandBuffer cmd, const FrameView& frame, VkExtent2D extent) const
     {
-        const float aspect = float(extent.width) / float(extent.height);
-        glm::mat4 proj = glm::perspectiveRH_ZO(glm::radians(camera.fov_y_deg), aspect, camera.near_m, camera.far_m);
-        proj[1][1] *= -1.0f; // Vulkan's framebuffer y points down
-        const glm::mat4 view = glm::lookAtRH(camera.eye, camera.target, camera.up);
-        const glm::mat4 view_proj = proj * view;
-        const glm::vec4 eye(camera.eye, 1.0f);
+        const glm::mat4& view_proj = frame.view_proj;
+        const glm::vec4 eye(frame.eye, 1.0f);
 
         VkViewport viewport{0.0f, 0.0f, float(extent.width), float(extent.height), 0.0f, 1.0f};
         VkRect2D scissor{{0, 0}, extent};
@@ -1079,12 +1217,13 @@ public:
             }
         };
         draw_all(opaque_, {RenderMaterial::Bark, RenderMaterial::Stroke});
-        draw_all(leaf_, {RenderMaterial::Leaf});
+        // Leaves and photos: opaque and two-sided (mesh.frag tells them apart).
+        draw_all(leaf_, {RenderMaterial::Leaf, RenderMaterial::Photo});
         // Translucent lobes last, far to near (by their centres), without depth writes.
         std::vector<std::pair<float, std::uint64_t>> lobes;
         for (std::uint64_t key : draws_) {
             const GpuMesh& m = cache_.at(key);
-            if (m.material == RenderMaterial::Lobe) lobes.emplace_back(-glm::length(m.centre - camera.eye), key);
+            if (m.material == RenderMaterial::Lobe) lobes.emplace_back(-glm::length(m.centre - frame.eye), key);
         }
         std::sort(lobes.begin(), lobes.end());
         if (!lobes.empty()) vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, lobe_);
@@ -1179,26 +1318,50 @@ private:
         return m;
     }
 
-    void upload_texture(const RgbaImage& tex, RenderStats& stats)
+    /// A texture of the scene and what it was made from.
+    struct TextureSlot {
+        GpuImage image;
+        std::uint64_t version = 0;
+        bool ready = false;
+        bool is_real = false; // false: the white texel
+    };
+    static constexpr std::uint32_t kLeafTextureBinding = 0, kPhotoTextureBinding = 1; // app/shaders/mesh.frag
+
+    /// Uploads `tex` into `slot` (and points `binding` at it) unless it holds that version
+    /// already. The white texel stands for "no texture": a texture replacing it (or replaced
+    /// by it) is uploaded whatever its version.
+    void update_texture(TextureSlot& slot, std::uint32_t binding, const RgbaImage& tex, bool is_real, std::uint64_t version,
+                        RenderStats& stats)
     {
+        if (!is_real) version = 0;
+        if (slot.ready && slot.is_real == is_real && slot.version == version) return;
         GpuImage fresh = upload_rgba_texture(ctx_, tex);
-        ctx_.destroy(texture_);
-        texture_ = fresh;
+        ctx_.destroy(slot.image);
+        slot.image = fresh;
+        slot.version = version;
+        slot.is_real = is_real;
+        slot.ready = true;
         stats.bytes_uploaded += tex.pixels.size();
-        write_texture_descriptor(ctx_.device(), descriptor_set_, sampler_, texture_);
+        write_texture_descriptor(ctx_.device(), descriptor_set_, sampler_, slot.image, binding);
     }
 
     void create(VkRenderPass pass, const FrameFormat& format)
     {
         const VkDevice dev = ctx_.device();
-        VkDescriptorSetLayoutBinding binding{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_FRAGMENT_BIT, nullptr};
+        // One texture (the overlay's font), and the scene's two: the leaf texture and the photo.
+        const VkDescriptorSetLayoutBinding bindings[2] = {
+            {kLeafTextureBinding, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_FRAGMENT_BIT, nullptr},
+            {kPhotoTextureBinding, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_FRAGMENT_BIT, nullptr},
+        };
         auto set_layout = vk_struct<VkDescriptorSetLayoutCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO);
         set_layout.bindingCount = 1;
-        set_layout.pBindings = &binding;
+        set_layout.pBindings = bindings;
         CHECK_VKCMD(vkCreateDescriptorSetLayout(dev, &set_layout, nullptr, &set_layout_));
-        layout_ = create_pipeline_layout(dev, set_layout_,
+        set_layout.bindingCount = 2;
+        CHECK_VKCMD(vkCreateDescriptorSetLayout(dev, &set_layout, nullptr, &scene_set_layout_));
+        layout_ = create_pipeline_layout(dev, scene_set_layout_,
                                          {VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(PushBlock)});
-        allocate_sampler_set(dev, set_layout_, descriptor_pool_, descriptor_set_);
+        allocate_sampler_set(dev, scene_set_layout_, descriptor_pool_, descriptor_set_, 2);
         auto sampler = vk_struct<VkSamplerCreateInfo>(VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO);
         sampler.magFilter = VK_FILTER_LINEAR;
         sampler.minFilter = VK_FILTER_LINEAR;
@@ -1249,17 +1412,20 @@ private:
         const VkDevice dev = ctx_.device();
         for (auto& [key, mesh] : cache_) ctx_.destroy(mesh.buffer);
         cache_.clear();
-        ctx_.destroy(texture_);
+        ctx_.destroy(leaf_texture_.image);
+        ctx_.destroy(photo_texture_.image);
         for (VkPipeline p : {sky_, ground_pipeline_, opaque_, leaf_, leaf_instanced_, lobe_})
             if (p) vkDestroyPipeline(dev, p, nullptr);
         if (sampler_) vkDestroySampler(dev, sampler_, nullptr);
         if (descriptor_pool_) vkDestroyDescriptorPool(dev, descriptor_pool_, nullptr);
         if (layout_) vkDestroyPipelineLayout(dev, layout_, nullptr);
         if (set_layout_) vkDestroyDescriptorSetLayout(dev, set_layout_, nullptr);
+        if (scene_set_layout_) vkDestroyDescriptorSetLayout(dev, scene_set_layout_, nullptr);
     }
 
     const VulkanContext& ctx_;
-    VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
+    VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;       // one texture (the overlay's set)
+    VkDescriptorSetLayout scene_set_layout_ = VK_NULL_HANDLE; // leaf texture and photo
     VkPipelineLayout layout_ = VK_NULL_HANDLE;
     VkDescriptorPool descriptor_pool_ = VK_NULL_HANDLE;
     VkDescriptorSet descriptor_set_ = VK_NULL_HANDLE;
@@ -1267,10 +1433,7 @@ private:
     VkPipeline sky_ = VK_NULL_HANDLE, ground_pipeline_ = VK_NULL_HANDLE, opaque_ = VK_NULL_HANDLE, leaf_ = VK_NULL_HANDLE,
                leaf_instanced_ = VK_NULL_HANDLE, lobe_ = VK_NULL_HANDLE;
     bool instanced_leaves_ = true;
-    GpuImage texture_;
-    std::uint64_t texture_version_ = 0;
-    bool texture_ready_ = false;
-    bool texture_is_real_ = false;
+    TextureSlot leaf_texture_, photo_texture_;
     std::unordered_map<std::uint64_t, GpuMesh> cache_;
     std::vector<std::uint64_t> draws_; // keys in scene order
     bool ground_ = true;
@@ -1654,17 +1817,6 @@ private:
     VkFilter filter_ = VK_FILTER_LINEAR;
 };
 
-/// A non-dispatchable handle from an integer, e.g. the VkSurfaceKHR attach_window's callback
-/// returns (a pointer on 64-bit builds, a 64-bit integer on 32-bit ones).
-template <class Handle>
-Handle handle_from_integer(std::uint64_t v)
-{
-    if constexpr (std::is_pointer_v<Handle>)
-        return reinterpret_cast<Handle>(static_cast<std::uintptr_t>(v));
-    else
-        return static_cast<Handle>(v);
-}
-
 } // namespace
 
 void keep_vulkan_drivers_loaded()
@@ -1711,6 +1863,7 @@ struct Renderer::Impl {
         last = nullptr;
         target.reset();
         window_frame.reset();
+        eye_targets.clear();
         overlay.reset();
         drawer.reset();
         vkDestroyRenderPass(ctx.device(), pass, nullptr);
@@ -1727,8 +1880,29 @@ struct Renderer::Impl {
         return *t;
     }
 
-    /// The scene and the overlay into `t`'s render pass (clear, draw, resolve).
-    void record_frame(VkCommandBuffer cmd, const OffscreenTarget& t, const Camera& camera) const
+    /// The eye target of `extent`, made when no kept one has that size (the least recently
+    /// used is dropped beyond kEyeTargets sizes).
+    OffscreenTarget& eye_target_of(VkExtent2D extent)
+    {
+        auto same = [&](const std::unique_ptr<OffscreenTarget>& t) {
+            return t->extent().width == extent.width && t->extent().height == extent.height;
+        };
+        auto it = std::find_if(eye_targets.begin(), eye_targets.end(), same);
+        if (it == eye_targets.end()) {
+            eye_targets.insert(eye_targets.begin(), std::make_unique<OffscreenTarget>(ctx, pass, format, extent));
+            while (eye_targets.size() > kEyeTargets) {
+                if (last == eye_targets.back().get()) last = nullptr;
+                eye_targets.pop_back();
+            }
+        } else {
+            std::rotate(eye_targets.begin(), it, it + 1); // most recently used first
+        }
+        return *eye_targets.front();
+    }
+
+    /// The scene (and the overlay when `with_overlay`) into `t`'s render pass (clear, draw,
+    /// resolve).
+    void record_frame(VkCommandBuffer cmd, const OffscreenTarget& t, const FrameView& view, bool with_overlay = true) const
     {
         const VkExtent2D extent = t.extent();
         VkClearValue clears[3]{};
@@ -1741,8 +1915,8 @@ struct Renderer::Impl {
         begin.clearValueCount = multisampled(format) ? 3u : 2u;
         begin.pClearValues = clears;
         vkCmdBeginRenderPass(cmd, &begin, VK_SUBPASS_CONTENTS_INLINE);
-        drawer->record(cmd, camera, extent);
-        overlay->record(cmd, extent);
+        drawer->record(cmd, view, extent);
+        if (with_overlay) overlay->record(cmd, extent);
         vkCmdEndRenderPass(cmd);
     }
 
@@ -1754,6 +1928,8 @@ struct Renderer::Impl {
     std::unique_ptr<OffscreenTarget> target;       // render()'s pictures
     std::unique_ptr<OffscreenTarget> window_frame; // present()'s frames, so screenshots of another size do not remake it
     std::unique_ptr<WindowTarget> window;
+    static constexpr std::size_t kEyeTargets = 4;
+    std::vector<std::unique_ptr<OffscreenTarget>> eye_targets; // render_to()'s, by size, most recently used first
     OffscreenTarget* last = nullptr; // the target of the last frame drawn (last_frame())
     RenderStats stats;
 };
@@ -1787,7 +1963,7 @@ RgbaImage Renderer::render(const Camera& camera, int width, int height)
         im.target_of(im.target, {static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height)});
     im.ctx.submit_and_wait(
         [&](VkCommandBuffer cmd) {
-            im.record_frame(cmd, target, camera);
+            im.record_frame(cmd, target, camera_frame_view(camera, target.extent()));
             target.record_copy_out(cmd);
         },
         &im.stats.record_ms, &im.stats.gpu_ms);
@@ -1824,7 +2000,7 @@ bool Renderer::present(const Camera& camera, int width, int height)
     if (!im.window->acquire(extent, &image)) return false;
     im.ctx.submit_and_wait(
         [&](VkCommandBuffer cmd) {
-            im.record_frame(cmd, target, camera);
+            im.record_frame(cmd, target, camera_frame_view(camera, target.extent()));
             im.window->record_blit(cmd, target.picture(), extent, image);
         },
         &im.stats.record_ms, &im.stats.gpu_ms, {im.window->acquired(), VK_PIPELINE_STAGE_TRANSFER_BIT, im.window->rendered(image)});
@@ -1832,6 +2008,124 @@ bool Renderer::present(const Camera& camera, int width, int height)
     im.last = &target;
     im.window->present(image);
     return true;
+}
+
+VulkanHandles Renderer::vulkan_handles() const
+{
+    const VulkanContext& ctx = impl_->ctx;
+    VulkanHandles h;
+    h.instance = handle_to_integer(ctx.instance());
+    h.physical_device = handle_to_integer(ctx.physical());
+    h.device = handle_to_integer(ctx.device());
+    h.queue_family = ctx.queue_family();
+    h.queue_index = 0; // the renderer's one queue
+    return h;
+}
+
+namespace {
+
+/// The formats render_to writes (ExternalImage::vk_format).
+bool is_external_format(VkFormat f)
+{
+    return f == VK_FORMAT_R8G8B8A8_UNORM || f == VK_FORMAT_R8G8B8A8_SRGB || f == VK_FORMAT_B8G8R8A8_UNORM ||
+           f == VK_FORMAT_B8G8R8A8_SRGB;
+}
+
+/// InvalidInput (one line) unless `eye` is finite, with 0 < near < far, every angle strictly
+/// between −90° and 90°, left < right, down < up, and an orientation of non-zero length.
+void check_eye(const EyeView& eye)
+{
+    const float values[] = {eye.position.x,    eye.position.y,    eye.position.z,      eye.orientation.w, eye.orientation.x,
+                            eye.orientation.y, eye.orientation.z, eye.angle_left,      eye.angle_right,   eye.angle_up,
+                            eye.angle_down,    eye.near_m,        eye.far_m};
+    for (float v : values)
+        if (!std::isfinite(v)) throw InvalidInput("render: an eye view with a value that is not finite");
+    if (!(eye.near_m > 0.0f && eye.far_m > eye.near_m))
+        throw InvalidInput("render: an eye view with near " + std::to_string(eye.near_m) + " m and far " +
+                           std::to_string(eye.far_m) + " m (0 < near < far)");
+    const float right_angle = 0.5f * glm::pi<float>();
+    auto ordered = [&](float lo, float hi) { return -right_angle < lo && lo < hi && hi < right_angle; };
+    if (!ordered(eye.angle_left, eye.angle_right) || !ordered(eye.angle_down, eye.angle_up))
+        throw InvalidInput("render: an eye view with angles left " + std::to_string(eye.angle_left) + ", right " +
+                           std::to_string(eye.angle_right) + ", down " + std::to_string(eye.angle_down) + ", up " +
+                           std::to_string(eye.angle_up) + " rad (each between -pi/2 and pi/2, left < right, down < up)");
+    if (glm::length(eye.orientation) < 1e-6f) throw InvalidInput("render: an eye view with an orientation of length 0");
+}
+
+/// After the render pass: `picture` (kColorFormat, TRANSFER_SRC_OPTIMAL, `extent`) into layer
+/// `layer` of `image` (`format`, the same size, COLOR_ATTACHMENT_OPTIMAL before and after):
+/// copied when the formats are the same, else blitted (the blit converts: RGBA to BGRA, and
+/// sRGB to linear for a UNORM image, whose texels then hold linear colours).
+void record_into_external(VkCommandBuffer cmd, VkImage picture, VkExtent2D extent, VkImage image, VkFormat format,
+                          std::uint32_t layer)
+{
+    auto barrier = vk_struct<VkImageMemoryBarrier>(VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER);
+    barrier.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    barrier.image = image;
+    barrier.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, layer, 1};
+    barrier.oldLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+    barrier.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    barrier.srcAccessMask = VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT;
+    barrier.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0,
+                         nullptr, 1, &barrier);
+    const VkImageSubresourceLayers src{VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1}, dst{VK_IMAGE_ASPECT_COLOR_BIT, 0, layer, 1};
+    if (format == kColorFormat) {
+        VkImageCopy region{};
+        region.srcSubresource = src;
+        region.dstSubresource = dst;
+        region.extent = {extent.width, extent.height, 1};
+        vkCmdCopyImage(cmd, picture, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+    } else {
+        VkImageBlit region{};
+        region.srcSubresource = src;
+        region.dstSubresource = dst;
+        region.srcOffsets[1] = region.dstOffsets[1] = {std::int32_t(extent.width), std::int32_t(extent.height), 1};
+        vkCmdBlitImage(cmd, picture, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region,
+                       VK_FILTER_NEAREST);
+    }
+    barrier.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    barrier.newLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+    barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    barrier.dstAccessMask = VK_ACCESS_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT;
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, 0, 0, nullptr, 0,
+                         nullptr, 1, &barrier);
+}
+
+} // namespace
+
+void Renderer::render_to(const EyeView& eye, const ExternalImage& target)
+{
+    check_size(target.width, target.height, "an eye's image");
+    if (!target.vk_image) throw InvalidInput("render: render_to was given no image (vk_image is 0)");
+    const auto format = static_cast<VkFormat>(target.vk_format);
+    if (!is_external_format(format))
+        throw InvalidInput("render: render_to cannot write images of VkFormat " + std::to_string(target.vk_format) +
+                           " (R8G8B8A8_UNORM 37, R8G8B8A8_SRGB 43, B8G8R8A8_UNORM 44 or B8G8R8A8_SRGB 50)");
+    if (target.array_layer < 0)
+        throw InvalidInput("render: render_to was given array layer " + std::to_string(target.array_layer) + " (0 or more)");
+    check_eye(eye);
+    Impl& im = *impl_;
+    if (format != im.format.color) {
+        VkFormatProperties src, dst;
+        vkGetPhysicalDeviceFormatProperties(im.ctx.physical(), im.format.color, &src);
+        vkGetPhysicalDeviceFormatProperties(im.ctx.physical(), format, &dst);
+        if (!(src.optimalTilingFeatures & VK_FORMAT_FEATURE_BLIT_SRC_BIT) || !(dst.optimalTilingFeatures & VK_FORMAT_FEATURE_BLIT_DST_BIT))
+            throw RenderUnavailable("render: the Vulkan device '" + im.ctx.name() + "' cannot blit into images of VkFormat " +
+                                    std::to_string(target.vk_format));
+    }
+    const VkExtent2D extent{static_cast<std::uint32_t>(target.width), static_cast<std::uint32_t>(target.height)};
+    OffscreenTarget& t = im.eye_target_of(extent);
+    const auto image = handle_from_integer<VkImage>(target.vk_image);
+    im.ctx.submit_and_wait(
+        [&](VkCommandBuffer cmd) {
+            im.record_frame(cmd, t, eye_frame_view(eye), false);
+            record_into_external(cmd, t.picture(), extent, image, format, static_cast<std::uint32_t>(target.array_layer));
+        },
+        &im.stats.record_ms, &im.stats.gpu_ms);
+    t.drawn = true;
+    im.last = &t;
 }
 
 RgbaImage Renderer::last_frame()

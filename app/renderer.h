@@ -20,6 +20,15 @@
 /// renderer.set_overlay(panel);             // optional 2D triangles over the scene (Dear ImGui)
 /// renderer.present(camera, fb_width, fb_height);  // false when minimised (0 × 0)
 /// ```
+///
+/// For a headset (OpenXR, XR_KHR_vulkan_enable2; docs/rendering.md):
+/// ```cpp
+/// RendererOptions o;
+/// o.vulkan_hooks = {create_instance, physical_device, create_device};  // xrCreateVulkanInstanceKHR, ...
+/// Renderer renderer(o);
+/// VulkanHandles h = renderer.vulkan_handles();  // XrGraphicsBindingVulkan2KHR
+/// renderer.render_to(eye_view, {swapchain_image, VK_FORMAT_R8G8B8A8_SRGB, width, height, 0});  // per eye
+/// ```
 
 #include <array>
 #include <cstdint>
@@ -28,6 +37,7 @@
 #include <string>
 #include <vector>
 
+#include <glm/gtc/quaternion.hpp>
 #include <glm/vec3.hpp>
 
 #include "core/errors.h"
@@ -53,6 +63,7 @@ enum class RenderMaterial : std::uint8_t {
     Leaf,   ///< alpha-tested from the leaf texture, two-sided; leaf quads drawn instanced (RendererOptions::instanced_leaves)
     Lobe,   ///< translucent (alpha blend, after the opaque meshes, no depth write), two-sided
     Stroke, ///< opaque, nearly unlit (stroke tubes)
+    Photo,  ///< opaque, unlit, two-sided, coloured by RenderScene::photo_texture at the item's uvs (times `color`)
 };
 
 /// One mesh of a scene.
@@ -61,7 +72,7 @@ struct RenderItem {
     std::uint64_t version = 0; ///< changes whenever `geometry` changes: equal key and version are not re-uploaded
     RenderMaterial material = RenderMaterial::Bark;
     std::array<float, 4> color{1.0f, 1.0f, 1.0f, 1.0f}; ///< linear RGBA (alpha used by lobes)
-    SurfaceGeometry geometry; ///< world space (metres, +Y up); uvs used by leaves only (may be empty otherwise)
+    SurfaceGeometry geometry; ///< world space (metres, +Y up); uvs used by leaves and photos only (may be empty otherwise; v = 0 is a texture's top row)
 };
 
 /// Axis-aligned bounding box; empty when lo > hi.
@@ -77,6 +88,8 @@ struct RenderScene {
     std::vector<RenderItem> items;
     RgbaImage leaf_texture;                ///< RGBA8 (sRGB colours, alpha cut-out); empty: white
     std::uint64_t leaf_texture_version = 0; ///< as RenderItem::version
+    RgbaImage photo_texture;                ///< RGBA8 (sRGB colours) for RenderMaterial::Photo; empty: white
+    std::uint64_t photo_texture_version = 0; ///< as RenderItem::version
     bool ground = true;                    ///< the ground grid at `ground_y`
     float ground_y = 0.0f;                 ///< height of the trunk base
     /// What the ground grid is centred under and sized by (8 × its largest side, at least
@@ -152,6 +165,62 @@ struct RendererOptions {
     /// on every quad) instanced: one shared quad, one instance per leaf. Any other leaf mesh is
     /// drawn as an ordinary mesh. false: every leaf mesh as an ordinary mesh (the reference).
     bool instanced_leaves = true;
+    /// Where the Vulkan instance and device come from. Empty (the default): the renderer
+    /// makes them itself. Set (all three): an OpenXR runtime makes them
+    /// (XR_KHR_vulkan_enable2's xrCreateVulkanInstanceKHR, xrGetVulkanGraphicsDevice2KHR,
+    /// xrCreateVulkanDeviceKHR), as `lobesketch vr` needs. The renderer still fills the create
+    /// infos (API version, extensions, queues) and owns and destroys what comes back.
+    /// The renderer calls Vulkan through the loader it links (libvulkan's exported functions),
+    /// so the hooks must make the objects through that loader too: pass `vkGetInstanceProcAddr`
+    /// as XrVulkanInstanceCreateInfoKHR::pfnGetInstanceProcAddr. With hooks, `prefer_software`
+    /// is ignored, the queue is the first graphics queue family of the hooks' physical device,
+    /// and `presentation` needs VK_KHR_swapchain on it. A hook returning 0 makes the
+    /// constructor throw RenderUnavailable (one line naming the hook and the VkResult); only
+    /// some of the three set is a RenderError.
+    struct VulkanHooks {
+        /// Gets a `const VkInstanceCreateInfo*`; returns the VkInstance as an integer, or 0
+        /// with `vk_result` (a VkResult) saying why.
+        std::function<std::uint64_t(const void* instance_create_info, int& vk_result)> create_instance;
+        /// Gets the VkInstance; returns the VkPhysicalDevice the runtime wants (0: none).
+        std::function<std::uint64_t(std::uint64_t vk_instance)> physical_device;
+        /// Gets the VkPhysicalDevice and a `const VkDeviceCreateInfo*`; returns the VkDevice,
+        /// or 0 with `vk_result` saying why.
+        std::function<std::uint64_t(std::uint64_t vk_physical_device, const void* device_create_info, int& vk_result)>
+            create_device;
+        bool empty() const { return !create_instance; }
+    } vulkan_hooks;
+};
+
+/// The renderer's Vulkan objects as integers, for an OpenXR session's graphics binding
+/// (XrGraphicsBindingVulkan2KHR) and for swapchain images made on its device.
+struct VulkanHandles {
+    std::uint64_t instance = 0, physical_device = 0, device = 0;
+    std::uint32_t queue_family = 0, queue_index = 0;
+};
+
+/// One eye of a stereo view as OpenXR gives it (XrView): the eye's pose in world space and
+/// its field of view as four angles in radians (left and down negative), so asymmetric
+/// frusta are drawn exactly.
+struct EyeView {
+    glm::vec3 position{0.0f};
+    glm::quat orientation{1.0f, 0.0f, 0.0f, 0.0f}; ///< −Z is the viewing direction, +Y up
+    float angle_left = -0.785f, angle_right = 0.785f, angle_up = 0.785f, angle_down = -0.785f;
+    float near_m = 0.05f;
+    float far_m = 100.0f;
+};
+
+/// An image the caller owns that the renderer draws into (an OpenXR swapchain image):
+/// a 2D colour image on the renderer's device, in VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL
+/// before and after.
+/// The picture is copied (same format, R8G8B8A8_SRGB) or blitted (the others) into it, so the
+/// image needs TRANSFER_DST usage (XR_SWAPCHAIN_USAGE_TRANSFER_DST_BIT). An sRGB image gets
+/// the picture's sRGB bytes (channels in its order); a UNORM one gets linear colours (what a
+/// compositor expects of a UNORM swapchain; 8-bit linear bands in the darks: prefer sRGB).
+struct ExternalImage {
+    std::uint64_t vk_image = 0;
+    int vk_format = 0;   ///< a VkFormat: R8G8B8A8 or B8G8R8A8, UNORM or SRGB
+    int width = 0, height = 0;
+    int array_layer = 0;
 };
 
 /// How much GPU upload the last set_scene did, and what the last render took.
@@ -233,6 +302,23 @@ public:
     RgbaImage last_frame();
 
     const RenderStats& stats() const;
+
+    /// The Vulkan objects the renderer uses (see VulkanHandles).
+    VulkanHandles vulkan_handles() const;
+
+    /// Draws the scene (no overlay) as seen by `eye` into `target`, exactly as render() draws
+    /// (MSAA offscreen, resolved), then copies it into the target image; returns when the GPU
+    /// has finished, so the image can be handed back to the runtime at once. The offscreen
+    /// targets are kept per size. last_frame() reads this picture back too.
+    /// The projection is asymmetric, exactly the four angles; a symmetric EyeView draws what
+    /// render() draws for a Camera at the same place looking along the same −Z, with
+    /// fov_y_deg = 2 · angle_up and an image of aspect tan(angle_right) / tan(angle_up).
+    /// Submits to the renderer's queue (vulkan_handles()) from the calling thread.
+    /// \throw InvalidInput for a size outside 1..16384, a format not listed, or a null image,
+    /// a negative array layer, or an eye that is not finite, has an orientation of length 0,
+    /// near ≤ 0 or far ≤ near, or angles not ordered left < right, down < up within ±90°;
+    /// RenderUnavailable when the device cannot blit into the format; RenderError.
+    void render_to(const EyeView& eye, const ExternalImage& target);
 
 private:
     struct Impl;

@@ -7,14 +7,19 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <memory>
+#include <stdexcept>
 #include <type_traits>
 
 #include <dlfcn.h>
 #include <sys/wait.h>
+
+#include <glm/gtc/constants.hpp>
+#include <vulkan/vulkan.h>
 
 #include "app/edit_hooks.h"
 #include "app/export_gltf.h"
@@ -1080,3 +1085,571 @@ RgbaImage read_x11_window(void*, void*, int, int) { return {}; }
 } // namespace
 } // namespace lobe
 #endif
+
+// --- OpenXR: the instance and device from hooks, drawing into a caller's image, photos -----------
+
+namespace lobe {
+namespace {
+
+constexpr int kEw = 64, kEh = 64; // eye and photo pictures: small
+
+#define LOBE_TEST_VK(call)                                                                    \
+    do {                                                                                      \
+        if (const VkResult r_ = (call); r_ != VK_SUCCESS)                                     \
+            throw std::runtime_error(std::string(#call) + " failed with " + std::to_string(r_)); \
+    } while (0)
+
+/// A zero-initialised Vulkan info struct with its sType set.
+template <class T>
+T vk_info(VkStructureType type)
+{
+    T s{};
+    s.sType = type;
+    return s;
+}
+
+template <class Handle>
+Handle from_integer(std::uint64_t v)
+{
+    if constexpr (std::is_pointer_v<Handle>)
+        return reinterpret_cast<Handle>(static_cast<std::uintptr_t>(v));
+    else
+        return static_cast<Handle>(v);
+}
+
+template <class Handle>
+std::uint64_t to_integer(Handle h)
+{
+    if constexpr (std::is_pointer_v<Handle>)
+        return static_cast<std::uint64_t>(reinterpret_cast<std::uintptr_t>(h));
+    else
+        return static_cast<std::uint64_t>(h);
+}
+
+/// A colour image made on the renderer's device as an OpenXR runtime makes a swapchain image
+/// (COLOR_ATTACHMENT and TRANSFER_DST usage, `layers` array layers), cleared to magenta and
+/// left in COLOR_ATTACHMENT_OPTIMAL; read() copies a layer out and leaves it in that layout.
+class TestImage {
+public:
+    TestImage(const VulkanHandles& h, VkFormat format, int width, int height, int layers = 1)
+        : device_(from_integer<VkDevice>(h.device)), format_(format), width_(width), height_(height)
+    {
+        vkGetDeviceQueue(device_, h.queue_family, h.queue_index, &queue_);
+        VkPhysicalDeviceMemoryProperties memory;
+        vkGetPhysicalDeviceMemoryProperties(from_integer<VkPhysicalDevice>(h.physical_device), &memory);
+        auto memory_type = [&](std::uint32_t bits, VkMemoryPropertyFlags flags) {
+            for (std::uint32_t i = 0; i < memory.memoryTypeCount; ++i)
+                if ((bits & (1u << i)) && (memory.memoryTypes[i].propertyFlags & flags) == flags) return i;
+            throw std::runtime_error("no memory type");
+        };
+        auto info = vk_info<VkImageCreateInfo>(VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO);
+        info.imageType = VK_IMAGE_TYPE_2D;
+        info.format = format;
+        info.extent = {std::uint32_t(width), std::uint32_t(height), 1};
+        info.mipLevels = 1;
+        info.arrayLayers = std::uint32_t(layers);
+        info.samples = VK_SAMPLE_COUNT_1_BIT;
+        info.tiling = VK_IMAGE_TILING_OPTIMAL;
+        info.usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+        info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+        LOBE_TEST_VK(vkCreateImage(device_, &info, nullptr, &image_));
+        VkMemoryRequirements req;
+        vkGetImageMemoryRequirements(device_, image_, &req);
+        auto alloc = vk_info<VkMemoryAllocateInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO);
+        alloc.allocationSize = req.size;
+        alloc.memoryTypeIndex = memory_type(req.memoryTypeBits, 0);
+        LOBE_TEST_VK(vkAllocateMemory(device_, &alloc, nullptr, &image_memory_));
+        LOBE_TEST_VK(vkBindImageMemory(device_, image_, image_memory_, 0));
+        auto buffer = vk_info<VkBufferCreateInfo>(VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO);
+        buffer.size = VkDeviceSize(width) * VkDeviceSize(height) * 4u;
+        buffer.usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+        LOBE_TEST_VK(vkCreateBuffer(device_, &buffer, nullptr, &buffer_));
+        vkGetBufferMemoryRequirements(device_, buffer_, &req);
+        alloc.allocationSize = req.size;
+        alloc.memoryTypeIndex = memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+        LOBE_TEST_VK(vkAllocateMemory(device_, &alloc, nullptr, &buffer_memory_));
+        LOBE_TEST_VK(vkBindBufferMemory(device_, buffer_, buffer_memory_, 0));
+        auto pool = vk_info<VkCommandPoolCreateInfo>(VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO);
+        pool.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+        pool.queueFamilyIndex = h.queue_family;
+        LOBE_TEST_VK(vkCreateCommandPool(device_, &pool, nullptr, &pool_));
+        auto cb = vk_info<VkCommandBufferAllocateInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO);
+        cb.commandPool = pool_;
+        cb.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+        cb.commandBufferCount = 1;
+        LOBE_TEST_VK(vkAllocateCommandBuffers(device_, &cb, &cmd_));
+        auto fence = vk_info<VkFenceCreateInfo>(VK_STRUCTURE_TYPE_FENCE_CREATE_INFO);
+        LOBE_TEST_VK(vkCreateFence(device_, &fence, nullptr, &fence_));
+        submit([&](VkCommandBuffer cmd) {
+            const VkImageSubresourceRange all{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, std::uint32_t(layers)};
+            barrier(cmd, all, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+            const VkClearColorValue magenta{{1.0f, 0.0f, 1.0f, 1.0f}};
+            vkCmdClearColorImage(cmd, image_, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &magenta, 1, &all);
+            barrier(cmd, all, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL);
+        });
+    }
+    ~TestImage()
+    {
+        vkDeviceWaitIdle(device_);
+        vkDestroyFence(device_, fence_, nullptr);
+        vkDestroyCommandPool(device_, pool_, nullptr);
+        vkDestroyBuffer(device_, buffer_, nullptr);
+        vkFreeMemory(device_, buffer_memory_, nullptr);
+        vkDestroyImage(device_, image_, nullptr);
+        vkFreeMemory(device_, image_memory_, nullptr);
+    }
+    TestImage(const TestImage&) = delete;
+    TestImage& operator=(const TestImage&) = delete;
+
+    ExternalImage target(int layer = 0) const { return {to_integer(image_), int(format_), width_, height_, layer}; }
+
+    /// Layer `layer` as RGBA bytes (B8G8R8A8 swizzled), rows top to bottom.
+    RgbaImage read(int layer = 0)
+    {
+        submit([&](VkCommandBuffer cmd) {
+            const VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, std::uint32_t(layer), 1};
+            barrier(cmd, range, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+            VkBufferImageCopy region{};
+            region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, std::uint32_t(layer), 1};
+            region.imageExtent = {std::uint32_t(width_), std::uint32_t(height_), 1};
+            vkCmdCopyImageToBuffer(cmd, image_, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buffer_, 1, &region);
+            barrier(cmd, range, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL);
+        });
+        RgbaImage out{width_, height_, std::vector<std::uint8_t>(std::size_t(width_) * std::size_t(height_) * 4)};
+        void* mapped = nullptr;
+        LOBE_TEST_VK(vkMapMemory(device_, buffer_memory_, 0, VK_WHOLE_SIZE, 0, &mapped));
+        std::memcpy(out.pixels.data(), mapped, out.pixels.size());
+        vkUnmapMemory(device_, buffer_memory_);
+        if (format_ == VK_FORMAT_B8G8R8A8_SRGB || format_ == VK_FORMAT_B8G8R8A8_UNORM)
+            for (std::size_t i = 0; i < out.pixels.size(); i += 4) std::swap(out.pixels[i], out.pixels[i + 2]);
+        return out;
+    }
+
+private:
+    void barrier(VkCommandBuffer cmd, const VkImageSubresourceRange& range, VkImageLayout from, VkImageLayout to) const
+    {
+        auto b = vk_info<VkImageMemoryBarrier>(VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER);
+        b.srcAccessMask = VK_ACCESS_MEMORY_WRITE_BIT;
+        b.dstAccessMask = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT;
+        b.oldLayout = from;
+        b.newLayout = to;
+        b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        b.image = image_;
+        b.subresourceRange = range;
+        vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0, nullptr, 0, nullptr,
+                             1, &b);
+    }
+    void submit(const std::function<void(VkCommandBuffer)>& record)
+    {
+        LOBE_TEST_VK(vkResetCommandBuffer(cmd_, 0));
+        auto begin = vk_info<VkCommandBufferBeginInfo>(VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO);
+        LOBE_TEST_VK(vkBeginCommandBuffer(cmd_, &begin));
+        record(cmd_);
+        LOBE_TEST_VK(vkEndCommandBuffer(cmd_));
+        LOBE_TEST_VK(vkResetFences(device_, 1, &fence_));
+        auto info = vk_info<VkSubmitInfo>(VK_STRUCTURE_TYPE_SUBMIT_INFO);
+        info.commandBufferCount = 1;
+        info.pCommandBuffers = &cmd_;
+        LOBE_TEST_VK(vkQueueSubmit(queue_, 1, &info, fence_));
+        LOBE_TEST_VK(vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX));
+    }
+
+    VkDevice device_;
+    VkQueue queue_ = VK_NULL_HANDLE;
+    VkFormat format_;
+    int width_, height_;
+    VkImage image_ = VK_NULL_HANDLE;
+    VkDeviceMemory image_memory_ = VK_NULL_HANDLE, buffer_memory_ = VK_NULL_HANDLE;
+    VkBuffer buffer_ = VK_NULL_HANDLE;
+    VkCommandPool pool_ = VK_NULL_HANDLE;
+    VkCommandBuffer cmd_ = VK_NULL_HANDLE;
+    VkFence fence_ = VK_NULL_HANDLE;
+};
+
+// The photo's four quadrants (sRGB), far from the sky's and the ground's colours.
+constexpr std::array<std::uint8_t, 3> kTopLeft{220, 30, 30}, kTopRight{30, 200, 60}, kBottomLeft{200, 40, 200},
+    kBottomRight{230, 210, 40};
+
+/// 8×8 texels, a colour per 4×4 quadrant (row 0 is the top).
+RgbaImage quadrant_texture()
+{
+    RgbaImage t{8, 8, std::vector<std::uint8_t>(8 * 8 * 4)};
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) {
+            const auto& c = y < 4 ? (x < 4 ? kTopLeft : kTopRight) : (x < 4 ? kBottomLeft : kBottomRight);
+            std::uint8_t* p = &t.pixels[std::size_t(y * 8 + x) * 4];
+            std::copy(c.begin(), c.end(), p);
+            p[3] = 255;
+        }
+    return t;
+}
+
+/// Sky, ground and a 1 m photo quad in the plane z = 0, x in [−0.5, 0.5], y in [0.5, 1.5],
+/// facing +Z, the texture's top-left corner at its top-left.
+RenderScene photo_scene(std::uint64_t texture_version = 1)
+{
+    RenderScene scene;
+    RenderItem photo;
+    photo.key = 1;
+    photo.version = 1;
+    photo.material = RenderMaterial::Photo;
+    photo.geometry.positions = {{-0.5f, 1.5f, 0.0f}, {0.5f, 1.5f, 0.0f}, {0.5f, 0.5f, 0.0f}, {-0.5f, 0.5f, 0.0f}};
+    photo.geometry.normals.assign(4, glm::vec3(0.0f, 0.0f, 1.0f));
+    photo.geometry.uvs = {{0.0f, 0.0f}, {1.0f, 0.0f}, {1.0f, 1.0f}, {0.0f, 1.0f}};
+    photo.geometry.triangles = {{0, 2, 1}, {0, 3, 2}};
+    scene.items.push_back(photo);
+    scene.photo_texture = quadrant_texture();
+    scene.photo_texture_version = texture_version;
+    scene.ground_area = Bounds{glm::vec3(-0.5f, 0.0f, -0.5f), glm::vec3(0.5f, 1.5f, 0.5f)};
+    return scene;
+}
+
+/// The camera of the eye tests: 3 m in front of the photo's centre, looking along −Z, 40°.
+Camera eye_camera()
+{
+    Camera c;
+    c.eye = glm::vec3(0.0f, 1.0f, 3.0f);
+    c.target = c.eye + glm::vec3(0.0f, 0.0f, -1.0f);
+    c.fov_y_deg = 40.0f;
+    c.near_m = 0.05f;
+    c.far_m = 100.0f;
+    return c;
+}
+
+/// eye_camera() as an OpenXR view of a square image: ±20° each way.
+EyeView eye_view()
+{
+    EyeView e;
+    e.position = glm::vec3(0.0f, 1.0f, 3.0f);
+    const float half = glm::radians(20.0f);
+    e.angle_left = e.angle_down = -half;
+    e.angle_right = e.angle_up = half;
+    e.near_m = 0.05f;
+    e.far_m = 100.0f;
+    return e;
+}
+
+/// Largest per-channel difference of the RGB of two pictures, and how many pixels differ.
+std::pair<int, std::size_t> rgb_difference(const RgbaImage& a, const RgbaImage& b)
+{
+    int most = 0;
+    std::size_t pixels = 0;
+    for (std::size_t i = 0; i < a.pixels.size() && i < b.pixels.size(); i += 4) {
+        int d = 0;
+        for (int c = 0; c < 3; ++c) d = std::max(d, std::abs(int(a.pixels[i + c]) - int(b.pixels[i + c])));
+        most = std::max(most, d);
+        pixels += d > 0;
+    }
+    return {most, pixels};
+}
+
+bool near_colour(const std::uint8_t* p, const std::array<std::uint8_t, 3>& c, int tolerance)
+{
+    for (int k = 0; k < 3; ++k)
+        if (std::abs(int(p[k]) - int(c[k])) > tolerance) return false;
+    return true;
+}
+
+/// Centre (pixel coordinates) of the pixels showing one of the photo's colours.
+glm::dvec2 photo_centre(const RgbaImage& im)
+{
+    glm::dvec2 sum(0.0);
+    std::size_t n = 0;
+    for (int y = 0; y < im.height; ++y)
+        for (int x = 0; x < im.width; ++x) {
+            const std::uint8_t* p = pixel(im, x, y);
+            for (const auto& c : {kTopLeft, kTopRight, kBottomLeft, kBottomRight})
+                if (near_colour(p, c, 6)) {
+                    sum += glm::dvec2(x, y);
+                    ++n;
+                    break;
+                }
+        }
+    return n ? sum / double(n) : glm::dvec2(-1.0);
+}
+
+/// Hooks that make the instance and device as the renderer would, with the first device;
+/// what they made and saw is recorded in `seen`.
+struct HookRecord {
+    std::uint64_t instance = 0, physical = 0, device = 0;
+    std::uint32_t api_version = 0, queue_family = ~0u;
+    int instance_calls = 0, physical_calls = 0, device_calls = 0;
+};
+
+RendererOptions::VulkanHooks direct_hooks(HookRecord& seen)
+{
+    RendererOptions::VulkanHooks h;
+    h.create_instance = [&seen](const void* create_info, int& result) -> std::uint64_t {
+        ++seen.instance_calls;
+        const auto* info = static_cast<const VkInstanceCreateInfo*>(create_info);
+        if (info->pApplicationInfo) seen.api_version = info->pApplicationInfo->apiVersion;
+        VkInstance instance = VK_NULL_HANDLE;
+        result = vkCreateInstance(info, nullptr, &instance);
+        return seen.instance = result == VK_SUCCESS ? to_integer(instance) : 0;
+    };
+    h.physical_device = [&seen](std::uint64_t instance) -> std::uint64_t {
+        ++seen.physical_calls;
+        std::uint32_t n = 1;
+        VkPhysicalDevice first = VK_NULL_HANDLE;
+        vkEnumeratePhysicalDevices(from_integer<VkInstance>(instance), &n, &first); // VK_INCOMPLETE with more
+        return seen.physical = n ? to_integer(first) : 0;
+    };
+    h.create_device = [&seen](std::uint64_t physical, const void* create_info, int& result) -> std::uint64_t {
+        ++seen.device_calls;
+        const auto* info = static_cast<const VkDeviceCreateInfo*>(create_info);
+        if (info->queueCreateInfoCount == 1) seen.queue_family = info->pQueueCreateInfos[0].queueFamilyIndex;
+        VkDevice device = VK_NULL_HANDLE;
+        result = vkCreateDevice(from_integer<VkPhysicalDevice>(physical), info, nullptr, &device);
+        return seen.device = result == VK_SUCCESS ? to_integer(device) : 0;
+    };
+    return h;
+}
+
+/// The message of the RenderUnavailable `make` throws ("" when it throws none).
+std::string unavailable_message(const std::function<void()>& make)
+{
+    try {
+        make();
+    } catch (const RenderUnavailable& e) {
+        return e.what();
+    }
+    return "";
+}
+
+TEST(RenderXr, HooksMakeTheInstanceAndDeviceAndTheRendererDrawsAsTheDefaultOne)
+{
+    HookRecord seen;
+    RendererOptions options;
+    options.vulkan_hooks = direct_hooks(seen);
+    Renderer hooked(options);
+    EXPECT_EQ(seen.instance_calls, 1);
+    EXPECT_EQ(seen.physical_calls, 1);
+    EXPECT_EQ(seen.device_calls, 1);
+    EXPECT_GE(seen.api_version, VK_API_VERSION_1_1);
+    const VulkanHandles h = hooked.vulkan_handles();
+    EXPECT_EQ(h.instance, seen.instance);
+    EXPECT_EQ(h.physical_device, seen.physical);
+    EXPECT_EQ(h.device, seen.device);
+    EXPECT_EQ(h.queue_family, seen.queue_family);
+    EXPECT_EQ(h.queue_index, 0u);
+
+    const RenderScene scene = photo_scene();
+    hooked.set_scene(scene);
+    const RgbaImage picture = hooked.render(eye_camera(), kEw, kEh);
+    ASSERT_EQ(picture.pixels.size(), std::size_t(kEw) * kEh * 4);
+    EXPECT_NE(photo_centre(picture).x, -1.0) << "the photo is drawn";
+    Renderer& plain = *shared().renderer;
+    if (plain.device_name() == hooked.device_name()) {
+        plain.set_scene(scene);
+        EXPECT_EQ(plain.render(eye_camera(), kEw, kEh).pixels, picture.pixels);
+    }
+}
+
+TEST(RenderXr, AHookReturning0IsRenderUnavailableInOneLineNamingTheHookAndTheResult)
+{
+    HookRecord seen;
+    RendererOptions options;
+    options.vulkan_hooks = direct_hooks(seen);
+    options.vulkan_hooks.create_instance = [](const void*, int& result) -> std::uint64_t {
+        result = VK_ERROR_INCOMPATIBLE_DRIVER;
+        return 0;
+    };
+    std::string m = unavailable_message([&] { Renderer r(options); });
+    EXPECT_NE(m.find("create_instance"), std::string::npos) << m;
+    EXPECT_NE(m.find("VK_ERROR_INCOMPATIBLE_DRIVER"), std::string::npos) << m;
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+    EXPECT_EQ(seen.physical_calls, 0);
+
+    options.vulkan_hooks = direct_hooks(seen);
+    options.vulkan_hooks.physical_device = [](std::uint64_t) -> std::uint64_t { return 0; };
+    m = unavailable_message([&] { Renderer r(options); });
+    EXPECT_NE(m.find("physical_device"), std::string::npos) << m;
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+    EXPECT_EQ(seen.device_calls, 0);
+
+    options.vulkan_hooks = direct_hooks(seen);
+    options.vulkan_hooks.create_device = [](std::uint64_t, const void*, int& result) -> std::uint64_t {
+        result = VK_ERROR_DEVICE_LOST;
+        return 0;
+    };
+    m = unavailable_message([&] { Renderer r(options); });
+    EXPECT_NE(m.find("create_device"), std::string::npos) << m;
+    EXPECT_NE(m.find("VK_ERROR_DEVICE_LOST"), std::string::npos) << m;
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+
+    options.vulkan_hooks.create_device = [](std::uint64_t, const void*, int&) -> std::uint64_t { return 0; };
+    m = unavailable_message([&] { Renderer r(options); });
+    EXPECT_NE(m.find("no VkResult"), std::string::npos) << m;
+
+    // Some of the three but not all is a mistake of the caller's.
+    RendererOptions partial;
+    partial.vulkan_hooks.create_instance = direct_hooks(seen).create_instance;
+    EXPECT_THROW(Renderer r(partial), RenderError);
+}
+
+TEST(RenderXr, RenderToASymmetricEyeDrawsWhatRenderDrawsForTheSameCameraInEveryFormat)
+{
+    Renderer& r = *shared().renderer;
+    r.set_overlay(Overlay{});
+    r.set_scene(photo_scene());
+    const RgbaImage expected = r.render(eye_camera(), kEw, kEh);
+    ASSERT_TRUE(near_colour(pixel(expected, 25, 25), kTopLeft, 2)) << "the photo is upright and not mirrored";
+    ASSERT_TRUE(near_colour(pixel(expected, 38, 38), kBottomRight, 2));
+    for (VkFormat format : {VK_FORMAT_R8G8B8A8_SRGB, VK_FORMAT_B8G8R8A8_SRGB}) {
+        SCOPED_TRACE(format == VK_FORMAT_R8G8B8A8_SRGB ? "R8G8B8A8_SRGB" : "B8G8R8A8_SRGB");
+        TestImage image(r.vulkan_handles(), format, kEw, kEh, 2);
+        r.render_to(eye_view(), image.target(1));
+        const RgbaImage drawn = image.read(1);
+        const auto [most, pixels] = rgb_difference(drawn, expected);
+        EXPECT_LE(most, 1) << pixels << " pixels differ";
+        EXPECT_EQ(rgb_difference(r.last_frame(), expected).first, 0) << "last_frame() reads the eye's picture back";
+        const RgbaImage untouched = image.read(0);
+        EXPECT_TRUE(near_colour(pixel(untouched, 0, 0), {255, 0, 255}, 0)) << "only the asked layer is written";
+        // Again into the same image: it was left in COLOR_ATTACHMENT_OPTIMAL.
+        r.render_to(eye_view(), image.target(1));
+        EXPECT_EQ(image.read(1).pixels, drawn.pixels);
+    }
+    // The linear formats get linear colours: sRGB 220 is linear 0.716, byte 183.
+    TestImage unorm(r.vulkan_handles(), VK_FORMAT_R8G8B8A8_UNORM, kEw, kEh);
+    r.render_to(eye_view(), unorm.target());
+    const std::uint8_t* p = pixel(unorm.read(), 25, 25);
+    EXPECT_NEAR(double(p[0]), srgb_to_linear(kTopLeft[0]) * 255.0, 1.0);
+}
+
+TEST(RenderXr, AnEyeTurnedOrOffCentreMovesThePictureTheWayItsPoseAndAnglesSay)
+{
+    Renderer& r = *shared().renderer;
+    r.set_overlay(Overlay{});
+    r.set_scene(photo_scene());
+    TestImage image(r.vulkan_handles(), VK_FORMAT_R8G8B8A8_SRGB, kEw, kEh);
+    r.render_to(eye_view(), image.target());
+    const glm::dvec2 centred = photo_centre(image.read());
+    EXPECT_NEAR(centred.x, 31.5, 0.5);
+    EXPECT_NEAR(centred.y, 31.5, 0.5);
+    // The frustum shifted right by 0.2 in tangent (of a width of 2 tan 20° = 0.728): what is
+    // straight ahead is 0.2 / 0.728 of the picture's width left of its centre.
+    const double shift = 0.2 / (2.0 * std::tan(glm::radians(20.0))) * kEw;
+    EyeView right = eye_view();
+    right.angle_left = std::atan(std::tan(right.angle_left) + 0.2f);
+    right.angle_right = std::atan(std::tan(right.angle_right) + 0.2f);
+    r.render_to(right, image.target());
+    glm::dvec2 c = photo_centre(image.read());
+    EXPECT_NEAR(c.x, centred.x - shift, 0.5);
+    EXPECT_NEAR(c.y, centred.y, 0.5);
+    // Shifted up: it is below the centre (rows go down).
+    EyeView up = eye_view();
+    up.angle_down = std::atan(std::tan(up.angle_down) + 0.2f);
+    up.angle_up = std::atan(std::tan(up.angle_up) + 0.2f);
+    r.render_to(up, image.target());
+    c = photo_centre(image.read());
+    EXPECT_NEAR(c.x, centred.x, 0.5);
+    EXPECT_NEAR(c.y, centred.y + shift, 0.5);
+    // Turned 10° to the left (about +Y): the photo moves right by tan 10° / tan 20° of half the width.
+    EyeView turned = eye_view();
+    turned.orientation = glm::angleAxis(glm::radians(10.0f), glm::vec3(0.0f, 1.0f, 0.0f));
+    r.render_to(turned, image.target());
+    c = photo_centre(image.read());
+    EXPECT_GT(c.x, centred.x + 0.7 * std::tan(glm::radians(10.0)) / std::tan(glm::radians(20.0)) * kEw / 2);
+    EXPECT_NEAR(c.y, centred.y, 1.0);
+    // Turned to look along −X, it equals render()'s camera looking along −X.
+    EyeView side = eye_view();
+    side.orientation = glm::angleAxis(glm::half_pi<float>(), glm::vec3(0.0f, 1.0f, 0.0f));
+    Camera side_camera = eye_camera();
+    side_camera.target = side_camera.eye + glm::vec3(-1.0f, 0.0f, 0.0f);
+    r.render_to(side, image.target());
+    const auto [most, pixels] = rgb_difference(image.read(), r.render(side_camera, kEw, kEh));
+    EXPECT_LE(pixels, std::size_t(kEw * kEh / 100)) << "largest difference " << most;
+}
+
+TEST(RenderXr, BadEyesAndImagesAreRefusedWithOneLine)
+{
+    Renderer& r = *shared().renderer;
+    TestImage image(r.vulkan_handles(), VK_FORMAT_R8G8B8A8_SRGB, 8, 8);
+    std::vector<std::pair<EyeView, ExternalImage>> bad;
+    auto with_image = [&](auto change) {
+        ExternalImage t = image.target();
+        change(t);
+        bad.emplace_back(eye_view(), t);
+    };
+    auto with_eye = [&](auto change) {
+        EyeView e = eye_view();
+        change(e);
+        bad.emplace_back(e, image.target());
+    };
+    with_image([](ExternalImage& t) { t.width = 0; });
+    with_image([](ExternalImage& t) { t.height = 16385; });
+    with_image([](ExternalImage& t) { t.vk_image = 0; });
+    with_image([](ExternalImage& t) { t.vk_format = VK_FORMAT_R16G16B16A16_SFLOAT; });
+    with_image([](ExternalImage& t) { t.array_layer = -1; });
+    with_eye([](EyeView& e) { e.angle_left = e.angle_right; });
+    with_eye([](EyeView& e) { e.angle_up = 1.6f; });
+    with_eye([](EyeView& e) { e.near_m = 0.0f; });
+    with_eye([](EyeView& e) { e.far_m = e.near_m; });
+    with_eye([](EyeView& e) { e.orientation = glm::quat(0.0f, 0.0f, 0.0f, 0.0f); });
+    with_eye([](EyeView& e) { e.position.x = std::nanf(""); });
+    for (const auto& [eye, target] : bad) {
+        try {
+            r.render_to(eye, target);
+            ADD_FAILURE() << "accepted";
+        } catch (const InvalidInput& e) {
+            EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+        }
+    }
+}
+
+TEST(RenderPhoto, APhotoShowsItsTextureUnlitFromBothSidesTimesItsColourAndWhiteWithout)
+{
+    Renderer& r = *shared().renderer;
+    r.set_overlay(Overlay{});
+    RenderScene scene = photo_scene();
+    r.set_scene(scene);
+    RgbaImage picture = r.render(eye_camera(), kEw, kEh);
+    EXPECT_TRUE(near_colour(pixel(picture, 25, 25), kTopLeft, 1));
+    EXPECT_TRUE(near_colour(pixel(picture, 38, 25), kTopRight, 1));
+    EXPECT_TRUE(near_colour(pixel(picture, 25, 38), kBottomLeft, 1));
+    EXPECT_TRUE(near_colour(pixel(picture, 38, 38), kBottomRight, 1));
+    // From behind: two-sided, mirrored left to right.
+    Camera behind = eye_camera();
+    behind.eye.z = -3.0f;
+    behind.target = behind.eye + glm::vec3(0.0f, 0.0f, 1.0f);
+    picture = r.render(behind, kEw, kEh);
+    EXPECT_TRUE(near_colour(pixel(picture, 25, 25), kTopRight, 1));
+    EXPECT_TRUE(near_colour(pixel(picture, 38, 38), kBottomLeft, 1));
+    // Times the colour (linear): half the red.
+    scene.items[0].color = {0.5f, 1.0f, 1.0f, 1.0f};
+    scene.items[0].version = 2;
+    r.set_scene(scene);
+    picture = r.render(eye_camera(), kEw, kEh);
+    EXPECT_NEAR(int(pixel(picture, 25, 25)[0]), int(linear_to_srgb(0.5 * srgb_to_linear(kTopLeft[0]))), 1);
+    EXPECT_NEAR(int(pixel(picture, 25, 25)[1]), int(kTopLeft[1]), 1);
+    // No texture: white.
+    scene.items[0].color = {1.0f, 1.0f, 1.0f, 1.0f};
+    scene.photo_texture = {};
+    r.set_scene(scene);
+    picture = r.render(eye_camera(), kEw, kEh);
+    EXPECT_TRUE(near_colour(pixel(picture, 25, 25), {255, 255, 255}, 0));
+    EXPECT_TRUE(near_colour(pixel(picture, 38, 38), {255, 255, 255}, 0));
+}
+
+TEST(RenderPhoto, ThePhotoIsUploadedOnlyWhenItsVersionChangesAndABadOneIsRefused)
+{
+    Renderer& r = *shared().renderer;
+    RenderScene scene = photo_scene(5);
+    r.set_scene(scene);
+    r.set_scene(scene);
+    EXPECT_EQ(r.stats().bytes_uploaded, 0u);
+    scene.photo_texture_version = 6;
+    r.set_scene(scene);
+    EXPECT_EQ(r.stats().bytes_uploaded, scene.photo_texture.pixels.size());
+    scene.photo_texture.pixels.pop_back();
+    scene.photo_texture_version = 7;
+    try {
+        r.set_scene(scene);
+        ADD_FAILURE() << "a short photo was accepted";
+    } catch (const InvalidInput& e) {
+        EXPECT_NE(std::string(e.what()).find("photo"), std::string::npos) << e.what();
+    }
+}
+
+} // namespace
+} // namespace lobe

@@ -1,7 +1,8 @@
 #version 450
 // Diffuse sun + hemisphere ambient. Leaves are alpha-tested and two-sided (the normal is
 // flipped on back faces, and light through a leaf lights its back a little); lobes are
-// translucent; strokes are nearly unlit so they read as marks on the sketch.
+// translucent; strokes are nearly unlit so they read as marks on the sketch. Photos are unlit:
+// the photo texture (sRGB, sampled as linear) times the colour, opaque, both sides alike.
 layout(push_constant) uniform Push {
     mat4 view_proj;
     vec4 color;
@@ -10,6 +11,7 @@ layout(push_constant) uniform Push {
 } pc;
 
 layout(set = 0, binding = 0) uniform sampler2D leaf_texture;
+layout(set = 0, binding = 1) uniform sampler2D photo_texture;
 
 layout(location = 0) in vec3 v_normal;
 layout(location = 1) in vec2 v_uv;
@@ -25,6 +27,10 @@ const vec3 kGroundAmbient = vec3(0.28, 0.25, 0.21);
 void main()
 {
     const int material = int(pc.params.x + 0.5);
+    if (material == 4) {
+        out_color = vec4(pc.color.rgb * texture(photo_texture, v_uv).rgb, 1.0);
+        return;
+    }
     vec3 n = normalize(v_normal);
     if (!gl_FrontFacing) n = -n;
     vec4 base = pc.color;

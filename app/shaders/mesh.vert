@@ -8,7 +8,7 @@ layout(push_constant) uniform Push {
     mat4 view_proj; // world -> clip
     vec4 color;     // linear RGBA of the material
     vec4 eye;       // camera position
-    vec4 params;    // x: material (0 bark, 1 leaf, 2 lobe, 3 stroke)
+    vec4 params;    // x: material (0 bark, 1 leaf, 2 lobe, 3 stroke, 4 photo)
 } pc;
 
 layout(location = 0) out vec3 v_normal;
