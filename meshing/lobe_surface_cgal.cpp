@@ -11,7 +11,6 @@
 #include <cstdlib>
 #include <limits>
 #include <map>
-#include <unordered_map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -48,9 +47,13 @@ using K = CGAL::Exact_predicates_inexact_constructions_kernel;
 struct VertexInfo {
     int id = -1; ///< index into the node table; -1: created by CGAL at a residual crossing
 };
+struct FaceInfo {
+    int region = -1;  ///< region id (see mark_regions)
+    bool fine = false; ///< refinement found nothing to add here; reset when the face changes
+};
 using Vb = CGAL::Triangulation_vertex_base_with_info_2<VertexInfo, K>;
 using Fb0 = CGAL::Constrained_triangulation_face_base_2<K>;
-using Fb = CGAL::Triangulation_face_base_with_info_2<int, K, Fb0>; // region id
+using Fb = CGAL::Triangulation_face_base_with_info_2<FaceInfo, K, Fb0>;
 using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
 using CDT = CGAL::Constrained_Delaunay_triangulation_2<K, Tds, CGAL::Exact_predicates_tag>;
 using VH = CDT::Vertex_handle;
@@ -164,35 +167,51 @@ public:
         cell_ = std::max({lengths[lengths.size() / 2] * 2.0, cap, 1e-12});
         nx_ = static_cast<int>(extent.x / cell_) + 1;
         ny_ = static_cast<int>(extent.y / cell_) + 1;
-        cells_.assign(static_cast<Index>(nx_) * static_cast<Index>(ny_), {});
-        for (int i = 0; i < static_cast<int>(segs_.size()); ++i) {
-            const Seg& s = segs_[static_cast<Index>(i)];
-            const auto [x0, y0] = cell_of(glm::min(s.p0, s.p1));
-            const auto [x1, y1] = cell_of(glm::max(s.p0, s.p1));
-            for (int y = y0; y <= y1; ++y)
-                for (int x = x0; x <= x1; ++x) cells_[static_cast<Index>(y * nx_ + x)].push_back(i);
-        }
+        // Cells in one array: cell c holds cells_[start_[c] .. start_[c + 1]), segments in order.
+        start_.assign(static_cast<Index>(nx_) * static_cast<Index>(ny_) + 1, 0);
+        for (const Seg& s : segs_) for_cells(s, [&](Index c) { ++start_[c + 1]; });
+        for (Index c = 1; c < start_.size(); ++c) start_[c] += start_[c - 1];
+        cells_.resize(static_cast<Index>(start_.back()));
+        std::vector<int> next(start_.begin(), start_.end() - 1);
+        for (int i = 0; i < static_cast<int>(segs_.size()); ++i)
+            for_cells(segs_[static_cast<Index>(i)], [&](Index c) { cells_[static_cast<Index>(next[c]++)] = i; });
     }
 
-    /// Calls f(seg_i, seg_j) once for each pair of segments whose boxes share a cell.
+    /// Calls f(seg_i, seg_j) once for each pair of segments whose boxes share a cell, in
+    /// increasing (i, j) order, i < j.
     template <typename F>
     void for_each_candidate(F&& f) const
     {
-        std::vector<std::pair<int, int>> pairs;
-        for (const auto& cell : cells_)
-            for (Index i = 0; i < cell.size(); ++i)
-                for (Index j = i + 1; j < cell.size(); ++j) {
-                    // Bounded work and memory on any input (a dense scribble in one spot).
-                    if (pairs.size() >= 20000000)
-                        throw InvalidInput("the lobe's strokes are too densely tangled to mesh");
-                    pairs.emplace_back(std::min(cell[i], cell[j]), std::max(cell[i], cell[j]));
-                }
-        std::sort(pairs.begin(), pairs.end());
-        pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-        for (const auto& [i, j] : pairs) f(segs_[static_cast<Index>(i)], segs_[static_cast<Index>(j)]);
+        // Bounded work and memory on any input (a dense scribble in one spot).
+        std::size_t total = 0;
+        for (Index c = 0; c + 1 < start_.size(); ++c) {
+            const std::size_t k = static_cast<std::size_t>(start_[c + 1] - start_[c]);
+            total += k * (k - (k > 0 ? 1 : 0)) / 2;
+        }
+        if (total > 20000000) throw InvalidInput("the lobe's strokes are too densely tangled to mesh");
+        std::vector<int> others;
+        for (int i = 0; i < static_cast<int>(segs_.size()); ++i) {
+            others.clear();
+            for_cells(segs_[static_cast<Index>(i)], [&](Index c) {
+                // Cells list their segments in increasing order.
+                for (int k = start_[c + 1] - 1; k >= start_[c] && cells_[static_cast<Index>(k)] > i; --k)
+                    others.push_back(cells_[static_cast<Index>(k)]);
+            });
+            std::sort(others.begin(), others.end());
+            others.erase(std::unique(others.begin(), others.end()), others.end());
+            for (int j : others) f(segs_[static_cast<Index>(i)], segs_[static_cast<Index>(j)]);
+        }
     }
 
 private:
+    template <typename F>
+    void for_cells(const Seg& s, F&& f) const
+    {
+        const auto [x0, y0] = cell_of(glm::min(s.p0, s.p1));
+        const auto [x1, y1] = cell_of(glm::max(s.p0, s.p1));
+        for (int y = y0; y <= y1; ++y)
+            for (int x = x0; x <= x1; ++x) f(static_cast<Index>(y * nx_ + x));
+    }
     std::pair<int, int> cell_of(const glm::dvec2& p) const
     {
         const int x = std::clamp(static_cast<int>((p.x - lo_.x) / cell_), 0, nx_ - 1);
@@ -203,7 +222,45 @@ private:
     glm::dvec2 lo_;
     double cell_ = 1;
     int nx_ = 1, ny_ = 1;
-    std::vector<std::vector<int>> cells_;
+    std::vector<int> start_, cells_;
+};
+
+/// Neighbours of every node, sorted and without repeats, in one array.
+struct Adjacency {
+    struct Range {
+        const int* b;
+        const int* e;
+        const int* begin() const { return b; }
+        const int* end() const { return e; }
+        bool empty() const { return b == e; }
+        Index size() const { return static_cast<Index>(e - b); }
+        int operator[](Index k) const { return b[k]; }
+    };
+    std::vector<int> start, list;
+
+    Adjacency(Index n, const std::vector<std::array<int, 3>>& triangles) : start(n + 1, 0)
+    {
+        for (const auto& t : triangles)
+            for (int id : t) start[static_cast<Index>(id) + 1] += 2;
+        for (Index i = 0; i < n; ++i) start[i + 1] += start[i];
+        std::vector<int> raw(static_cast<Index>(start[n]));
+        std::vector<int> next(start.begin(), start.end() - 1);
+        for (const auto& t : triangles)
+            for (Index k = 0; k < 3; ++k) {
+                const Index a = static_cast<Index>(t[k]), b = static_cast<Index>(t[(k + 1) % 3]);
+                raw[static_cast<Index>(next[a]++)] = t[(k + 1) % 3];
+                raw[static_cast<Index>(next[b]++)] = t[k];
+            }
+        list.reserve(raw.size());
+        for (Index i = 0; i < n; ++i) {
+            const auto b = raw.begin() + start[i], e = raw.begin() + start[i + 1];
+            std::sort(b, e);
+            start[i] = static_cast<int>(list.size());
+            list.insert(list.end(), b, std::unique(b, e));
+        }
+        start[n] = static_cast<int>(list.size());
+    }
+    Range operator[](Index i) const { return {list.data() + start[i], list.data() + start[i + 1]}; }
 };
 
 /// Everything one build needs.
@@ -230,9 +287,11 @@ private:
     void find_paper_regions();
     void refine();
     void seed_fill(double max_edge, int& added);
+    void insert_fill(const glm::dvec2& x, int region, VH& hint, int& added);
+    void insert_fill(const Node& n, const glm::dvec2& x, int region, VH& hint, int& added);
     void emit(LobeSurface& out);
     void solve_fill_radii(const std::vector<std::array<int, 3>>& triangles);
-    bool fit_radius_model(const std::vector<std::vector<int>>& adj, std::vector<double>& model) const;
+    bool fit_radius_model(const Adjacency& adj, std::vector<double>& model) const;
 
     int add_node(const Node& n)
     {
@@ -265,6 +324,7 @@ private:
     std::vector<char> paper_region_;               ///< per region: stitched with stitch_closed_closed
     std::vector<std::pair<int, int>> region_strokes_;
     int region_count_ = 0;
+    bool regions_stale_ = false;                   ///< faces' regions must be marked again
     int pole_node_ = -1;
     double max_piece_angle_ = 6.0 * M_PI / 180.0;
     double ring_angle_ = 0;
@@ -317,22 +377,43 @@ void Builder::choose_pole()
     const double golden = M_PI * (3.0 - std::sqrt(5.0));
     double best_dot = 2.0;
     glm::dvec3 best(0, 0, 1);
+    std::vector<glm::dvec3> all;
+    for (const auto& stroke : dirs_) all.insert(all.end(), stroke.begin(), stroke.end());
     auto max_dot = [&](const glm::dvec3& d, glm::dvec3* nearest) {
         double m = -2.0;
-        for (const auto& stroke : dirs_)
-            for (const glm::dvec3& u : stroke) {
-                const double c = glm::dot(u, d);
-                if (c > m) {
-                    m = c;
-                    if (nearest) *nearest = u;
-                }
+        for (const glm::dvec3& u : all) {
+            const double c = glm::dot(u, d);
+            if (c > m) {
+                m = c;
+                if (nearest) *nearest = u;
             }
+        }
         return m;
+    };
+    // A candidate is only of interest when its nearest sample is farther than the best
+    // one's: the scan stops at the first sample at least as near (`witness`), and the
+    // witnesses of the candidate's lattice neighbours (Fibonacci index steps) are tried first.
+    std::vector<int> witness(kCandidates, 0);
+    auto beaten = [&](const glm::dvec3& d, int& w) {
+        for (Index k = 0; k < all.size(); ++k)
+            if (glm::dot(all[k], d) >= best_dot) {
+                w = static_cast<int>(k);
+                return true;
+            }
+        return false;
     };
     for (int i = 0; i < kCandidates; ++i) {
         const double z = 1.0 - (2.0 * i + 1.0) / kCandidates;
         const double rr = std::sqrt(std::max(0.0, 1.0 - z * z));
         const glm::dvec3 d(rr * std::cos(golden * i), rr * std::sin(golden * i), z);
+        bool out = false;
+        for (int step : {1, 2, 3, 5, 8, 13, 21, 34, 55, 89})
+            if (i >= step && glm::dot(all[static_cast<Index>(witness[static_cast<Index>(i - step)])], d) >= best_dot) {
+                witness[static_cast<Index>(i)] = witness[static_cast<Index>(i - step)];
+                out = true;
+                break;
+            }
+        if (out || beaten(d, witness[static_cast<Index>(i)])) continue;
         const double m = max_dot(d, nullptr);
         if (m < best_dot) {
             best_dot = m;
@@ -344,7 +425,8 @@ void Builder::choose_pole()
         glm::dvec3 nearest(0.0);
         max_dot(best, &nearest);
         const glm::dvec3 trial = glm::normalize(best - step * (nearest - glm::dot(nearest, best) * best));
-        const double m = max_dot(trial, nullptr);
+        int w = 0;
+        const double m = beaten(trial, w) ? best_dot : max_dot(trial, nullptr);
         if (m < best_dot) {
             best_dot = m;
             best = trial;
@@ -576,20 +658,20 @@ void Builder::triangulate()
 
 void Builder::mark_regions()
 {
-    for (FH f : cdt_.all_face_handles()) f->info() = -1;
+    for (FH f : cdt_.all_face_handles()) f->info() = FaceInfo{};
     region_count_ = 0;
     std::vector<FH> stack;
     for (FH f : cdt_.finite_face_handles()) {
-        if (f->info() >= 0) continue;
-        f->info() = region_count_;
+        if (f->info().region >= 0) continue;
+        f->info().region = region_count_;
         stack.push_back(f);
         while (!stack.empty()) {
             FH g = stack.back();
             stack.pop_back();
             for (int i = 0; i < 3; ++i) {
                 FH h = g->neighbor(i);
-                if (cdt_.is_infinite(h) || h->info() >= 0 || cdt_.is_constrained(CDT::Edge(g, i))) continue;
-                h->info() = region_count_;
+                if (cdt_.is_infinite(h) || h->info().region >= 0 || cdt_.is_constrained(CDT::Edge(g, i))) continue;
+                h->info().region = region_count_;
                 stack.push_back(h);
             }
         }
@@ -611,7 +693,7 @@ void Builder::find_paper_regions()
     };
     std::vector<std::array<int, 2>> edge_counts(static_cast<Index>(region_count_), {0, 0});
     for (FH f : cdt_.finite_face_handles()) {
-        const Index r = static_cast<Index>(f->info());
+        const Index r = static_cast<Index>(f->info().region);
         auto& rs = region_strokes_[r];
         for (int i = 0; i < 3; ++i) {
             const int s = stroke_of(f->vertex(i));
@@ -642,6 +724,39 @@ void Builder::find_paper_regions()
     }
 }
 
+void Builder::insert_fill(const glm::dvec2& x, int region, VH& hint, int& added)
+{
+    Node n;
+    n.dir = glm::normalize(stereo_.to_sphere(x));
+    insert_fill(n, x, region, hint, added);
+}
+
+void Builder::insert_fill(const Node& n, const glm::dvec2& x, int region, VH& hint, int& added)
+{
+    const int id = add_node(n);
+    node_vertex_.push_back(VH());
+    const K::Point_2 p(x.x, x.y);
+    const std::size_t before = cdt_.number_of_vertices();
+    VH v = hint == VH() ? cdt_.insert(p) : cdt_.insert(p, hint->face());
+    if (v->info().id < 0) v->info().id = id;
+    node_vertex_[static_cast<Index>(id)] = v;
+    hint = v;
+    ++added;
+    if (cdt_.number_of_vertices() == before) return; // an existing vertex: nothing changed
+    // Every face an insertion creates or changes is incident to the new vertex, and lies in
+    // the region of the point, unless the point fell on a stroke segment (which it then
+    // splits) or outside every region: then the regions are marked again before they are read.
+    if (region < 0 || cdt_.are_there_incident_constraints(v)) {
+        regions_stale_ = true;
+        return;
+    }
+    auto f = cdt_.incident_faces(v);
+    const auto done = f;
+    do {
+        if (!cdt_.is_infinite(f)) f->info() = FaceInfo{region, false};
+    } while (++f != done);
+}
+
 void Builder::seed_fill(double max_edge, int& added)
 {
     // Fill vertices on a Fibonacci lattice of directions about as dense as the largest
@@ -649,32 +764,43 @@ void Builder::seed_fill(double max_edge, int& added)
     // a new stroke only removes the lattice points near it.
     const double spacing = 0.85 * max_edge;
     const double clearance = 0.5 * spacing;
-    const double cell = clearance;
-    std::unordered_map<std::int64_t, std::vector<glm::dvec3>> grid;
-    auto key = [&](const glm::dvec3& d, int dx, int dy, int dz) {
-        const std::int64_t x = static_cast<std::int64_t>(std::floor(d.x / cell)) + dx + (1 << 20);
-        const std::int64_t y = static_cast<std::int64_t>(std::floor(d.y / cell)) + dy + (1 << 20);
-        const std::int64_t z = static_cast<std::int64_t>(std::floor(d.z / cell)) + dz + (1 << 20);
-        return (x << 42) | (y << 21) | z;
-    };
-    auto add = [&](const glm::dvec3& d) { grid[key(d, 0, 0, 0)].push_back(d); };
+    // Directions along every stroke, binned in a uniform grid over [-1, 1]³ whose cells are
+    // at least `clearance` wide: every direction within `clearance` of a lattice point lies
+    // in the point's cell or in a neighbouring one.
+    std::vector<glm::dvec3> along;
     for (Index s = 0; s < chains_.size(); ++s) {
         const auto& chain = chains_[s];
         const Index n = chain.size();
         const Index count = strokes_[s].closed ? n : n - 1;
-        add(nodes_[static_cast<Index>(chain[0])].dir);
+        along.push_back(nodes_[static_cast<Index>(chain[0])].dir);
         for (Index i = 0; i < count; ++i) {
             const glm::dvec3 a = nodes_[static_cast<Index>(chain[i])].dir;
             const glm::dvec3 b = nodes_[static_cast<Index>(chain[(i + 1) % n])].dir;
             const int steps = std::max(1, static_cast<int>(std::ceil(angle_between(a, b) / (0.25 * clearance))));
-            for (int k = 1; k <= steps; ++k) add(glm::normalize(a + (b - a) * (static_cast<double>(k) / steps)));
+            for (int k = 1; k <= steps; ++k) along.push_back(glm::normalize(a + (b - a) * (static_cast<double>(k) / steps)));
         }
+    }
+    const double cell = std::max(clearance, 2.0 / 48.0);
+    const int dim = static_cast<int>(std::floor(2.0 / cell)) + 1;
+    auto coord = [&](double c) { return std::clamp(static_cast<int>(std::floor((c + 1.0) / cell)), 0, dim - 1); };
+    auto cell_index = [&](int x, int y, int z) { return (static_cast<Index>(z) * static_cast<Index>(dim) + static_cast<Index>(y)) * static_cast<Index>(dim) + static_cast<Index>(x); };
+    std::vector<int> start(static_cast<Index>(dim) * static_cast<Index>(dim) * static_cast<Index>(dim) + 1, 0);
+    for (const glm::dvec3& d : along) ++start[cell_index(coord(d.x), coord(d.y), coord(d.z)) + 1];
+    for (Index i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+    std::vector<glm::dvec3> binned(along.size());
+    {
+        std::vector<int> next(start.begin(), start.end() - 1);
+        for (const glm::dvec3& d : along) binned[static_cast<Index>(next[cell_index(coord(d.x), coord(d.y), coord(d.z))]++)] = d;
     }
     const double cos_clear = std::cos(clearance);
     const double ring_keep = std::cos(ring_angle_ + clearance);
     const int count = static_cast<int>(std::ceil(4.0 * M_PI / (spacing * spacing * 0.866)));
     const double golden = M_PI * (3.0 - std::sqrt(5.0));
-    std::vector<glm::dvec3> candidates;
+    struct Candidate {
+        glm::dvec3 dir;
+        int region; ///< -1: not located inside a face
+    };
+    std::vector<Candidate> candidates;
     FH hint_face;
     for (int i = 0; i < count; ++i) {
         const double z = 1.0 - (2.0 * i + 1.0) / count;
@@ -682,40 +808,36 @@ void Builder::seed_fill(double max_edge, int& added)
         const glm::dvec3 d(rr * std::cos(golden * i), rr * std::sin(golden * i), z);
         if (glm::dot(d, stereo_.pole) > ring_keep) continue;
         bool near = false;
-        for (int dx = -1; dx <= 1 && !near; ++dx)
-            for (int dy = -1; dy <= 1 && !near; ++dy)
-                for (int dz = -1; dz <= 1 && !near; ++dz) {
-                    auto it = grid.find(key(d, dx, dy, dz));
-                    if (it == grid.end()) continue;
-                    for (const glm::dvec3& u : it->second)
-                        if (glm::dot(u, d) > cos_clear) {
+        const int cx = coord(d.x), cy = coord(d.y), cz = coord(d.z);
+        for (int z2 = std::max(0, cz - 1); z2 <= std::min(dim - 1, cz + 1) && !near; ++z2)
+            for (int y2 = std::max(0, cy - 1); y2 <= std::min(dim - 1, cy + 1) && !near; ++y2)
+                for (int x2 = std::max(0, cx - 1); x2 <= std::min(dim - 1, cx + 1) && !near; ++x2) {
+                    const Index c = cell_index(x2, y2, z2);
+                    for (int k = start[c]; k < start[c + 1]; ++k)
+                        if (glm::dot(binned[static_cast<Index>(k)], d) > cos_clear) {
                             near = true;
                             break;
                         }
                 }
         if (near) continue;
-        // Located before any fill vertex goes in (faces made by insertion carry no region).
+        // Located before any fill vertex goes in.
         const glm::dvec2 x = stereo_.to_plane(d);
         const K::Point_2 p(x.x, x.y);
-        hint_face = cdt_.locate(p, hint_face);
-        if (hint_face != FH() && !cdt_.is_infinite(hint_face) && hint_face->info() >= 0 &&
-            static_cast<Index>(hint_face->info()) < paper_region_.size() && paper_region_[static_cast<Index>(hint_face->info())])
+        CDT::Locate_type lt;
+        int li = 0;
+        hint_face = cdt_.locate(p, lt, li, hint_face);
+        const bool inside = hint_face != FH() && !cdt_.is_infinite(hint_face) && hint_face->info().region >= 0;
+        if (inside && static_cast<Index>(hint_face->info().region) < paper_region_.size() &&
+            paper_region_[static_cast<Index>(hint_face->info().region)])
             continue;
-        candidates.push_back(d);
+        candidates.push_back({d, inside && lt == CDT::FACE ? hint_face->info().region : -1});
     }
     VH hint;
-    for (const glm::dvec3& d : candidates) {
+    for (const Candidate& c : candidates) {
         if (added >= options_.max_fill_vertices) break;
         Node n;
-        n.dir = d;
-        const int id = add_node(n);
-        node_vertex_.push_back(VH());
-        const glm::dvec2 x = stereo_.to_plane(d);
-        VH v = cdt_.insert(K::Point_2(x.x, x.y), hint == VH() ? FH() : hint->face());
-        if (v->info().id < 0) v->info().id = id;
-        node_vertex_[static_cast<Index>(id)] = v;
-        hint = v;
-        ++added;
+        n.dir = c.dir;
+        insert_fill(n, stereo_.to_plane(c.dir), c.region, hint, added);
     }
 }
 
@@ -726,32 +848,57 @@ void Builder::refine()
     const double by_edge = options_.fill_edge_m / r;
     const double max_angle = std::max(1e-3, std::min(by_sagitta, by_edge));
     const double max_edge = std::sqrt(3.0) * max_angle;
+    // A side whose chord is below this spans less than max_edge (with a margin far above
+    // rounding), so most triangles are passed without an arcsine.
+    const double short_chord = 2.0 * std::sin(0.5 * max_edge) * (1.0 - 1e-9);
     int added = 0;
     auto dir_of = [&](VH v) {
         const int id = v->info().id;
         if (id >= 0) return nodes_[static_cast<Index>(id)].dir;
         return glm::normalize(stereo_.to_sphere({v->point().x(), v->point().y()}));
     };
+    // Regions are marked once; fill vertices inserted into a region keep its faces tagged
+    // (insert_fill), and faces found fine in one pass are not looked at again until an
+    // insertion changes them. Neither changes which points a pass adds.
     mark_regions();
     find_paper_regions();
+    regions_stale_ = false;
     seed_fill(max_edge, added);
     for (int pass = 0; pass < 4; ++pass) {
-        mark_regions();
-        find_paper_regions();
-        std::vector<glm::dvec2> points;
+        if (regions_stale_) {
+            mark_regions();
+            find_paper_regions();
+            regions_stale_ = false;
+        }
+        std::vector<std::pair<glm::dvec2, int>> points; // (where, region)
         for (FH f : cdt_.finite_face_handles()) {
-            const int region = f->info();
-            if (paper_region_[static_cast<Index>(region)]) continue;
+            if (f->info().fine) continue;
+            const int region = f->info().region;
+            if (paper_region_[static_cast<Index>(region)]) {
+                f->info().fine = true;
+                continue;
+            }
             const glm::dvec3 a = dir_of(f->vertex(0)), b = dir_of(f->vertex(1)), c = dir_of(f->vertex(2));
             // Too large: a free side longer than that of an equilateral triangle with the
             // largest circumradius allowed.
             // Stroke segments are never split here (remeshing splits them), so only free sides count.
             const std::array<glm::dvec3, 3> d{a, b, c};
+            double chord = 0;
+            for (int i = 0; i < 3; ++i)
+                if (!cdt_.is_constrained(CDT::Edge(f, i)))
+                    chord = std::max(chord, glm::length(d[static_cast<Index>((i + 1) % 3)] - d[static_cast<Index>((i + 2) % 3)]));
+            if (chord < short_chord) {
+                f->info().fine = true;
+                continue;
+            }
             double longest = 0;
             for (int i = 0; i < 3; ++i)
                 if (!cdt_.is_constrained(CDT::Edge(f, i)))
                     longest = std::max(longest, angle_between(d[static_cast<Index>((i + 1) % 3)], d[static_cast<Index>((i + 2) % 3)]));
-            if (longest <= max_edge) continue;
+            if (longest <= max_edge) {
+                f->info().fine = true;
+                continue;
+            }
             // The circumcentre (Delaunay refinement) when the triangle is not a sliver and its
             // circumcentre lies in the same region, else the centroid, which is inside the
             // triangle: no stroke is crossed either way.
@@ -763,36 +910,32 @@ void Builder::refine()
                 CDT::Locate_type lt;
                 int li = 0;
                 FH located = cdt_.locate(cc, lt, li, f);
-                use_cc = lt == CDT::FACE && !cdt_.is_infinite(located) && located->info() == region;
+                use_cc = lt == CDT::FACE && !cdt_.is_infinite(located) && located->info().region == region;
             }
             if (use_cc) {
-                points.emplace_back(cc.x(), cc.y());
+                points.emplace_back(glm::dvec2(cc.x(), cc.y()), region);
             } else {
                 glm::dvec2 x(0.0);
                 for (int i = 0; i < 3; ++i) x += glm::dvec2(f->vertex(i)->point().x(), f->vertex(i)->point().y());
-                points.push_back(x / 3.0);
+                points.emplace_back(x / 3.0, region);
             }
         }
         if (points.empty()) break;
         VH hint;
-        for (const glm::dvec2& x : points) {
+        for (const auto& [x, region] : points) {
             if (added >= options_.max_fill_vertices) break;
-            Node n;
-            n.dir = glm::normalize(stereo_.to_sphere(x));
-            const int id = add_node(n);
-            node_vertex_.push_back(VH());
-            const K::Point_2 p(x.x, x.y);
-            VH v = hint == VH() ? cdt_.insert(p) : cdt_.insert(p, hint->face());
-            if (v->info().id < 0) v->info().id = id;
-            node_vertex_[static_cast<Index>(id)] = v;
-            hint = v;
-            ++added;
+            insert_fill(x, region, hint, added);
         }
         if (added >= options_.max_fill_vertices) break;
     }
-    // Paper regions may have been renumbered: find them again on the final triangulation.
-    mark_regions();
-    find_paper_regions();
+    // The output emits paper regions in region order (regions numbered by their first face):
+    // with any paper region, or when an insertion left the regions stale, they are marked
+    // again on the final triangulation. Otherwise the tags kept up by insert_fill are exact.
+    if (regions_stale_ || std::find(paper_region_.begin(), paper_region_.end(), 1) != paper_region_.end()) {
+        mark_regions();
+        find_paper_regions();
+        regions_stale_ = false;
+    }
 }
 
 void Builder::solve_fill_radii(const std::vector<std::array<int, 3>>& triangles)
@@ -814,17 +957,12 @@ void Builder::solve_fill_radii(const std::vector<std::array<int, 3>>& triangles)
     for (Index i = 0; i < n; ++i)
         if (nodes_[i].origin.kind == LobeVertexKind::Fill) unknown[i] = count++;
     if (count == 0) return;
-    std::vector<std::vector<int>> adj(n);
-    for (const auto& t : triangles)
-        for (int k = 0; k < 3; ++k) {
-            adj[static_cast<Index>(t[static_cast<Index>(k)])].push_back(t[static_cast<Index>((k + 1) % 3)]);
-            adj[static_cast<Index>(t[static_cast<Index>((k + 1) % 3)])].push_back(t[static_cast<Index>(k)]);
-        }
+    const Adjacency adj(n, triangles);
     // Rows of L over the free columns (b: the fixed columns' part of each row), weighted by
     // inverse angular edge length so long strip edges and short cap edges measure slope alike.
     auto solve = [&](bool biharmonic, Eigen::VectorXd& x) {
         std::vector<Eigen::Triplet<double>> entries;
-        std::vector<double> fixed_part, sums;
+        std::vector<double> fixed_part, sums, w;
         int rows = 0;
         for (Index i = 0; i < n; ++i) {
             const auto& nb = adj[i];
@@ -833,7 +971,7 @@ void Builder::solve_fill_radii(const std::vector<std::array<int, 3>>& triangles)
             bool touches_free = unknown[i] >= 0;
             for (int j : nb) touches_free = touches_free || unknown[static_cast<Index>(j)] >= 0;
             if (!touches_free) continue;
-            std::vector<double> w(nb.size());
+            w.assign(nb.size(), 0.0);
             double sum = 0;
             for (Index k = 0; k < nb.size(); ++k) {
                 w[k] = 1.0 / std::max(1e-6, angle_between(nodes_[i].dir, nodes_[static_cast<Index>(nb[k])].dir));
@@ -869,11 +1007,6 @@ void Builder::solve_fill_radii(const std::vector<std::array<int, 3>>& triangles)
         }
         return solver_ok(x);
     };
-    for (Index i = 0; i < n; ++i) {
-        auto& nb = adj[i];
-        std::sort(nb.begin(), nb.end());
-        nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
-    }
     double lo = std::numeric_limits<double>::infinity(), hi = 0;
     for (Index i = 0; i < n; ++i)
         if (unknown[i] < 0 && !adj[i].empty()) {
@@ -904,7 +1037,7 @@ void Builder::solve_fill_radii(const std::vector<std::array<int, 3>>& triangles)
         }
 }
 
-bool Builder::fit_radius_model(const std::vector<std::vector<int>>& adj, std::vector<double>& model) const
+bool Builder::fit_radius_model(const Adjacency& adj, std::vector<double>& model) const
 {
     // Monomials x^a y^b z^c of the direction, a + b + c ≤ 3: 20 functions spanning the
     // spherical harmonics up to degree 3 on the sphere.
@@ -929,12 +1062,24 @@ bool Builder::fit_radius_model(const std::vector<std::vector<int>>& adj, std::ve
     Eigen::VectorXd atb = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(k));
     Eigen::VectorXd phi(static_cast<Eigen::Index>(k));
     double samples = 0;
+    // The normal equations, upper triangle only (the products are symmetric exactly).
+    std::array<double, 20 * 20> upper{};
+    std::array<double, 20> rhs{};
     for (Index i = 0; i < nodes_.size(); ++i) {
         if (nodes_[i].origin.kind == LobeVertexKind::Fill || adj[i].empty()) continue;
         basis(nodes_[i].dir, phi);
-        ata.noalias() += phi * phi.transpose();
-        atb.noalias() += phi * nodes_[i].radius;
+        const double* f = phi.data();
+        for (Index c = 0; c < k; ++c) {
+            for (Index r = 0; r <= c; ++r) upper[c * k + r] += f[c] * f[r];
+            rhs[c] += f[c] * nodes_[i].radius;
+        }
         samples += 1;
+    }
+    for (Index c = 0; c < k; ++c) {
+        for (Index r = 0; r <= c; ++r)
+            ata(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) =
+                ata(static_cast<Eigen::Index>(c), static_cast<Eigen::Index>(r)) = upper[c * k + r];
+        atb(static_cast<Eigen::Index>(c)) = rhs[c];
     }
     if (samples < static_cast<double>(k)) return false;
     // Penalty growing with degree (d(d+1))², scaled to the number of samples.
@@ -1011,7 +1156,7 @@ void Builder::emit(LobeSurface& out)
         tris.insert(tris.end(), region.begin(), region.end());
     }
     for (FH f : cdt_.finite_face_handles()) {
-        if (paper_region_[static_cast<Index>(f->info())]) continue;
+        if (paper_region_[static_cast<Index>(f->info().region)]) continue;
         // Planar counter-clockwise is clockwise seen from outside the sphere.
         tris.push_back({node_of(f->vertex(0)), node_of(f->vertex(2)), node_of(f->vertex(1))});
     }
