@@ -2,7 +2,10 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <limits>
 #include <type_traits>
+#include <unordered_set>
 
 #include "core/atomic_file.h"
 #include "core/errors.h"
@@ -13,11 +16,22 @@ using nlohmann::json;
 
 namespace {
 
-// Upper bounds on what a document may hold; a file beyond them is refused.
-constexpr std::size_t kMaxStrokes = 100000;
-constexpr std::size_t kMaxPointsPerStroke = 1000000;
+/// "N LIST, more than the LIMIT a session may hold" (the document limits, docs/limits.md).
+std::string too_many(std::size_t n, std::size_t limit, const char* what)
+{
+    return std::to_string(n) + " " + what + ", more than the " + std::to_string(limit) + " a session may hold";
+}
 
 json rgb_json(const double (&c)[3]) { return json::array({c[0], c[1], c[2]}); }
+
+/// A JSON number as float. A number beyond the float range becomes ±infinity (casting such a
+/// double is undefined), which every caller then refuses as not finite.
+float json_float(const json& v)
+{
+    const double d = v.get<double>();
+    if (std::abs(d) <= static_cast<double>(std::numeric_limits<float>::max())) return static_cast<float>(d);
+    return d < 0 ? -std::numeric_limits<float>::infinity() : std::numeric_limits<float>::infinity();
+}
 
 } // namespace
 
@@ -324,7 +338,7 @@ LobeModel lobe_model_from_json(const json& j, const std::string& w)
     for (std::size_t i = 0; i < p->size(); ++i) {
         const json& v = (*p)[i];
         if (!v.is_number()) throw InvalidInput(w + ".positions: expected numbers");
-        m.mesh.positions[i / 3][static_cast<int>(i % 3)] = static_cast<float>(v.get<double>());
+        m.mesh.positions[i / 3][static_cast<int>(i % 3)] = json_float(v);
     }
     const auto t = j.find("triangles");
     if (t == j.end() || !t->is_array() || t->size() % 3 != 0)
@@ -360,7 +374,11 @@ Stroke stroke_from_json(const json& j, const std::string& where)
     s.id = read_id(j, "id", where);
     auto kind = j.find("kind");
     if (kind == j.end() || !kind->is_string()) throw InvalidInput(where + ".kind: expected a string");
-    s.kind = stroke_kind_from_name(kind->get<std::string>());
+    try {
+        s.kind = stroke_kind_from_name(kind->get<std::string>());
+    } catch (const InvalidInput& e) {
+        throw InvalidInput(where + ".kind: " + e.what());
+    }
     if (auto h = j.find("hand"); h != j.end()) {
         if (!h->is_string() || (*h != "left" && *h != "right"))
             throw InvalidInput(where + ".hand: expected \"left\" or \"right\"");
@@ -372,7 +390,8 @@ Stroke stroke_from_json(const json& j, const std::string& where)
     }
     auto pts = j.find("points");
     if (pts == j.end() || !pts->is_array()) throw InvalidInput(where + ".points: expected an array");
-    if (pts->size() > kMaxPointsPerStroke) throw InvalidInput(where + ".points: too many points");
+    if (pts->size() > kMaxStrokePoints)
+        throw InvalidInput(where + ".points: " + too_many(pts->size(), kMaxStrokePoints, "points"));
     const json* times = nullptr;
     if (auto t = j.find("times"); t != j.end()) {
         if (!t->is_array() || t->size() != pts->size())
@@ -385,7 +404,7 @@ Stroke stroke_from_json(const json& j, const std::string& where)
         if (!p.is_array() || p.size() != 3 || !p[0].is_number() || !p[1].is_number() || !p[2].is_number())
             throw InvalidInput(where + ".points[" + std::to_string(i) + "]: expected [x, y, z]");
         StrokePoint sp;
-        sp.position = {p[0].get<float>(), p[1].get<float>(), p[2].get<float>()};
+        sp.position = {json_float(p[0]), json_float(p[1]), json_float(p[2])};
         if (!std::isfinite(sp.position.x) || !std::isfinite(sp.position.y) || !std::isfinite(sp.position.z))
             throw InvalidInput(where + ".points[" + std::to_string(i) + "]: not finite");
         if (times) {
@@ -394,6 +413,7 @@ Stroke stroke_from_json(const json& j, const std::string& where)
         }
         s.points.push_back(sp);
     }
+    if (const std::string why = stroke_points_problem(s); !why.empty()) throw InvalidInput(where + ".points: " + why);
     return s;
 }
 
@@ -531,8 +551,8 @@ json document_to_json(const Document& doc)
             for (int r = 0; r < 4; ++r) m.push_back(t.transform[c][r]);
         trees.push_back({{"id", t.id}, {"transform", m}, {"seed", t.seed}, {"lobes", t.lobe_ids}});
     }
-    return json{{"format", "lobesketch-session"},
-                {"version", doc.version},
+    json out{{"format", "lobesketch-session"},
+             {"version", doc.version},
                 {"source_recording", doc.source_recording},
                 {"seed", doc.seed},
                 {"settings", settings_to_json(doc.settings)},
@@ -540,6 +560,12 @@ json document_to_json(const Document& doc)
                 {"lobes", std::move(lobes)},
                 {"edits", std::move(edits)},
                 {"trees", std::move(trees)}};
+    // Where in source_recording this document stands (docs/crash-safety.md).
+    if (doc.recording_frames) {
+        out["recording_frames"] = *doc.recording_frames;
+        if (doc.recording_finished) out["recording_finished"] = true;
+    }
+    return out;
 }
 
 Document document_from_json(const json& j)
@@ -550,14 +576,30 @@ Document document_from_json(const json& j)
         throw InvalidInput("not a session document (missing \"format\": \"lobesketch-session\")");
     auto ver = j.find("version");
     if (ver == j.end() || !ver->is_number_integer()) throw InvalidInput("version: expected an integer");
-    int version = ver->get<int>();
+    // Read wide: a version beyond int must not wrap into a supported one.
+    const bool huge = ver->is_number_unsigned() && ver->get<std::uint64_t>() > std::uint64_t{1} << 32;
+    const std::int64_t version = huge ? -1 : ver->get<std::int64_t>();
     if (version < 1 || version > kDocumentVersion)
-        throw InvalidInput("unsupported session version " + std::to_string(version) + " (this build reads 1.." +
+        throw InvalidInput("unsupported session version " + ver->dump() + " (this build reads 1.." +
                            std::to_string(kDocumentVersion) + ")");
     Document doc;
     doc.version = kDocumentVersion;
-    if (auto it = j.find("source_recording"); it != j.end() && it->is_string())
+    if (auto it = j.find("source_recording"); it != j.end()) {
+        if (!it->is_string()) throw InvalidInput("source_recording: expected a string");
         doc.source_recording = it->get<std::string>();
+    }
+    if (auto it = j.find("recording_frames"); it != j.end()) {
+        if (!it->is_number_integer() || it->get<std::int64_t>() < 0 ||
+            it->get<std::uint64_t>() > kMaxDocumentRecordingFrames)
+            throw InvalidInput("recording_frames: expected an integer in [0, " +
+                               std::to_string(kMaxDocumentRecordingFrames) + "]");
+        doc.recording_frames = it->get<std::uint64_t>();
+    }
+    if (auto it = j.find("recording_finished"); it != j.end()) {
+        if (!it->is_boolean()) throw InvalidInput("recording_finished: expected true or false");
+        if (*it && !doc.recording_frames) throw InvalidInput("recording_finished: needs recording_frames");
+        doc.recording_finished = it->get<bool>();
+    }
     if (auto it = j.find("seed"); it != j.end()) {
         if (!it->is_number_unsigned()) throw InvalidInput("seed: expected a non-negative integer");
         doc.seed = it->get<std::uint64_t>();
@@ -571,25 +613,38 @@ Document document_from_json(const json& j)
         return &*it;
     };
     if (const json* a = array_of("strokes")) {
-        if (a->size() > kMaxStrokes) throw InvalidInput("strokes: too many strokes");
-        for (std::size_t i = 0; i < a->size(); ++i)
-            doc.strokes.push_back(stroke_from_json((*a)[i], "strokes[" + std::to_string(i) + "]"));
+        if (a->size() > kMaxDocumentStrokes) throw InvalidInput("strokes: " + too_many(a->size(), kMaxDocumentStrokes, "strokes"));
+        std::unordered_set<std::int64_t> ids;
+        for (std::size_t i = 0; i < a->size(); ++i) {
+            const std::string w = "strokes[" + std::to_string(i) + "]";
+            doc.strokes.push_back(stroke_from_json((*a)[i], w));
+            if (!ids.insert(doc.strokes.back().id).second)
+                throw InvalidInput(w + ".id: stroke id " + std::to_string(doc.strokes.back().id) + " is used twice");
+        }
     }
     if (const json* a = array_of("lobes")) {
+        if (a->size() > kMaxDocumentLobes) throw InvalidInput("lobes: " + too_many(a->size(), kMaxDocumentLobes, "lobes"));
+        std::unordered_set<std::int64_t> ids;
         for (std::size_t i = 0; i < a->size(); ++i) {
             const json& l = (*a)[i];
             const std::string w = "lobes[" + std::to_string(i) + "]";
             if (!l.is_object()) throw InvalidInput(w + ": expected an object");
             LobeRecord r;
             r.id = read_id(l, "id", w);
+            if (!ids.insert(r.id).second) throw InvalidInput(w + ".id: lobe id " + std::to_string(r.id) + " is used twice");
             if (auto s = l.find("strokes"); s != l.end()) {
                 if (!s->is_array()) throw InvalidInput(w + ".strokes: expected an array of ids");
+                if (s->size() > kMaxDocumentStrokes)
+                    throw InvalidInput(w + ".strokes: " + too_many(s->size(), kMaxDocumentStrokes, "stroke ids"));
                 for (const json& id : *s) {
                     if (!id.is_number_integer()) throw InvalidInput(w + ".strokes: expected integer ids");
                     r.stroke_ids.push_back(id.get<std::int64_t>());
                 }
             }
-            if (auto m = l.find("mesh"); m != l.end() && m->is_string()) r.mesh_file = m->get<std::string>();
+            if (auto m = l.find("mesh"); m != l.end()) {
+                if (!m->is_string()) throw InvalidInput(w + ".mesh: expected a file name");
+                r.mesh_file = m->get<std::string>();
+            }
             read_number_in_range(l, "split_angle_deg", 5.0, 180.0, r.split_angle_deg, w);
             if (auto sp = l.find("species"); sp != l.end()) {
                 if (!sp->is_string() || sp->get<std::string>().size() > 64)
@@ -615,6 +670,7 @@ Document document_from_json(const json& j)
         }
     }
     if (const json* a = array_of("edits")) {
+        if (a->size() > kMaxDocumentEdits) throw InvalidInput("edits: " + too_many(a->size(), kMaxDocumentEdits, "edits"));
         for (std::size_t i = 0; i < a->size(); ++i) {
             const json& e = (*a)[i];
             const std::string w = "edits[" + std::to_string(i) + "]";
@@ -630,6 +686,7 @@ Document document_from_json(const json& j)
         }
     }
     if (const json* a = array_of("trees")) {
+        if (a->size() > kMaxDocumentTrees) throw InvalidInput("trees: " + too_many(a->size(), kMaxDocumentTrees, "trees"));
         for (std::size_t i = 0; i < a->size(); ++i) {
             const json& t = (*a)[i];
             const std::string w = "trees[" + std::to_string(i) + "]";
@@ -640,7 +697,7 @@ Document document_from_json(const json& j)
                 if (!m->is_array() || m->size() != 16) throw InvalidInput(w + ".transform: expected 16 numbers");
                 for (int k = 0; k < 16; ++k) {
                     if (!(*m)[k].is_number()) throw InvalidInput(w + ".transform: expected 16 numbers");
-                    float v = (*m)[k].get<float>();
+                    const float v = json_float((*m)[k]);
                     if (!std::isfinite(v)) throw InvalidInput(w + ".transform: not finite");
                     ti.transform[k / 4][k % 4] = v;
                 }
@@ -651,6 +708,8 @@ Document document_from_json(const json& j)
             }
             if (auto l = t.find("lobes"); l != t.end()) {
                 if (!l->is_array()) throw InvalidInput(w + ".lobes: expected an array of ids");
+                if (l->size() > kMaxDocumentLobes)
+                    throw InvalidInput(w + ".lobes: " + too_many(l->size(), kMaxDocumentLobes, "lobe ids"));
                 for (const json& id : *l) {
                     if (!id.is_number_integer()) throw InvalidInput(w + ".lobes: expected integer ids");
                     ti.lobe_ids.push_back(id.get<std::int64_t>());
@@ -677,6 +736,24 @@ Document load_document(const std::string& path)
     } catch (const InvalidInput& e) {
         throw FileError(path, e.what());
     }
+}
+
+std::string previous_autosave_path(const std::string& path) { return path + ".1"; }
+
+void save_autosave(const std::string& path, const Document& doc)
+{
+    // The file about to be replaced becomes the previous generation: a second name for it,
+    // moved into place by rename, so PATH.1 too is always a whole document.
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(path, ec)) {
+        const std::string previous = previous_autosave_path(path);
+        const std::string link = previous + ".tmp";
+        std::filesystem::remove(link, ec);
+        std::filesystem::create_hard_link(path, link, ec);
+        if (!ec) std::filesystem::rename(link, previous, ec);
+        if (ec) std::filesystem::remove(link, ec);
+    }
+    save_document(path, doc);
 }
 
 } // namespace lobe

@@ -83,6 +83,15 @@ struct TreeInstance {
 struct Document {
     int version = kDocumentVersion;
     std::string source_recording; ///< the recording this session was replayed from, if any
+    /// How much of source_recording the document holds: the actions derived from its first
+    /// recording_frames hand frames (and the events up to the last of them) are applied.
+    /// Written by live sessions at every save and autosave; absent when the document is not
+    /// a position in a recording. `lobesketch recover` replays the rest (docs/crash-safety.md).
+    std::optional<std::uint64_t> recording_frames;
+    /// Set with recording_frames when the recording had ended when the document was saved:
+    /// the actions of its end (events after the last frame, strokes still being drawn) are
+    /// applied too, so nothing of that recording is left to replay.
+    bool recording_finished = false;
     std::uint64_t seed = 1;
     Settings settings;
     std::vector<Stroke> strokes;
@@ -121,7 +130,26 @@ void save_document(const std::string& path, const Document& doc);
 /// \throw FileError with a one-line reason naming the file.
 Document load_document(const std::string& path);
 
+/// The previous generation of an autosave: "PATH.1".
+std::string previous_autosave_path(const std::string& path);
+/// Saves an autosave as save_document does, first keeping the file it replaces as
+/// previous_autosave_path(path) (a hard link, renamed into place: that file too is always a
+/// whole document). Keeping the previous generation is best effort; the save itself throws.
+/// \throw FileError
+void save_autosave(const std::string& path, const Document& doc);
+
+/// Most frames recording_frames may say (far above any recording's frame limit).
+inline constexpr std::uint64_t kMaxDocumentRecordingFrames = 1u << 31;
+
 /// Largest session file the loader accepts.
 inline constexpr std::size_t kMaxDocumentBytes = 256u << 20;
+
+/// Most of each list a session document may hold (docs/limits.md): the reader refuses a
+/// document beyond them, naming the list, and the session builder refuses to add past them.
+/// Each stroke holds at most kMaxStrokePoints points (core/stroke.h).
+inline constexpr std::size_t kMaxDocumentStrokes = 100000;
+inline constexpr std::size_t kMaxDocumentLobes = 1000;   ///< each is rebuilt and remeshed on load
+inline constexpr std::size_t kMaxDocumentEdits = 20000;  ///< each pinch edit is a Laplacian solve on replay
+inline constexpr std::size_t kMaxDocumentTrees = 1000;
 
 } // namespace lobe

@@ -2,6 +2,7 @@
 /// \file stroke.h
 /// A stroke: the fingertip path between pen-down and pen-up, in metres.
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -35,5 +36,22 @@ struct Stroke {
     /// Polyline length in metres.
     double length() const;
 };
+
+/// What one stroke of a session may hold (docs/limits.md). The document reader and the
+/// session builder refuse a stroke beyond them; the meshing stages have their own, tighter
+/// limits (meshing/polyline.h).
+inline constexpr std::size_t kMinStrokePoints = 2;
+inline constexpr std::size_t kMaxStrokePoints = 1000000;
+inline constexpr double kMaxStrokeCoordinateM = 1000.0; ///< along each axis, from the stage origin
+
+/// Empty when every point of `stroke` is usable (kMinStrokePoints to kMaxStrokePoints
+/// points, every coordinate and time finite, every coordinate within kMaxStrokeCoordinateM);
+/// else why not, one line, e.g. "point 3 has a coordinate that is not finite".
+std::string stroke_points_problem(const Stroke& stroke);
+
+/// True when the stroke's points all coincide or all lie on one straight line (within 10⁻⁵
+/// of its extent, the rule of meshing's check_stroke_points): such a stroke cannot bound a
+/// lobe. Points must be finite.
+bool stroke_is_straight(const Stroke& stroke);
 
 } // namespace lobe

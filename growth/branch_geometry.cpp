@@ -722,8 +722,28 @@ void build_tree_geometry_into(TreeGeometry& geo, const TreeGraph& graph, const B
     const TreeGraph clean = merge_coincident_nodes(graph);
     const std::vector<BranchChain> chains = decompose_branch_chains(clean);
     const std::vector<BranchCurve> curves = smooth_branch_curves(clean, chains, std::max(0, branches.smoothing_iterations));
-    const LeafCloud cloud = make_leaf_cloud(graph, leaves, seed, lobe_leaves);
     const CurveMetrics metrics = curve_metrics(curves);
+
+    // LOD0's rings, and what LOD0 would hold before anything is allocated for it
+    // (kMaxTreeTriangles): two triangles per ring segment per radial segment, two per leaf.
+    std::vector<RingSample> samples;
+    std::vector<RingRange> ranges;
+    const BranchMeshOptions lod0 = branch_lod_options(branches, 0);
+    sample_all_rings(curves, metrics, lod0, samples, ranges);
+    {
+        // Leaves: at most the most leaves per tip (the tree's or a lobe's) at every tip.
+        int most = std::max(0, leaves.per_node);
+        for (const LobeLeafOverride& o : lobe_leaves) most = std::max(most, o.per_node.value_or(0));
+        const double leaf_count = most > 0 ? static_cast<double>(leaf_tip_nodes(graph).size()) * most : 0.0;
+        double triangles = 2.0 * leaf_count;
+        for (const RingRange& r : ranges)
+            if (r.count >= 2) triangles += 2.0 * lod0.radial_segments * (r.count - 1.0) + 2.0 * lod0.radial_segments;
+        if (triangles > static_cast<double>(kMaxTreeTriangles))
+            throw InvalidInput("tree geometry: LOD0 would have about " + std::to_string(static_cast<long long>(triangles)) +
+                               " triangles, more than the " + std::to_string(kMaxTreeTriangles) +
+                               " allowed (lower max_nodes, radial_segments or leaves per node)");
+    }
+    const LeafCloud cloud = make_leaf_cloud(graph, leaves, seed, lobe_leaves);
 
     // Nothing can throw past this point: `geo` is only changed when the whole build succeeds.
     geo.species = species;
@@ -735,14 +755,11 @@ void build_tree_geometry_into(TreeGeometry& geo, const TreeGraph& graph, const B
     geo.bark_texture = bark;
     geo.lods.resize(static_cast<std::size_t>(branches.lod_count));
 
-    std::vector<RingSample> samples;
-    std::vector<RingRange> ranges;
     CurveScratch scratch;
 
-    // LOD0: everything at full resolution.
+    // LOD0: everything at full resolution (its rings are sampled above).
     {
-        const BranchMeshOptions o = branch_lod_options(branches, 0);
-        sample_all_rings(curves, metrics, o, samples, ranges);
+        const BranchMeshOptions& o = lod0;
         sweep_curves(curves, samples, ranges, std::vector<char>(curves.size(), 1), o.radial_segments, geo.lods[0].branches,
                      scratch, nullptr);
         emit_leaf_quads(cloud, LeafLodOptions{}, geo.lods[0].leaves);

@@ -126,6 +126,10 @@ BranchMeshOptions branch_lod_options(const BranchSettings& branches, int lod);
 /// × 0.3 per further level (10 % below the 50 % and 15 % the LODs must stay under).
 double lod_triangle_budget(int lod);
 
+/// Most triangles LOD0 of a tree may have (branches and leaves), estimated from its rings and
+/// leaves before any mesh is built; a larger tree is refused (docs/limits.md).
+inline constexpr std::size_t kMaxTreeTriangles = 50000000;
+
 /// Builds the tree's branch and leaf geometry at branches.lod_count levels of detail, the
 /// leaf texture of leaves.shape, and the colours. LOD0 uses the settings as they are. Coarser
 /// LODs come from the same smoothed skeleton with the coarser resolution of
@@ -135,7 +139,8 @@ double lod_triangle_budget(int lod);
 /// LOD's budget) at the same tips, so the foliage keeps its area and silhouette.
 /// Deterministic: the same inputs give the same bytes.
 /// \throw InvalidInput on an invalid graph (see merge_coincident_nodes), lod_count outside
-/// [1, 6], radial_segments < 3, ring_spacing_m ≤ 0 or an unknown leaf shape.
+/// [1, 6], radial_segments < 3, ring_spacing_m ≤ 0, an unknown leaf shape, or a LOD0 beyond
+/// kMaxTreeTriangles.
 /// `lobe_leaves`: per-lobe leaf length, count and seed (make_leaf_cloud).
 TreeGeometry build_tree_geometry(const TreeGraph& graph, const BranchSettings& branches, const LeafSettings& leaves,
                                  std::uint64_t seed, const std::string& species = {},

@@ -414,7 +414,8 @@ std::vector<TreeNode> grow_in_lobe(const Skeleton& skeleton, int lobe_index, con
 }
 
 GrowthResult grow_tree(const std::vector<std::vector<glm::vec3>>& trunk_strokes, const std::vector<GrowthLobe>& lobes,
-                       const GrowthSettings& settings, const SubtreeLibrary& library, std::uint64_t seed)
+                       const GrowthSettings& settings, const SubtreeLibrary& library, std::uint64_t seed,
+                       std::size_t max_tree_nodes)
 {
     GrowthResult result;
     std::vector<TriangleMesh> meshes;
@@ -435,8 +436,19 @@ GrowthResult grow_tree(const std::vector<std::vector<glm::vec3>>& trunk_strokes,
     const std::size_t s = skeleton.graph.nodes.size();
     for (std::size_t l = 0; l < lobes.size(); ++l) {
         LobeGrowthStats stats;
+        // The whole tree's cap (kMaxTreeNodes): a lobe grows at most the nodes left under it.
+        const std::size_t left = max_tree_nodes - std::min(max_tree_nodes, result.tree.nodes.size());
+        if (left == 0) {
+            result.messages.push_back("lobe " + std::to_string(l + 1) + ": not grown, the tree already has " +
+                                      std::to_string(result.tree.nodes.size()) + " nodes (limit " +
+                                      std::to_string(max_tree_nodes) + ")");
+            result.lobes.push_back(stats);
+            continue;
+        }
+        GrowthSettings capped = settings;
+        if (static_cast<std::size_t>(capped.max_nodes) > left) capped.max_nodes = static_cast<int>(left);
         std::vector<TreeNode> nodes =
-            grow_in_lobe(skeleton, static_cast<int>(l), lobes[l], settings, library, seed, stats, &rays[l]);
+            grow_in_lobe(skeleton, static_cast<int>(l), lobes[l], capped, library, seed, stats, &rays[l]);
         const int offset = static_cast<int>(result.tree.nodes.size());
         for (TreeNode& n : nodes) {
             if (n.parent >= static_cast<int>(s)) n.parent = offset + (n.parent - static_cast<int>(s));
@@ -444,7 +456,7 @@ GrowthResult grow_tree(const std::vector<std::vector<glm::vec3>>& trunk_strokes,
         }
         if (stats.node_cap)
             result.messages.push_back("lobe " + std::to_string(l + 1) + ": node cap of " +
-                                      std::to_string(settings.max_nodes) + " reached; growth stopped early");
+                                      std::to_string(capped.max_nodes) + " reached; growth stopped early");
         if (stats.iteration_cap)
             result.messages.push_back("lobe " + std::to_string(l + 1) + ": iteration cap of " +
                                       std::to_string(settings.max_iterations) + " reached with attractors left");

@@ -61,6 +61,11 @@ struct GrowthResult {
 inline constexpr int kMaxPiecesPerNode = 256;
 /// A node grows at most this many times (once per iteration it is active in).
 inline constexpr int kMaxGrowthsPerNode = 4;
+/// Most nodes of a whole tree (skeleton and every lobe's growth): GrowthSettings::max_nodes
+/// caps each lobe, this caps their sum, so memory stays bounded however many lobes a session
+/// holds. A lobe grows at most the nodes left under it; lobes after the cap is reached are
+/// not grown, each with a message (docs/limits.md).
+inline constexpr std::size_t kMaxTreeNodes = 5000000;
 
 /// V_A = V_cluster + α·V_default + β·(0, −1, 0), unnormalised (§5.2).
 glm::dvec3 growth_vector(const glm::dvec3& v_cluster, const glm::dvec3& v_default, double alpha, double beta);
@@ -93,8 +98,10 @@ std::vector<TreeNode> grow_in_lobe(const Skeleton& skeleton, int lobe_index, con
 
 /// The whole tree: skeleton from the trunk strokes (or the default trunk), then every lobe's
 /// growth, merged into one graph rooted at the trunk base. Radii are left to
-/// assign_pipe_radii (radii.h).
+/// assign_pipe_radii (radii.h). `max_tree_nodes` caps the whole tree (kMaxTreeNodes; tests
+/// lower it).
 GrowthResult grow_tree(const std::vector<std::vector<glm::vec3>>& trunk_strokes, const std::vector<GrowthLobe>& lobes,
-                       const GrowthSettings& settings, const SubtreeLibrary& library, std::uint64_t seed);
+                       const GrowthSettings& settings, const SubtreeLibrary& library, std::uint64_t seed,
+                       std::size_t max_tree_nodes = kMaxTreeNodes);
 
 } // namespace lobe

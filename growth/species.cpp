@@ -63,7 +63,11 @@ SpeciesPreset parse_species(const std::string& text, const std::string& where)
     if (p.growth.contains("species")) throw InvalidInput(where + ": growth.species is the preset's own name");
     // Every key and type is checked now, so a bad preset fails when it is read, not when used.
     Settings probe;
-    apply_species(probe, p);
+    try {
+        apply_species(probe, p);
+    } catch (const InvalidInput& e) {
+        throw InvalidInput(where + ": " + e.what());
+    }
     return p;
 }
 

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <limits>
 #include <set>
+#include <unordered_map>
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
@@ -199,6 +200,21 @@ glm::vec3 place_point(const glm::vec3& p, bool mirror, const glm::dvec3& shift, 
     return glm::vec3(glm::dvec3(p) + shift);
 }
 
+/// Empty when `doc` can take `strokes` more strokes, `lobes` more lobes and `edits` more
+/// edits within the document limits (core/document.h); else why not.
+std::string over_limits(const Document& doc, std::size_t strokes, std::size_t lobes, std::size_t edits)
+{
+    auto full = [](std::size_t have, std::size_t more, std::size_t limit, const char* what) {
+        if (have + more <= limit) return std::string();
+        return "the session holds " + std::to_string(have) + " " + what + " and may hold at most " +
+               std::to_string(limit);
+    };
+    std::string why = full(doc.strokes.size(), strokes, kMaxDocumentStrokes, "strokes");
+    if (why.empty()) why = full(doc.lobes.size(), lobes, kMaxDocumentLobes, "lobes");
+    if (why.empty()) why = full(doc.edits.size(), edits, kMaxDocumentEdits, "edits");
+    return why;
+}
+
 std::string when(const char* what, double t)
 {
     char buf[96];
@@ -249,13 +265,13 @@ namespace {
 
 /// Smallest distance between (up to 256 evenly spread) points of `stroke` and (up to 4,096)
 /// points of the lobe's strokes; also the lobe's radius around the centroid of its points.
-void lobe_distance(const Document& doc, const LobeRecord& lobe, const Stroke& stroke, double& distance, double& radius)
+void lobe_distance(const std::unordered_map<std::int64_t, const Stroke*>& by_id, const LobeRecord& lobe,
+                   const Stroke& stroke, double& distance, double& radius)
 {
     std::vector<glm::vec3> pts;
     for (std::int64_t id : lobe.stroke_ids)
-        for (const Stroke& s : doc.strokes)
-            if (s.id == id)
-                for (const StrokePoint& p : s.points) pts.push_back(p.position);
+        if (const auto it = by_id.find(id); it != by_id.end())
+            for (const StrokePoint& p : it->second->points) pts.push_back(p.position);
     distance = 0; // without geometry to compare, the stroke stays with the lobe
     radius = 0;
     if (pts.empty() || stroke.points.empty()) return;
@@ -273,21 +289,54 @@ void lobe_distance(const Document& doc, const LobeRecord& lobe, const Stroke& st
 
 } // namespace
 
-void SessionBuilder::add_stroke(const Stroke& drawn)
+bool SessionBuilder::add_stroke(const InputAction& a)
 {
+    const Stroke& drawn = a.stroke;
+    auto refuse = [&](const std::string& why) {
+        char buf[128];
+        std::snprintf(buf, sizeof buf, "%s stroke %lld at t=%.2fs refused: ", stroke_kind_name(drawn.kind),
+                      static_cast<long long>(drawn.id), drawn.points.empty() ? a.time : drawn.points.front().time);
+        messages_.push_back(buf + why);
+        return false;
+    };
+    // What no session may hold is refused before anything changes (docs/limits.md).
+    if (std::string why = stroke_points_problem(drawn); !why.empty()) return refuse(why);
+    const InputOptions& in = doc_.settings.input;
+    const double length = drawn.length();
+    const auto n = static_cast<long long>(drawn.points.size());
+    if (length <= 0.0) return refuse("all its points lie at one place (zero length)");
+    if (length < in.min_stroke_length_m || n < in.min_stroke_points) {
+        char buf[160];
+        std::snprintf(buf, sizeof buf, "too short (%.1f cm, %lld points; need %.1f cm and %d points)", length * 100.0,
+                      n, in.min_stroke_length_m * 100.0, in.min_stroke_points);
+        return refuse(buf);
+    }
+    if (drawn.kind == StrokeKind::Lobe && stroke_is_straight(drawn))
+        return refuse("all its points lie on one straight line, so it cannot bound a lobe");
+    if (doc_.strokes.size() >= kMaxDocumentStrokes)
+        return refuse("the session already holds " + std::to_string(kMaxDocumentStrokes) +
+                      " strokes, the most it may hold");
+
     Stroke stroke = drawn;
     if (find_stroke(doc_.strokes, stroke.id)) stroke.id = next_stroke_id_;
-    next_stroke_id_ = std::max(next_stroke_id_, stroke.id + 1);
-    doc_.strokes.push_back(stroke);
-    if (stroke.kind != StrokeKind::Lobe) return;
+    if (stroke.kind != StrokeKind::Lobe) {
+        snapshot();
+        next_stroke_id_ = std::max(next_stroke_id_, stroke.id + 1);
+        doc_.strokes.push_back(stroke);
+        return true;
+    }
     // A stroke joins the lobe it is drawn into: the current lobe when it comes near it, else
     // the nearest lobe it comes near; far from every lobe (or after "new lobe") it starts one.
     LobeRecord* target = nullptr;
     if (!new_lobe_pending_ && !doc_.lobes.empty()) {
+        // Strokes by id, once: a session may hold up to kMaxDocumentStrokes.
+        std::unordered_map<std::int64_t, const Stroke*> by_id;
+        by_id.reserve(doc_.strokes.size());
+        for (const Stroke& s : doc_.strokes) by_id.emplace(s.id, &s);
         auto near = [&](const LobeRecord& l, double& d) {
             if (l.model) return false; // a lobe made from a mesh takes no strokes
             double radius = 0;
-            lobe_distance(doc_, l, stroke, d, radius);
+            lobe_distance(by_id, l, stroke, d, radius);
             return d <= std::max(kJoinDistanceM, 0.5 * radius);
         };
         double d = 0;
@@ -302,12 +351,18 @@ void SessionBuilder::add_stroke(const Stroke& drawn)
                 }
         }
     }
-    if (!target) {
-        doc_.lobes.push_back(LobeRecord::of_strokes(next_lobe_id_++));
-        target = &doc_.lobes.back();
-    }
+    if (!target && doc_.lobes.size() >= kMaxDocumentLobes)
+        return refuse("it would start a new lobe, and the session already holds " + std::to_string(kMaxDocumentLobes) +
+                      " lobes, the most it may hold");
+    // The lobe the stroke joins, by index: the snapshot and the push below move lobes.
+    const std::size_t target_index = target ? static_cast<std::size_t>(target - doc_.lobes.data()) : doc_.lobes.size();
+    snapshot();
+    next_stroke_id_ = std::max(next_stroke_id_, stroke.id + 1);
+    doc_.strokes.push_back(stroke);
+    if (target_index == doc_.lobes.size()) doc_.lobes.push_back(LobeRecord::of_strokes(next_lobe_id_++));
     new_lobe_pending_ = false;
-    target->stroke_ids.push_back(stroke.id);
+    doc_.lobes[target_index].stroke_ids.push_back(stroke.id);
+    return true;
 }
 
 void SessionBuilder::snapshot()
@@ -330,6 +385,17 @@ bool SessionBuilder::add_drag(const InputAction& a)
     };
     if (drag.path.empty()) return nothing("it has no points");
     if (drag.tool == Tool::DrawLobe || drag.tool == Tool::DrawTrunk) return nothing("not an editing tool");
+    if (doc_.edits.size() >= kMaxDocumentEdits)
+        return nothing("the session already holds " + std::to_string(kMaxDocumentEdits) + " edits, the most it may hold");
+    {
+        Stroke path;
+        path.points = drag.path;
+        if (drag.path.size() == 1) path.points.push_back(drag.path.front()); // a tap: one point is a path
+        if (std::string why = stroke_points_problem(path); !why.empty()) return nothing("its path: " + why);
+        if (drag.other_tip && !(std::isfinite(drag.other_tip->x) && std::isfinite(drag.other_tip->y) &&
+                                std::isfinite(drag.other_tip->z)))
+            return nothing("the pointing fingertip is not at a finite position");
+    }
     const glm::dvec3 start(drag.path.front().position);
     const std::vector<Stroke> view = this->view();
 
@@ -387,10 +453,7 @@ bool SessionBuilder::apply(const InputAction& a)
 {
     if (a.type != InputAction::Type::SettingChanged) setting_run_.reset();
     switch (a.type) {
-    case InputAction::Type::StrokeCompleted:
-        snapshot();
-        add_stroke(a.stroke);
-        return true;
+    case InputAction::Type::StrokeCompleted: return add_stroke(a);
     case InputAction::Type::DragCompleted: return add_drag(a);
     case InputAction::Type::NewLobe:
         // Only a pending flag: an empty lobe is never created.
@@ -496,6 +559,8 @@ std::vector<EditOperation> SessionBuilder::placed_deforms(const LobeRecord& lobe
         for (std::size_t i = 0; ok && i < path.size(); ++i) {
             const nlohmann::json& q = path[i];
             ok = q.is_array() && q.size() >= 3 && q[0].is_number() && q[1].is_number() && q[2].is_number();
+            // Finite and within what a float holds (casting a larger double is undefined).
+            for (int c = 0; ok && c < 3; ++c) ok = std::abs(q[static_cast<std::size_t>(c)].get<double>()) <= 1e30;
             if (!ok) break;
             st.points.push_back({glm::vec3(q[0].get<float>(), q[1].get<float>(), q[2].get<float>()), 0.0});
             t.push_back(q.size() >= 4 && q[3].is_number() ? q[3].get<double>() : 0.0);
@@ -579,6 +644,8 @@ bool SessionBuilder::copy_at_tip(const InputAction& a)
         const glm::dvec3 shift(2.0 * pick.radius + kDuplicateGapM, 0.0, 0.0);
         std::string note;
         std::vector<EditOperation> deforms = placed_deforms(source, mirror, shift, mirror_x, note);
+        if (std::string why = over_limits(doc_, source.stroke_ids.size(), 1, deforms.size()); !why.empty())
+            return nothing(why);
         snapshot();
         LobeRecord copy = source;
         copy.id = next_lobe_id_++;
@@ -622,6 +689,7 @@ bool SessionBuilder::copy_at_tip(const InputAction& a)
         return nothing(why);
     }
     const Stroke source = *s;
+    if (std::string why = over_limits(doc_, 1, 0, 0); !why.empty()) return nothing(why);
     snapshot();
     doc_.strokes.push_back(copy_of(source, glm::dvec3(kTrunkCopyOffsetM, 0.0, 0.0)));
     return true;
@@ -738,6 +806,7 @@ bool SessionBuilder::import_mesh(const InputAction& a)
         return false;
     };
     if (!hooks_.import_model) return nothing("this session cannot read imported meshes");
+    if (std::string why = over_limits(doc_, 0, 1, 0); !why.empty()) return nothing(why);
     std::shared_ptr<const LobeModel> model;
     try {
         model = hooks_.import_model(a.import_number);

@@ -85,6 +85,15 @@ public:
     /// Stroke ids: a completed stroke keeps its id unless the document already has that id
     /// (a copy took it), then it gets the next id above every id used so far; copies get
     /// such ids too.
+    ///
+    /// A completed stroke that no session may hold is refused with a warning and changes
+    /// nothing (docs/limits.md): fewer than 2 points, fewer points or shorter than
+    /// settings.input asks (min_stroke_points, min_stroke_length_m: what the pipeline
+    /// discards), a coordinate or time that is not finite, a coordinate beyond
+    /// kMaxStrokeCoordinateM, more than kMaxStrokePoints points, all points at one place,
+    /// a lobe stroke whose points all lie on one straight line (it cannot bound a lobe), or
+    /// a stroke or lobe past kMaxDocumentStrokes / kMaxDocumentLobes. Drags, copies and
+    /// imports past the document limits are refused the same way.
     bool apply(const InputAction& action);
     void apply(const std::vector<InputAction>& actions);
 
@@ -94,7 +103,7 @@ public:
     const std::vector<std::string>& messages() const { return messages_; }
 
 private:
-    void add_stroke(const Stroke& stroke);
+    bool add_stroke(const InputAction& action);
     bool add_drag(const InputAction& action);
     bool delete_at_tip(const InputAction& action);
     bool copy_at_tip(const InputAction& action);

@@ -77,6 +77,28 @@ LobeStrokeSamples prepare_lobe_stroke(std::int64_t id, const std::vector<glm::ve
     const CurvatureSampling sampling = sample_by_curvature_detailed(line, out.closed, options.sampling);
     out.points = refine_samples(line, sampling.indices, out.closed, options.max_chord_deviation_m);
     if (out.points.size() < 4) throw InvalidInput(who + " is too short to sample");
+    // The same loop twice (or a path and back): every sample of the stroke's second half lies
+    // within duplicate_distance_m of its first half. Checked on at most 2,000 samples.
+    {
+        const std::vector<glm::dvec3> q = to_double(out.points);
+        std::vector<double> arc(q.size(), 0.0);
+        for (std::size_t i = 1; i < q.size(); ++i) arc[i] = arc[i - 1] + glm::distance(q[i - 1], q[i]);
+        const std::size_t half = static_cast<std::size_t>(
+            std::lower_bound(arc.begin(), arc.end(), 0.5 * arc.back()) - arc.begin());
+        const std::size_t stride = std::max<std::size_t>(1, (q.size() - half) / 2000);
+        bool retraced = half >= 2 && half + 2 <= q.size();
+        for (std::size_t k = half + 1; retraced && k < q.size(); k += stride) {
+            double best = std::numeric_limits<double>::infinity();
+            for (std::size_t i = 0; i + 1 < half && best > options.duplicate_distance_m; ++i) {
+                const glm::dvec3 ab = q[i + 1] - q[i];
+                const double len2 = glm::dot(ab, ab);
+                const double t = len2 > 0 ? std::clamp(glm::dot(q[k] - q[i], ab) / len2, 0.0, 1.0) : 0.0;
+                best = std::min(best, glm::distance(q[k], q[i] + t * ab));
+            }
+            retraced = best <= options.duplicate_distance_m;
+        }
+        if (retraced) throw InvalidInput(who + " retraces itself (the same loop twice, or a path and back along it)");
+    }
     // A stroke that reverses (turns by more than 160° from one Eq. 1 sample to the next)
     // folds back on itself: its two legs would make a zero-width sliver of the lobe.
     std::vector<glm::vec3> samples;

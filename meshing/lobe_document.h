@@ -26,6 +26,11 @@ struct BuiltLobe {
     std::size_t edits_applied = 0;
 };
 
+/// Most strokes one lobe is built from: joining compares each stroke with every stroke
+/// already in the lobe, so the work grows with the square of their number. Strokes beyond
+/// the first kMaxStrokesPerLobe of a lobe are left out with one warning (docs/limits.md).
+inline constexpr std::size_t kMaxStrokesPerLobe = 1000;
+
 /// The options the document's settings give.
 LobeOptions lobe_options_from(const Settings& settings);
 

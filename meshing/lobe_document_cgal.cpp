@@ -37,8 +37,9 @@ bool drag_ends(const EditOperation& op, glm::vec3& from, glm::vec3& to)
         if (!p.is_array() || p.size() < 3) return false;
         for (int k = 0; k < 3; ++k) {
             if (!p[static_cast<std::size_t>(k)].is_number()) return false;
-            out[k] = p[static_cast<std::size_t>(k)].get<float>();
-            if (!std::isfinite(out[k])) return false;
+            const double v = p[static_cast<std::size_t>(k)].get<double>();
+            if (!(std::abs(v) <= 1e30)) return false; // not finite, or beyond what a float holds
+            out[k] = static_cast<float>(v);
         }
         return true;
     };
@@ -163,7 +164,15 @@ std::vector<BuiltLobe> build_document_lobes(const Document& doc, std::vector<std
         Lobe lobe(options);
         BuiltLobe built;
         built.lobe_id = rec.id;
-        for (std::int64_t id : rec.stroke_ids) {
+        for (std::size_t k = 0; k < rec.stroke_ids.size(); ++k) {
+            const std::int64_t id = rec.stroke_ids[k];
+            if (k == kMaxStrokesPerLobe) {
+                if (warnings)
+                    warnings->push_back("lobe " + std::to_string(rec.id) + ": " +
+                                        std::to_string(rec.stroke_ids.size() - k) + " strokes beyond the first " +
+                                        std::to_string(kMaxStrokesPerLobe) + " are left out");
+                break;
+            }
             const Stroke* s = find_stroke(strokes, id);
             if (!s) {
                 if (warnings) warnings->push_back("lobe " + std::to_string(rec.id) + ": stroke " + std::to_string(id) + " is missing");
@@ -183,7 +192,13 @@ std::vector<BuiltLobe> build_document_lobes(const Document& doc, std::vector<std
         if (lobe.empty()) continue;
         built.surface = lobe.surface();
         if (remesh.iterations > 0) {
-            built.mesh = remesh_isotropic(built.surface.mesh, remesh);
+            try {
+                built.mesh = remesh_isotropic(built.surface.mesh, remesh);
+            } catch (const InvalidInput& e) {
+                // Too large for the spacing (kMaxRemeshTriangles), or a surface remeshing refuses.
+                if (warnings) warnings->push_back("lobe " + std::to_string(rec.id) + ": " + e.what() + "; the lobe is left out");
+                continue;
+            }
         } else {
             built.mesh = built.surface.mesh;
         }
@@ -219,11 +234,26 @@ std::vector<BuiltLobe> build_document_lobes(const Document& doc, std::vector<std
             ++target->edits_applied;
     }
     // Move, rotate and scale (in document order) take each lobe to where the person put it.
+    // Scales compose: many of them could take a lobe anywhere, so a lobe that ends up beyond
+    // kMaxStrokeCoordinateM (or not finite) is left out, as its strokes would be.
+    std::vector<BuiltLobe> placed;
+    placed.reserve(out.size());
     for (BuiltLobe& b : out) {
         const glm::dmat4 t = lobe_transform(doc, b.lobe_id);
         if (t != glm::dmat4(1.0)) transform_mesh(b.mesh, t);
+        bool inside = true;
+        for (const glm::vec3& p : b.mesh.positions)
+            for (int k = 0; k < 3; ++k) inside = inside && std::abs(p[k]) <= static_cast<float>(kMaxStrokeCoordinateM);
+        if (!inside) {
+            if (warnings)
+                warnings->push_back("lobe " + std::to_string(b.lobe_id) + ": its moves and scales take it beyond " +
+                                    std::to_string(static_cast<int>(kMaxStrokeCoordinateM)) +
+                                    " m from the origin; the lobe is left out");
+            continue;
+        }
+        placed.push_back(std::move(b));
     }
-    return out;
+    return placed;
 }
 
 std::size_t apply_pinch_edits(const Document& doc, std::int64_t lobe_id, TriangleMesh& mesh,

@@ -32,12 +32,19 @@ struct RemeshOptions {
     std::vector<int> faces;
 };
 
+/// Most triangles a remeshing may make, estimated before it starts from the area it remeshes
+/// and the target edge length (an equilateral triangle of that edge covers √3/4 · L²). A
+/// larger surface or a finer spacing is refused, so no input can make remeshing run out of
+/// memory (docs/limits.md). 3 cm spacing reaches it at about 1,500 m², 5 mm at about 43 m².
+inline constexpr std::size_t kMaxRemeshTriangles = 4000000;
+
 /// Remeshes `mesh` towards edges of options.target_edge_length_m with
 /// CGAL::Polygon_mesh_processing::isotropic_remeshing on an OpenMesh TriMesh, projecting
 /// onto the input surface. The output's feature_edges are the constrained edges after
 /// splitting. Vertex indices change; positions of vertices outside options.faces do not.
 /// \pre mesh is 2-manifold (closed or with boundary), indices in range; target > 0.
-/// \throw InvalidInput when the precondition does not hold (one-line message).
+/// \throw InvalidInput when the precondition does not hold, or the estimate exceeds
+/// kMaxRemeshTriangles (one-line message).
 TriangleMesh remesh_isotropic(const TriangleMesh& mesh, const RemeshOptions& options = {});
 
 } // namespace lobe

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,7 @@
 #include <CGAL/Polygon_mesh_processing/remesh.h>
 #pragma GCC diagnostic pop
 
+#include <glm/geometric.hpp>
 
 #include "core/errors.h"
 #include "meshing/mesh_quality.h"
@@ -112,6 +114,32 @@ TriangleMesh remesh_isotropic(const TriangleMesh& mesh, const RemeshOptions& opt
     if (!q.manifold)
         throw InvalidInput("remesh_isotropic: the mesh is not 2-manifold or not consistently oriented "
                            "(run repair_mesh first)");
+    {
+        // What the remeshing would make, before it allocates anything (kMaxRemeshTriangles).
+        auto area_of = [&](std::size_t f) {
+            const auto& t = mesh.triangles[f];
+            const glm::dvec3 a(mesh.positions[static_cast<std::size_t>(t[0])]);
+            const glm::dvec3 b(mesh.positions[static_cast<std::size_t>(t[1])]);
+            const glm::dvec3 c(mesh.positions[static_cast<std::size_t>(t[2])]);
+            return 0.5 * glm::length(glm::cross(b - a, c - a));
+        };
+        double area = 0.0;
+        if (options.faces.empty()) {
+            for (std::size_t f = 0; f < mesh.triangles.size(); ++f) area += area_of(f);
+        } else {
+            for (int f : options.faces)
+                if (f >= 0 && f < static_cast<int>(mesh.triangles.size())) area += area_of(static_cast<std::size_t>(f));
+        }
+        const double estimate = area / (std::sqrt(3.0) / 4.0 * target * target);
+        if (!(estimate <= static_cast<double>(kMaxRemeshTriangles))) {
+            char buf[200];
+            std::snprintf(buf, sizeof buf,
+                          "remesh_isotropic: %.3g m² at edge length %g m would make about %.3g triangles, more than the "
+                          "%zu allowed",
+                          area, target, estimate, kMaxRemeshTriangles);
+            throw InvalidInput(buf);
+        }
+    }
 
     OMesh om;
     om.request_vertex_status();

@@ -253,6 +253,15 @@ TEST(SessionBuilder, NewLobeKeyGroupsStrokesAndUndoRedoRestoreThem)
         a.type = InputAction::Type::StrokeCompleted;
         a.stroke.id = id;
         a.stroke.kind = k;
+        // Lobe strokes: loops around one centre, each turned a little; the trunk: a line.
+        for (int i = 0; i < 40; ++i) {
+            const float t = 0.16f * static_cast<float>(i), turn = 0.5f * static_cast<float>(id);
+            a.stroke.points.push_back(
+                {k == StrokeKind::Lobe ? glm::vec3(0.15f * std::cos(t), 1.4f + 0.15f * std::sin(t) * std::cos(turn),
+                                                   -0.4f + 0.15f * std::sin(t) * std::sin(turn))
+                                       : glm::vec3(0.0f, 0.8f + 0.01f * static_cast<float>(i), -0.4f),
+                 0.01 * i});
+        }
         return a;
     };
     InputAction newlobe;
