@@ -9,6 +9,15 @@
 
 namespace lobe {
 
+namespace cli {
+// Crash safety (docs/crash-safety.md): app/cli_recover.cpp.
+void add_recover_command(CLI::App& app, int& exit_code);
+// The live VR session fed from a recording: app/cli_sketch.cpp.
+void add_sketch_command(CLI::App& app, int& exit_code);
+// Sketching in a headset (docs/vr.md): app/cli_vr.cpp.
+void add_vr_command(CLI::App& app, int& exit_code);
+} // namespace cli
+
 int run_cli(int argc, char** argv)
 {
     CLI::App app{"Lobesketch: sketch trees in mid-air with your fingers.\n"
@@ -27,6 +36,9 @@ int run_cli(int argc, char** argv)
     cli::add_export_command(app, exit_code);
     cli::add_render_command(app, exit_code);
     cli::add_desktop_command(app, exit_code);
+    cli::add_vr_command(app, exit_code);
+    cli::add_recover_command(app, exit_code);
+    cli::add_sketch_command(app, exit_code);
     app.parse_complete_callback([&] { cli::set_quiet(quiet); });
     try {
         app.parse(argc, argv);

@@ -7,8 +7,10 @@
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 
+#include "app/autosave.h"
 #include "app/edit_hooks.h"
 #include "app/render_scene.h"
+#include "app/scene_parts.h"
 #include "app/tree_output.h"
 #include "core/errors.h"
 #include "meshing/edit_ops.h"
@@ -32,59 +34,6 @@ constexpr std::array<float, 4> kLobeInkColor{1.0f, 1.0f, 1.0f, 1.0f};
 constexpr std::array<float, 4> kTrunkInkColor{0.55f, 0.33f, 0.16f, 1.0f};
 constexpr std::array<float, 4> kDragInkColor{0.25f, 0.65f, 1.0f, 1.0f};
 
-/// The fingertip marker's colour says the tool (and so what a pinch does).
-std::array<float, 4> tool_color(Tool t)
-{
-    switch (t) {
-    case Tool::DrawLobe: return {0.35f, 0.85f, 0.30f, 1.0f};
-    case Tool::DrawTrunk: return {0.60f, 0.38f, 0.18f, 1.0f};
-    case Tool::DeformLobe: return {0.85f, 0.25f, 0.85f, 1.0f};
-    case Tool::EditStroke: return {1.0f, 0.55f, 0.10f, 1.0f};
-    case Tool::MoveLobe: return {0.20f, 0.60f, 1.0f, 1.0f};
-    case Tool::RotateLobe: return {0.10f, 0.85f, 0.85f, 1.0f};
-    case Tool::ScaleLobe: return {0.95f, 0.95f, 0.30f, 1.0f};
-    }
-    return {1.0f, 1.0f, 1.0f, 1.0f};
-}
-
-/// A UV sphere appended to `g`.
-void append_sphere(SurfaceGeometry& g, const glm::vec3& centre, float radius, int rings = 5, int segments = 8)
-{
-    const auto base = static_cast<std::uint32_t>(g.positions.size());
-    for (int r = 0; r <= rings; ++r) {
-        const float phi = glm::pi<float>() * float(r) / float(rings);
-        for (int s = 0; s <= segments; ++s) {
-            const float theta = glm::two_pi<float>() * float(s) / float(segments);
-            const glm::vec3 n(std::sin(phi) * std::cos(theta), std::cos(phi), std::sin(phi) * std::sin(theta));
-            g.positions.push_back(centre + radius * n);
-            g.normals.push_back(n);
-        }
-    }
-    const auto row = static_cast<std::uint32_t>(segments + 1);
-    for (int r = 0; r < rings; ++r)
-        for (int s = 0; s < segments; ++s) {
-            const std::uint32_t a = base + std::uint32_t(r) * row + std::uint32_t(s), b = a + row;
-            g.triangles.push_back({a, a + 1, b});
-            g.triangles.push_back({a + 1, b + 1, b});
-        }
-}
-
-void append(SurfaceGeometry& into, const SurfaceGeometry& part)
-{
-    const auto base = static_cast<std::uint32_t>(into.positions.size());
-    into.positions.insert(into.positions.end(), part.positions.begin(), part.positions.end());
-    into.normals.insert(into.normals.end(), part.normals.begin(), part.normals.end());
-    for (const auto& t : part.triangles) into.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
-}
-
-/// Joints of each finger from the wrist to the tip (OpenXR order), for the bones.
-const std::array<std::vector<int>, 5> kFingerChains = {{
-    {1, 2, 3, 4, 5},         // wrist, thumb metacarpal … tip
-    {1, 6, 7, 8, 9, 10},     // wrist, index metacarpal … tip
-    {1, 11, 12, 13, 14, 15}, // middle
-    {1, 16, 17, 18, 19, 20}, // ring
-    {1, 21, 22, 23, 24, 25}, // little
-}};
 
 } // namespace
 
@@ -132,6 +81,10 @@ DesktopSession::DesktopSession(Document doc, DesktopOptions options)
         recording_ = std::make_unique<RecordingWriter>(options_.record_path, header, 6);
         doc.source_recording = std::filesystem::absolute(options_.record_path).lexically_normal().string();
     }
+    // A loaded document's position in its old recording no longer holds; the saves of this
+    // session stamp theirs (at_recording_position).
+    doc.recording_frames.reset();
+    doc.recording_finished = false;
     EditHooks hooks = meshing_edit_hooks();
     // Imports of this session, by number (the recording's ImportMesh events).
     hooks.import_model = [this](int n) {
@@ -322,7 +275,10 @@ void DesktopSession::frame(double time, int width, int height)
     pose.pinched = pinch_;
     const HandFrame hand_frame = desktop_frame(time_, pose, cursor_seen_ && cursor_inside_);
     pipeline_.push_frame(hand_frame);
-    if (recording_) recording_->append(hand_frame);
+    if (recording_) {
+        recording_->append(hand_frame);
+        ++frames_recorded_;
+    }
     apply_actions();
 
     for (int code : commands) {
@@ -372,11 +328,9 @@ void DesktopSession::document_changed()
 {
     ++revision_;
     if (!options_.autosave_path.empty()) {
-        try {
-            save_document(options_.autosave_path, document());
-        } catch (const Error& e) {
-            note(std::string("autosave failed: ") + e.what());
-        }
+        const std::string why =
+            write_autosave(options_.autosave_path, recording_.get(), document(), frames_recorded_, finished_);
+        if (!why.empty()) note("autosave failed: " + why);
     }
     request_regrowth();
     rebuild_static_scene(); // strokes show at once; lobes and the tree follow the regrowth
@@ -445,15 +399,7 @@ void DesktopSession::add_dynamic_items()
         scene_.items.push_back(std::move(item));
     };
     if (last_hand_.active) {
-        SurfaceGeometry hand;
-        for (int j = 1; j < kJointCount; ++j) // the palm joint is not drawn
-            append_sphere(hand, last_hand_.joints[std::size_t(j)].pose.position,
-                          0.45f * last_hand_.joints[std::size_t(j)].radius);
-        for (const auto& chain : kFingerChains) {
-            std::vector<glm::vec3> pts;
-            for (int j : chain) pts.push_back(last_hand_.joints[std::size_t(j)].pose.position);
-            append(hand, polyline_tube(pts, 0.0025f, 5));
-        }
+        SurfaceGeometry hand = hand_geometry(last_hand_);
         add(RenderMaterial::Stroke, status_.pinching ? kPinchColor : kHandColor, std::move(hand));
         SurfaceGeometry marker;
         append_sphere(marker, status_.tip, 0.008f, 6, 10);
@@ -476,7 +422,9 @@ bool DesktopSession::save()
         return false;
     }
     try {
-        save_document(options_.session_path, document());
+        if (recording_ && !finished_) recording_->flush(); // closed once finished
+        save_document(options_.session_path,
+                      at_recording_position(document(), recording_ != nullptr, frames_recorded_, finished_));
         note("saved " + options_.session_path);
         return true;
     } catch (const Error& e) {
@@ -542,8 +490,16 @@ void DesktopSession::finish(double time)
     }
     pending_.clear();
     pipeline_.finish();
+    finished_ = true; // an autosave from here on holds the end of the recording too
+    const std::uint64_t revision = revision_;
     apply_actions();
-    finished_ = true;
+    // The end changed nothing: the last autosave still says so, for `recover` to see that
+    // nothing of the recording is left to replay.
+    if (revision_ == revision && revision_ > 0 && !options_.autosave_path.empty()) {
+        const std::string why =
+            write_autosave(options_.autosave_path, recording_.get(), document(), frames_recorded_, finished_);
+        if (!why.empty()) note("autosave failed: " + why);
+    }
     if (recording_) recording_->close();
 }
 

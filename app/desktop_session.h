@@ -163,6 +163,7 @@ private:
     bool quit_ = false, finished_ = false;
     float depth_m_ = 0.0f; ///< fingertip plane distance from the eye (0: through the orbit target)
     double time_ = 0.0;
+    std::uint64_t frames_recorded_ = 0; ///< hand frames appended to the recording (Document::recording_frames)
 
     bool grown_ = false;
     int lod_ = 0;

@@ -83,6 +83,12 @@ struct PreparedExport {
 /// negative triangle indices, or a leaf texture whose pixel count does not match its size.
 PreparedExport prepare_export(const ExportScene& scene, const ExportOptions& options);
 
+/// Reads a PNG or JPEG picture (a reference photo) as RGBA8, scaled down (box filter) so that
+/// neither side exceeds `max_side`. Untrusted: files over 64 MB or pictures over 16384 pixels
+/// a side are refused before decoding.
+/// \throw FileError (one line naming the file) when it cannot be read or decoded.
+RgbaImage read_picture_file(const std::string& path, int max_side = 1024);
+
 /// PNG encoding of an RGBA8 image (stb_image_write, deterministic: same pixels, same bytes).
 /// \throw InvalidInput for an empty image or a pixel count that does not match.
 std::vector<std::uint8_t> encode_png(const RgbaImage& image);

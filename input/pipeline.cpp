@@ -46,12 +46,33 @@ double shortest_double(float x)
 
 } // namespace
 
+glm::quat SceneTransform::rotation() const { return glm::angleAxis(yaw, glm::vec3(0.0f, 1.0f, 0.0f)); }
+
+glm::vec3 SceneTransform::to_stage(const glm::vec3& p) const { return rotation() * (scale * p) + translation; }
+
+glm::vec3 SceneTransform::to_document(const glm::vec3& p) const
+{
+    if (identity()) return p; // bit-exact for sessions that never move the scene
+    return (glm::inverse(rotation()) * (p - translation)) / scale;
+}
+
+void SceneTransform::set(SceneComponent component, float value)
+{
+    switch (component) {
+    case SceneComponent::Scale: scale = value; break;
+    case SceneComponent::Yaw: yaw = value; break;
+    case SceneComponent::TranslationX: translation.x = value; break;
+    case SceneComponent::TranslationY: translation.y = value; break;
+    case SceneComponent::TranslationZ: translation.z = value; break;
+    }
+}
+
 void InputPipeline::attach_tip(InputAction& a) const
 {
     for (Hand h : {Hand::Right, Hand::Left}) {
         const HandGesture& g = gestures_.hand(h);
         if (!g.tracked) continue;
-        a.tip = g.index_tip;
+        a.tip = scene_.to_document(g.index_tip);
         a.tip_hand = h;
         return;
     }
@@ -68,6 +89,10 @@ void InputPipeline::push_event(const InputEvent& event)
         a.setting.lobe = event.value;
         a.setting.value = shortest_double(event.x);
         actions_.push_back(std::move(a));
+        return;
+    }
+    if (event.kind == InputEventKind::Scene) {
+        if (valid_scene_event(event.code, event.x)) scene_.set(static_cast<SceneComponent>(event.code), event.x);
         return;
     }
     if (event.kind == InputEventKind::ImportMesh) {
@@ -121,20 +146,22 @@ void InputPipeline::pen_down(int h, const HandGesture& g, double t)
     pen.drag = !(tool_ == Tool::DrawLobe || tool_ == Tool::DrawTrunk);
     pen.stroke.kind = tool_ == Tool::DrawTrunk ? StrokeKind::Trunk : StrokeKind::Lobe;
     pen.stroke.hand = static_cast<Hand>(h);
-    pen.stroke.points.push_back({g.index_tip, t});
+    pen.stroke.points.push_back({scene_.to_document(g.index_tip), t});
     pen.last_good_t = t;
     // Stroke edits with two fingertips: the other hand points at the segment's other end.
     const HandGesture& other = gestures_.hand(static_cast<Hand>(1 - h));
-    if (tool_ == Tool::EditStroke && other.tracked && other.pointing) pen.other_tip = other.index_tip;
+    if (tool_ == Tool::EditStroke && other.tracked && other.pointing) pen.other_tip = scene_.to_document(other.index_tip);
 }
 
 void InputPipeline::pen_move(int h, const HandGesture& g, double t)
 {
     Pen& pen = pen_[h];
     pen.last_good_t = t;
-    // The paper keeps a point only when the fingertip moved at least the minimum distance.
-    if (glm::distance(g.index_tip, pen.stroke.points.back().position) >= options_.min_point_distance_m)
-        pen.stroke.points.push_back({g.index_tip, t});
+    // The paper keeps a point only when the fingertip moved at least the minimum distance
+    // (in the document: a scaled scene keeps the spacing that meshing expects).
+    const glm::vec3 tip = scene_.to_document(g.index_tip);
+    if (glm::distance(tip, pen.stroke.points.back().position) >= options_.min_point_distance_m)
+        pen.stroke.points.push_back({tip, t});
 }
 
 void InputPipeline::pen_up(int h, double t)
@@ -146,9 +173,9 @@ void InputPipeline::pen_up(int h, double t)
     // A drag always keeps it: its end decides the edit (a move, a Bézier displacement).
     const HandGesture& g = gestures_.hand(static_cast<Hand>(h));
     const double min_last = pen.drag ? 0.0 : 0.5 * options_.min_point_distance_m;
-    if (g.tracked && pen.stroke.points.size() >= 1 &&
-        glm::distance(g.index_tip, pen.stroke.points.back().position) > min_last)
-        pen.stroke.points.push_back({g.index_tip, std::max(t, pen.stroke.points.back().time)});
+    const glm::vec3 tip = scene_.to_document(g.index_tip);
+    if (g.tracked && pen.stroke.points.size() >= 1 && glm::distance(tip, pen.stroke.points.back().position) > min_last)
+        pen.stroke.points.push_back({tip, std::max(t, pen.stroke.points.back().time)});
 
     InputAction a;
     a.time = t;

@@ -10,6 +10,9 @@
 #include <string>
 #include <vector>
 
+#include <glm/gtc/quaternion.hpp>
+#include <glm/vec3.hpp>
+
 #include "core/settings.h"
 #include "core/stroke.h"
 #include "input/gestures.h"
@@ -17,6 +20,24 @@
 #include "input/tools.h"
 
 namespace lobe {
+
+/// Where the document sits in stage space: stage = R_y(yaw) · scale · document + translation.
+/// Scene events (the VR app's two-handed grab) change it; it starts as the identity. Gestures
+/// are recognised on the hands as tracked (stage space: pinch distances stay physical); the
+/// points they make (stroke points, drag paths, fingertips of key actions) are taken into the
+/// document through the inverse.
+struct SceneTransform {
+    float scale = 1.0f;
+    float yaw = 0.0f; ///< radians about +Y
+    glm::vec3 translation{0.0f};
+
+    glm::vec3 to_stage(const glm::vec3& document_point) const;
+    glm::vec3 to_document(const glm::vec3& stage_point) const;
+    glm::quat rotation() const; ///< R_y(yaw)
+    bool identity() const { return scale == 1.0f && yaw == 0.0f && translation == glm::vec3(0.0f); }
+    /// Sets one component (a Scene event's code and value; input/recording.h).
+    void set(SceneComponent component, float value);
+};
 
 /// A pinch-move-release made under an editing tool (deform a lobe, bend a stroke segment,
 /// move, rotate or scale a lobe): the path of the pinch point.
@@ -85,6 +106,8 @@ public:
     std::vector<InputAction> take_actions();
     const GestureRecognizer& gestures() const { return gestures_; }
     Tool tool() const { return tool_; }
+    /// Where the document sits in stage space (Scene events).
+    const SceneTransform& scene_transform() const { return scene_; }
     /// True while `hand` is drawing; `current_stroke` then holds the points so far.
     bool drawing(Hand hand) const { return pen_[static_cast<int>(hand)].down; }
     const Stroke& current_stroke(Hand hand) const { return pen_[static_cast<int>(hand)].stroke; }
@@ -110,6 +133,7 @@ private:
     std::array<Pen, kHandCount> pen_{};
     std::int64_t next_stroke_id_ = 1;
     double last_time_ = 0.0;
+    SceneTransform scene_;
     std::vector<InputAction> actions_;
 };
 

@@ -378,7 +378,7 @@ std::size_t json_nesting(std::string_view s)
 }
 
 
-bool known_event_kind(std::uint8_t k) { return k >= 1 && k <= 6; }
+bool known_event_kind(std::uint8_t k) { return k >= 1 && k <= 7; }
 
 // ---------------------------------------------------------------------------------------
 // Collector: validation and bounded report shared by both readers
@@ -871,6 +871,10 @@ void decode_record(Collector& c, RecordType type, ByteReader r, Where w)
             c.skip_unknown_setting(w, e.code);
             return;
         }
+        if (e.kind == InputEventKind::Scene && !valid_scene_event(e.code, e.x)) {
+            c.drop_event(w, "scene event out of range (component " + std::to_string(e.code) + ")");
+            return;
+        }
         c.add_event(e, w);
         return;
     }
@@ -1061,6 +1065,13 @@ void append_event_line(std::string& out, const InputEvent& e)
         out += kind;
         out += ' ';
         append_number(out, e.code);
+        break;
+    case InputEventKind::Scene:
+        out += kind;
+        out += ' ';
+        append_number(out, e.code);
+        out += ' ';
+        append_number(out, e.x);
         break;
     default: // a kind this build does not know: written so that readers skip it
         out += "kind_" + std::to_string(static_cast<int>(e.kind));
@@ -1273,6 +1284,13 @@ void parse_text_line(Collector& c, std::string_view line, Where w)
         } else if (ek == "import_mesh") {
             e.kind = InputEventKind::ImportMesh;
             ok = take_number(t, e.code, "import number", error);
+        } else if (ek == "scene") {
+            e.kind = InputEventKind::Scene;
+            ok = take_number(t, e.code, "scene component", error) && take_number(t, e.x, "value", error);
+            if (ok && !valid_scene_event(e.code, e.x)) {
+                ok = false;
+                error = "component or value out of range";
+            }
         } else if (ek.empty()) {
             return c.drop_event(w, "missing event kind");
         } else {
@@ -1501,6 +1519,19 @@ void RecordingWriter::close()
     if (!ok) throw FileError(path_, std::string("close failed: ") + std::strerror(err));
 }
 
+bool valid_scene_event(std::int32_t component, float value)
+{
+    if (!std::isfinite(value)) return false;
+    switch (static_cast<SceneComponent>(component)) {
+    case SceneComponent::Scale: return value >= kMinSceneScale && value <= kMaxSceneScale;
+    case SceneComponent::Yaw: return std::abs(value) <= 4.0f * 3.14159265f;
+    case SceneComponent::TranslationX:
+    case SceneComponent::TranslationY:
+    case SceneComponent::TranslationZ: return std::abs(value) <= kMaxSceneTranslation;
+    }
+    return false;
+}
+
 std::string import_mesh_path(const std::string& recording_path, int n)
 {
     return recording_path + ".import-" + std::to_string(n) + ".ply";
@@ -1515,6 +1546,7 @@ const char* event_kind_name(InputEventKind k)
     case InputEventKind::MouseWheel: return "wheel";
     case InputEventKind::Setting: return "setting";
     case InputEventKind::ImportMesh: return "import_mesh";
+    case InputEventKind::Scene: return "scene";
     }
     return nullptr;
 }

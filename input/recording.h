@@ -44,7 +44,22 @@ enum class InputEventKind : std::uint8_t {
     Setting = 5,     ///< an appearance setting: code = SettingId, value = lobe id (0 = the whole tree), x = the number
     ImportMesh = 6,  ///< a mesh imported as a lobe at the fingertip: code = N ≥ 1, the mesh is the file
                      ///< import_mesh_path(recording, N) beside the recording
+    Scene = 7,       ///< where the document sits in stage space changed (the VR app's two-handed grab):
+                     ///< code = SceneComponent, x = its new value
 };
+
+/// What a Scene event sets (InputEvent::code): stage = R_y(yaw) · scale · document + translation.
+/// Hand positions in stage space become document positions through the inverse (InputPipeline).
+enum class SceneComponent : std::int32_t {
+    Scale = 0,        ///< in [kMinSceneScale, kMaxSceneScale]
+    Yaw = 1,          ///< radians about +Y, in [-4π, 4π]
+    TranslationX = 2, ///< metres, |value| ≤ kMaxSceneTranslation
+    TranslationY = 3,
+    TranslationZ = 4,
+};
+inline constexpr float kMinSceneScale = 0.01f, kMaxSceneScale = 100.0f, kMaxSceneTranslation = 1000.0f;
+/// The value is in the range of its component (readers drop Scene events outside it).
+bool valid_scene_event(std::int32_t component, float value);
 
 /// The mesh of ImportMesh event N of the recording at `recording_path`: a PLY file beside it,
 /// "REC.import-N.ply" (the lobe mesh as imported: repaired, scaled, remeshed, centred on the

@@ -872,3 +872,32 @@ TEST(RecordingWriter, UnwritablePathIsAOneLineFileError)
     std::string m = file_error(path, [&] { RecordingWriter w(path, RecordingHeader{}); });
     EXPECT_NE(m.find("cannot create"), std::string::npos) << m;
 }
+
+TEST(RecordingEvents, SceneEventsRoundTripInBothFormsAndOutOfRangeOnesAreDroppedWithAWarning)
+{
+    Recording rec = sample_recording();
+    rec.events.push_back({1.0, InputEventKind::Scene, int(SceneComponent::Scale), 0, 0.5f, 0.0f});
+    rec.events.push_back({1.0, InputEventKind::Scene, int(SceneComponent::Yaw), 0, -0.25f, 0.0f});
+    rec.events.push_back({1.0, InputEventKind::Scene, int(SceneComponent::TranslationZ), 0, -1.5f, 0.0f});
+    const Recording from_binary = parse_recording(encode_recording_binary(rec), "a.lrec");
+    const std::string text = encode_recording_text(from_binary);
+    EXPECT_NE(text.find("event 1 scene 0 0.5\n"), std::string::npos) << text;
+    const Recording from_text = parse_recording(text, "a.txt");
+    EXPECT_EQ(encode_recording_binary(from_text), encode_recording_binary(from_binary));
+    int scene = 0;
+    for (const InputEvent& e : from_text.events) scene += e.kind == InputEventKind::Scene;
+    EXPECT_EQ(scene, 3);
+
+    for (const auto& [component, value] : std::vector<std::pair<int, float>>{
+             {0, 0.0f}, {0, 1000.0f}, {1, 20.0f}, {2, 1e6f}, {5, 1.0f}, {0, std::nanf("")}}) {
+        Recording bad = sample_recording();
+        bad.events.push_back({1.0, InputEventKind::Scene, component, 0, value, 0.0f});
+        for (const std::string& bytes : {encode_recording_binary(bad), encode_recording_text(bad)}) {
+            ReadReport report;
+            const Recording back = parse_recording(bytes, "bad.lrec", &report);
+            for (const InputEvent& e : back.events) EXPECT_NE(e.kind, InputEventKind::Scene) << component << " " << value;
+            ASSERT_FALSE(report.problems.empty());
+            EXPECT_EQ(report.problems.front().find('\n'), std::string::npos);
+        }
+    }
+}

@@ -1,0 +1,274 @@
+// The VR session without a headset: scripted hands (tests/vr_script.h) poke the panel, draw,
+// edit, grab the scene with both hands and undo; every change is checked on the document, and
+// the recording the session wrote replays to the same document.
+#include <cmath>
+#include <filesystem>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <glm/gtc/constants.hpp>
+
+#include "app/cli_common.h"
+#include "app/vr_session.h"
+#include "core/document.h"
+#include "input/recording.h"
+#include "tests/vr_script.h"
+
+namespace lobe {
+namespace {
+
+namespace fs = std::filesystem;
+using test::HandPose;
+using test::VrScript;
+
+fs::path scratch(const std::string& name)
+{
+    const fs::path dir = fs::temp_directory_path() / ("lobesketch_vr_session_" + name);
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+
+std::vector<glm::vec3> circle(glm::vec3 centre, glm::vec3 u, glm::vec3 v, float r, int n = 48)
+{
+    std::vector<glm::vec3> out;
+    for (int i = 0; i <= n; ++i) {
+        const float a = glm::two_pi<float>() * float(i) / float(n);
+        out.push_back(centre + r * (std::cos(a) * u + std::sin(a) * v));
+    }
+    return out;
+}
+
+const VrButton& button(const VrSession& s, const std::string& text)
+{
+    for (const VrButton& b : s.panel().buttons)
+        if (b.text == text) return b;
+    throw std::runtime_error("no button " + text);
+}
+
+glm::vec3 board_normal(const VrSession& s) { return s.panel().orientation * glm::vec3(0, 0, 1); }
+
+void poke(VrScript& script, const VrSession& s, const std::string& text)
+{
+    script.poke(Hand::Right, button(s, text).centre, board_normal(s));
+}
+
+float extent(const Stroke& stroke)
+{
+    glm::vec3 lo(1e9f), hi(-1e9f);
+    for (const StrokePoint& p : stroke.points) {
+        lo = glm::min(lo, p.position);
+        hi = glm::max(hi, p.position);
+    }
+    return glm::length(hi - lo);
+}
+
+TEST(VrSession, PanelLayoutStandsInFrontOfAndBelowTheFirstHeadPoseFacingIt)
+{
+    Pose head;
+    head.position = {0.3f, 1.7f, -0.2f};
+    head.orientation = glm::angleAxis(glm::radians(90.0f), glm::vec3(0, 1, 0)); // looking along -X
+    const VrPanel p = vr_panel_layout(head);
+    EXPECT_LT(p.origin.x, head.position.x - 0.3f); // in front
+    EXPECT_LT(p.origin.y, head.position.y - 0.2f); // below the eyes
+    const glm::vec3 n = p.orientation * glm::vec3(0, 0, 1);
+    EXPECT_GT(glm::dot(n, glm::normalize(head.position - p.origin)), 0.99f); // faces the eyes
+    EXPECT_EQ(p.buttons.size(), 27u);
+    for (std::size_t i = 0; i < p.buttons.size(); ++i)
+        for (std::size_t j = i + 1; j < p.buttons.size(); ++j)
+            EXPECT_GT(glm::distance(p.buttons[i].centre, p.buttons[j].centre), 0.04f) << p.buttons[i].text;
+}
+
+TEST(VrSession, ScriptedSessionExercisesEveryInteractionAndItsRecordingReplaysToTheSameDocument)
+{
+    const fs::path dir = scratch("scripted");
+    VrOptions o;
+    o.record_path = (dir / "vr.lrec").string();
+    o.autosave_path = (dir / "autosave.json").string();
+    o.session_path = (dir / "session.json").string();
+    o.background_regrowth = false;
+    VrSession s(Document{}, o);
+    VrScript script([&](const HandFrame& f) { s.frame(f); });
+    script.hand(Hand::Right) = {true, HandPose::Open, {0.25f, 1.3f, -0.3f}, 0.05f};
+    script.wait(0.3);
+    ASSERT_EQ(s.panel().buttons.size(), vr_panel_layout(script.head()).buttons.size());
+
+    // Three loops around one lobe, drawn with a pinch.
+    const glm::vec3 c(0.15f, 1.45f, -0.45f);
+    const glm::vec3 X(1, 0, 0), Y(0, 1, 0), Z(0, 0, 1);
+    script.pinch_along(Hand::Right, circle(c, X, Z, 0.12f));
+    ASSERT_EQ(s.document().strokes.size(), 1u) << (s.messages().empty() ? "" : s.messages().back());
+    script.pinch_along(Hand::Right, circle(c, X, Y, 0.12f));
+    script.pinch_along(Hand::Right, circle(c, Z, Y, 0.12f));
+    ASSERT_EQ(s.document().strokes.size(), 3u);
+    ASSERT_EQ(s.document().lobes.size(), 1u);
+    EXPECT_FALSE(fs::is_empty(o.autosave_path)); // autosaved after each stroke
+    EXPECT_EQ(load_document(o.autosave_path).strokes.size(), 3u);
+
+    // The panel: TRUNK, then a trunk stroke below the lobe.
+    poke(script, s, "TRUNK");
+    EXPECT_EQ(s.status().tool, Tool::DrawTrunk);
+    EXPECT_EQ(s.document().strokes.size(), 3u); // poking draws nothing
+    script.pinch_along(Hand::Right, {c + glm::vec3(0, -0.45f, 0), c + glm::vec3(0.005f, -0.30f, 0), c + glm::vec3(0, -0.12f, 0)});
+    ASSERT_EQ(s.document().strokes.size(), 4u);
+    EXPECT_EQ(s.document().strokes.back().kind, StrokeKind::Trunk);
+
+    // Pinch-deform the lobe's top 5 cm upwards.
+    poke(script, s, "PINCH");
+    EXPECT_EQ(s.status().tool, Tool::DeformLobe);
+    const std::size_t edits0 = s.document().edits.size();
+    script.pinch_along(Hand::Right, {c + glm::vec3(0, 0.12f, 0), c + glm::vec3(0, 0.17f, 0)}, 0.1);
+    ASSERT_EQ(s.document().edits.size(), edits0 + 1);
+    EXPECT_EQ(s.document().edits.back().type, "drag:deform-lobe");
+
+    // Bend a stroke: drag a point of the horizontal loop outwards.
+    poke(script, s, "BEND");
+    EXPECT_EQ(s.status().tool, Tool::EditStroke);
+    script.pinch_along(Hand::Right, {c + glm::vec3(0, 0, 0.12f), c + glm::vec3(0, 0, 0.16f)}, 0.1);
+    ASSERT_EQ(s.document().edits.size(), edits0 + 2);
+    EXPECT_EQ(s.document().edits.back().type, "drag:edit-stroke");
+
+    // Grab the lobe and move it 8 cm to the right.
+    poke(script, s, "MOVE");
+    script.pinch_along(Hand::Right, {c + glm::vec3(0.05f, 0, 0), c + glm::vec3(0.13f, 0, 0)}, 0.15);
+    ASSERT_EQ(s.document().edits.size(), edits0 + 3);
+    EXPECT_EQ(s.document().edits.back().type, "drag:move-lobe");
+
+    // Undo and redo the move.
+    poke(script, s, "UNDO");
+    EXPECT_EQ(s.document().edits.size(), edits0 + 2);
+    poke(script, s, "REDO");
+    EXPECT_EQ(s.document().edits.size(), edits0 + 3);
+
+    // Appearance: the split angle goes up by 5 degrees, the seed changes.
+    const double angle0 = s.document().settings.growth.split_angle_deg;
+    poke(script, s, "ANGLE +");
+    EXPECT_DOUBLE_EQ(s.document().settings.growth.split_angle_deg, angle0 + 5.0);
+    const std::uint64_t seed0 = s.document().seed;
+    poke(script, s, "SEED");
+    EXPECT_NE(s.document().seed, seed0);
+
+    // Both fists pulled apart to twice their distance: the scene doubles in size about them.
+    script.move(Hand::Right, {0.15f, 1.25f, -0.35f}, 0.6);
+    script.fist(Hand::Right, true);
+    const glm::vec3 right_palm = script.hand(Hand::Right).tip;
+    script.hand(Hand::Left) = {true, HandPose::Fist, right_palm - glm::vec3(0.3f, 0, 0), 0.05f};
+    script.wait(0.3);
+    const glm::vec3 mid = right_palm - glm::vec3(0.15f, 0, 0);
+    script.move_both(mid - glm::vec3(0.3f, 0, 0), mid + glm::vec3(0.3f, 0, 0), 0.8);
+    script.wait(0.3);
+    EXPECT_NEAR(s.scene_transform().scale, 2.0f, 0.05f);
+    EXPECT_NEAR(s.scene_transform().yaw, 0.0f, 0.02f);
+    // The point between the hands stays where it was in the document.
+    EXPECT_LT(glm::distance(s.scene_transform().to_document(mid), mid), 0.01f);
+    const SceneTransform scaled = s.scene_transform();
+    script.hand(Hand::Left).active = false;
+    script.fist(Hand::Right, false);
+    script.wait(0.3);
+    EXPECT_EQ(s.scene_transform().scale, scaled.scale); // letting go keeps it
+
+    // A loop of 10 cm drawn now is 5 cm in the document, and starts a new lobe there.
+    poke(script, s, "NEW LOBE");
+    EXPECT_EQ(s.status().tool, Tool::DrawLobe);
+    const std::size_t strokes0 = s.document().strokes.size();
+    script.pinch_along(Hand::Right, circle({0.35f, 1.5f, -0.5f}, X, Z, 0.05f));
+    ASSERT_EQ(s.document().strokes.size(), strokes0 + 1);
+    EXPECT_NEAR(extent(s.document().strokes.back()), 0.5f * 0.1f * std::sqrt(2.0f), 0.01f);
+    EXPECT_EQ(s.document().lobes.size(), 2u);
+
+    // Grow: the tree is built; the label says so.
+    poke(script, s, "GROW");
+    EXPECT_TRUE(s.status().grown);
+    EXPECT_NE(s.status().label.find("TREE"), std::string::npos) << s.status().label;
+    EXPECT_TRUE(s.status().tree_error.empty()) << s.status().tree_error;
+    script.wait(0.2);
+
+    const Document live = s.document();
+    s.finish(script.time() + 0.01);
+    EXPECT_EQ(load_document(o.session_path).strokes.size(), live.strokes.size());
+
+    // The recording holds the panel's presses as key and setting events and the scene grab as
+    // scene events; replayed without the panel it gives the same document.
+    Recording rec = read_recording(o.record_path);
+    int keys = 0, settings = 0, scene = 0;
+    for (const InputEvent& e : rec.events) {
+        keys += e.kind == InputEventKind::Key && e.value == 1;
+        settings += e.kind == InputEventKind::Setting;
+        scene += e.kind == InputEventKind::Scene;
+    }
+    EXPECT_EQ(keys, 8); // TRUNK, PINCH, BEND, MOVE, UNDO, REDO, NEW LOBE, GROW
+    EXPECT_EQ(settings, 2);
+    EXPECT_GT(scene, 5);
+    Document replayed = cli::replay_into_document(o.record_path, Document{});
+    replayed.source_recording = live.source_recording;
+    EXPECT_EQ(document_to_json(replayed).dump(), document_to_json(live).dump());
+}
+
+TEST(VrSession, HandsThatAreNeverTrackedMakeNoStrokesAndNoMessages)
+{
+    VrOptions o;
+    o.background_regrowth = false;
+    VrSession s(Document{}, o);
+    for (int i = 0; i < 300; ++i) {
+        HandFrame f;
+        f.time = i / 90.0;
+        f.head.position = {0, 1.6f, 0};
+        f.head_valid = true;
+        s.frame(f);
+    }
+    s.finish(4.0);
+    EXPECT_TRUE(s.document().strokes.empty());
+    EXPECT_TRUE(s.messages().empty()) << s.messages().front();
+    EXPECT_FALSE(s.status().hands_tracked[0] || s.status().hands_tracked[1]);
+}
+
+TEST(VrSession, EventTrackGivenIsAppliedAtItsTimesAndRecorded)
+{
+    const fs::path dir = scratch("events");
+    VrOptions o;
+    o.background_regrowth = false;
+    o.record_path = (dir / "vr.lrec").string();
+    InputEvent trunk;
+    trunk.time = 0.5;
+    trunk.kind = InputEventKind::Key;
+    trunk.code = keys::kDrawTrunk;
+    trunk.value = 1;
+    o.events = {trunk};
+    VrSession s(Document{}, o);
+    VrScript script([&](const HandFrame& f) { s.frame(f); });
+    script.wait(0.4);
+    EXPECT_EQ(s.status().tool, Tool::DrawLobe);
+    script.wait(0.2);
+    EXPECT_EQ(s.status().tool, Tool::DrawTrunk);
+    s.finish(script.time());
+    const Recording rec = read_recording(o.record_path);
+    ASSERT_EQ(rec.events.size(), 1u);
+    EXPECT_EQ(rec.events[0].time, 0.5);
+}
+
+TEST(VrSession, EyeInDocumentSeesTheScaledSceneAsTheStageEyeSeesItsStageImage)
+{
+    VrOptions o;
+    o.background_regrowth = false;
+    o.events = {InputEvent{0.0, InputEventKind::Scene, int(SceneComponent::Scale), 0, 0.5f, 0},
+                InputEvent{0.0, InputEventKind::Scene, int(SceneComponent::Yaw), 0, 0.3f, 0},
+                InputEvent{0.0, InputEventKind::Scene, int(SceneComponent::TranslationY), 0, 0.2f, 0}};
+    VrSession s(Document{}, o);
+    HandFrame f;
+    f.time = 0.01;
+    s.frame(f);
+    const SceneTransform& t = s.scene_transform();
+    ASSERT_FLOAT_EQ(t.scale, 0.5f);
+    EyeView eye;
+    eye.position = {0.1f, 1.6f, 0.2f};
+    eye.orientation = glm::angleAxis(0.4f, glm::vec3(0, 1, 0));
+    const EyeView d = s.eye_in_document(eye);
+    // A document point seen along the eye's -Z in the stage is along the document eye's -Z.
+    const glm::vec3 stage_point = eye.position + eye.orientation * glm::vec3(0, 0, -1.0f);
+    const glm::vec3 doc_dir = glm::normalize(t.to_document(stage_point) - d.position);
+    EXPECT_GT(glm::dot(doc_dir, d.orientation * glm::vec3(0, 0, -1)), 0.99999f);
+    EXPECT_FLOAT_EQ(d.near_m, eye.near_m / 0.5f);
+}
+
+} // namespace
+} // namespace lobe
