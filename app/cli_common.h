@@ -48,6 +48,11 @@ void add_tree_input_options(CLI::App* cmd, TreeInputOptions& o);
 /// and validates the result. \throw InvalidInput
 void apply_tree_input_options(Settings& s, const TreeInputOptions& o);
 
+/// The local time as "YYYYMMDD-HHMMSS", for default file names.
+std::string timestamp();
+/// "tree.json" → "tree<suffix>" beside it.
+std::string beside(const std::string& session, const std::string& suffix);
+
 /// Replays the recording at `path` into `doc` (its settings and seed are used): the input
 /// pipeline, then the session builder with the meshing edit hooks, as `replay` does. Warnings
 /// of both go to stderr naming the file; `drags` (when given) receives the number of drags.

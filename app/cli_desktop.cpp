@@ -34,23 +34,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string timestamp()
-{
-    const std::time_t now = std::time(nullptr);
-    std::tm tm{};
-    localtime_r(&now, &tm);
-    char buf[32];
-    std::strftime(buf, sizeof buf, "%Y%m%d-%H%M%S", &tm);
-    return buf;
-}
-
-/// "tree.json" → "tree<suffix>" beside it.
-std::string beside(const std::string& session, const std::string& suffix)
-{
-    const fs::path p(session);
-    return (p.parent_path() / (p.stem().string() + suffix)).string();
-}
-
 std::string last_glfw_error()
 {
     const char* description = nullptr;
