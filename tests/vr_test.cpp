@@ -52,12 +52,12 @@ namespace {
 namespace fs = std::filesystem;
 using test::CliRun;
 
-void skip_unless_optimised()
-{
-#if !LOBE_VR_TESTS_ENABLED
-    GTEST_SKIP() << "lobesketch vr end-to-end tests run in optimised builds without sanitizers only";
-#endif
-}
+// A macro: GTEST_SKIP() returns from the function it is in, which must be the test itself.
+#define SKIP_UNLESS_OPTIMISED()                                                                                   \
+    do {                                                                                                          \
+        if (!LOBE_VR_TESTS_ENABLED)                                                                               \
+            GTEST_SKIP() << "lobesketch vr end-to-end tests run in optimised builds without sanitizers only";    \
+    } while (0)
 
 std::string quoted(const std::string& s) { return "'" + s + "'"; }
 
@@ -222,7 +222,7 @@ Recording untracked_recording(int frames)
 
 TEST(Vr, MatchesReplayOnTable1OneLobe)
 {
-    skip_unless_optimised();
+    SKIP_UNLESS_OPTIMISED();
     expect_vr_matches_replay("table1-1lobe-5strokes");
 }
 
@@ -231,19 +231,19 @@ TEST(Vr, MatchesReplayOnTable1OneLobe)
 // `lobe_vr_tests --gtest_also_run_disabled_tests --gtest_filter='Vr.*'`.
 TEST(Vr, DISABLED_MatchesReplayOnTable1ThreeLobes)
 {
-    skip_unless_optimised();
+    SKIP_UNLESS_OPTIMISED();
     expect_vr_matches_replay("table1-3lobes-16strokes");
 }
 
 TEST(Vr, DISABLED_MatchesReplayOnTable1FourLobes)
 {
-    skip_unless_optimised();
+    SKIP_UNLESS_OPTIMISED();
     expect_vr_matches_replay("table1-4lobes-22strokes");
 }
 
 TEST(Vr, EyeImagesShowTheSceneFromTwoEyes)
 {
-    skip_unless_optimised();
+    SKIP_UNLESS_OPTIMISED();
     const std::string rec = test::source_path("recordings/table1-1lobe-5strokes.lrec");
     const std::string dir = test::temp_dir("vr-eyes");
     const CliRun r = run_vr(quoted(dir + "/s.json") + " --sync-regrowth",
@@ -273,7 +273,7 @@ TEST(Vr, EyeImagesShowTheSceneFromTwoEyes)
 
 TEST(Vr, HandsNeverTrackedGiveNoStrokesAndNoError)
 {
-    skip_unless_optimised();
+    SKIP_UNLESS_OPTIMISED();
     const std::string dir = test::temp_dir("vr-untracked");
     const std::string rec = dir + "/untracked.lrec";
     write_recording_binary(rec, untracked_recording(180));
@@ -293,7 +293,7 @@ TEST(Vr, HandsNeverTrackedGiveNoStrokesAndNoError)
 
 TEST(Vr, QuitFromTheEventTrackEndsTheSession)
 {
-    skip_unless_optimised();
+    SKIP_UNLESS_OPTIMISED();
     const std::string dir = test::temp_dir("vr-quit");
     const std::string rec = dir + "/quit.lrec";
     // Quit (what the panel's button sends) pressed 1 s into a 5 s recording.
@@ -322,7 +322,7 @@ TEST(Vr, QuitFromTheEventTrackEndsTheSession)
 
 TEST(Vr, SessionLossSavesAndEndsCleanly)
 {
-    skip_unless_optimised();
+    SKIP_UNLESS_OPTIMISED();
     const std::string rec = test::source_path("recordings/table1-1lobe-5strokes.lrec");
     const std::string dir = test::temp_dir("vr-lost");
     // Lost at frame 750 (after the first stroke), no reconnection.
@@ -351,7 +351,7 @@ TEST(Vr, SessionLossSavesAndEndsCleanly)
 
 TEST(Vr, NoHandTrackingRefusesInOneLine)
 {
-    skip_unless_optimised();
+    SKIP_UNLESS_OPTIMISED();
     const std::string rec = test::source_path("recordings/table1-1lobe-5strokes.lrec");
     const std::string dir = test::temp_dir("vr-nohands");
     const CliRun r = run_vr(quoted(dir + "/s.json"), replay_env(rec, "LOBESKETCH_REPLAY_NO_HAND_TRACKING=1"));
@@ -364,7 +364,7 @@ TEST(Vr, NoHandTrackingRefusesInOneLine)
 
 TEST(Vr, NoVulkanRefusesInOneLine)
 {
-    skip_unless_optimised();
+    SKIP_UNLESS_OPTIMISED();
     const std::string rec = test::source_path("recordings/table1-1lobe-5strokes.lrec");
     const CliRun r = run_vr(quoted(test::temp_dir("vr-novk") + "/s.json"),
                             replay_env(rec, "LOBESKETCH_REPLAY_NO_VULKAN=1"));
@@ -375,7 +375,7 @@ TEST(Vr, NoVulkanRefusesInOneLine)
 
 TEST(Vr, NoRuntimeSaysWhatToInstall)
 {
-    skip_unless_optimised();
+    SKIP_UNLESS_OPTIMISED();
     const std::string dir = test::temp_dir("vr-noruntime");
     const CliRun r = test::run_cli("vr " + quoted(dir + "/s.json"),
                                    "env XR_RUNTIME_JSON=" + quoted(dir + "/missing.json"));
@@ -387,7 +387,7 @@ TEST(Vr, NoRuntimeSaysWhatToInstall)
 
 TEST(Vr, InterruptEndsTheSessionCleanly)
 {
-    skip_unless_optimised();
+    SKIP_UNLESS_OPTIMISED();
     const std::string rec = test::source_path("recordings/table1-1lobe-5strokes.lrec");
     const std::string dir = test::temp_dir("vr-sigint");
     // At the recording's own pace the session lasts 40 s; SIGINT comes after 8.
