@@ -170,6 +170,7 @@ struct VrSession::Impl {
     std::uint64_t panel_version = 0;
     bool panel_dirty = true;
     SceneTransform panel_built_for;
+    std::vector<RenderItem> panel_items; ///< the panel's meshes as last built
 
     // The two-handed scene grab.
     bool grabbing_scene = false;
@@ -576,25 +577,38 @@ void VrSession::Impl::add_dynamic_items()
         }
         const bool moved = t.scale != panel_built_for.scale || t.yaw != panel_built_for.yaw ||
                            t.translation != panel_built_for.translation;
-        if (panel_dirty || moved) ++panel_version;
+        if (panel_dirty || moved || panel_items.empty()) {
+            ++panel_version;
+            panel_items.clear();
+            const VrPanel& panel = self.panel_;
+            SurfaceGeometry board, buttons, lit, text;
+            append_board(board, panel.origin, panel.orientation, 6 * (kButtonW + kButtonGap) + kButtonGap,
+                         5 * (kButtonH + kButtonGap) + kButtonGap, -0.002f);
+            for (std::size_t i = 0; i < panel.buttons.size(); ++i) {
+                const VrButton& b = panel.buttons[i];
+                append_board(int(i) == highlighted ? lit : buttons, b.centre, panel.orientation, 2 * b.half_width,
+                             2 * b.half_height);
+                append_text(text, b.text, b.centre, panel.orientation, 0.0075f, 0.001f);
+            }
+            std::uint64_t part = 0;
+            for (auto& [g, color] : {std::pair{&board, kBoardColor}, std::pair{&buttons, kButtonColor},
+                                     std::pair{&lit, kPressedColor}, std::pair{&text, kTextColor}}) {
+                to_document(*g, t);
+                const std::uint64_t key = kPanelKey | part++; // each part keeps its key
+                if (g->triangles.empty()) continue;
+                RenderItem item;
+                item.key = key;
+                item.version = panel_version;
+                item.material = RenderMaterial::Stroke;
+                item.color = color;
+                item.geometry = std::move(*g);
+                panel_items.push_back(std::move(item));
+            }
+        }
         panel_dirty = false;
         panel_built_for = t;
-        const VrPanel& panel = self.panel_;
-        SurfaceGeometry board, buttons, lit, text;
-        append_board(board, panel.origin, panel.orientation, 6 * (kButtonW + kButtonGap) + kButtonGap,
-                     5 * (kButtonH + kButtonGap) + kButtonGap, -0.002f);
-        for (std::size_t i = 0; i < panel.buttons.size(); ++i) {
-            const VrButton& b = panel.buttons[i];
-            append_board(int(i) == highlighted ? lit : buttons, b.centre, panel.orientation, 2 * b.half_width,
-                         2 * b.half_height);
-            append_text(text, b.text, b.centre, panel.orientation, 0.0075f, 0.001f);
-        }
-        std::uint64_t part = 0;
-        for (auto& [g, color] : {std::pair{&board, kBoardColor}, std::pair{&buttons, kButtonColor},
-                                 std::pair{&lit, kPressedColor}, std::pair{&text, kTextColor}}) {
-            to_document(*g, t);
-            add(kPanelKey | part++, panel_version, RenderMaterial::Stroke, color, std::move(*g));
-        }
+        // Unchanged, the panel's meshes keep their key and version: nothing is rebuilt or uploaded.
+        scene.items.insert(scene.items.end(), panel_items.begin(), panel_items.end());
     }
 
     // The reference photo, in the document (it scales and turns with the sketch).
