@@ -15,30 +15,7 @@
 #include <string>
 #include <vector>
 
-#define STB_IMAGE_IMPLEMENTATION
-#define STB_IMAGE_STATIC
-#if defined(__clang__)
-#pragma clang diagnostic push
-#pragma clang diagnostic ignored "-Wmissing-field-initializers"
-#pragma clang diagnostic ignored "-Wconversion"
-#pragma clang diagnostic ignored "-Wsign-conversion"
-#pragma clang diagnostic ignored "-Wshadow"
-#pragma clang diagnostic ignored "-Wunused-function"
-#elif defined(__GNUC__)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
-#pragma GCC diagnostic ignored "-Wconversion"
-#pragma GCC diagnostic ignored "-Wsign-conversion"
-#pragma GCC diagnostic ignored "-Wshadow"
-#pragma GCC diagnostic ignored "-Wunused-function"
-#endif
-#include <stb/stb_image.h>
-#if defined(__clang__)
-#pragma clang diagnostic pop
-#elif defined(__GNUC__)
-#pragma GCC diagnostic pop
-#endif
-
+#include "app/export_scene.h"
 #include "app/vr_session.h"
 #include "core/document.h"
 #include "input/recording.h"
@@ -129,21 +106,6 @@ void expect_same_document(const Document& want, const Document& got, const std::
     EXPECT_EQ(settings_json(got.settings), settings_json(want.settings)) << what;
 }
 
-struct Rgba {
-    int w = 0, h = 0;
-    std::vector<unsigned char> px;
-};
-
-Rgba read_png(const std::string& path)
-{
-    Rgba img;
-    int n = 0;
-    unsigned char* data = stbi_load(path.c_str(), &img.w, &img.h, &n, 4);
-    if (!data) return img;
-    img.px.assign(data, data + std::size_t(img.w) * std::size_t(img.h) * 4);
-    stbi_image_free(data);
-    return img;
-}
 
 /// `replay REC --out DIR` and `vr SESSION --events REC --out DIR` under the replay runtime
 /// give the same document; so does replaying the recording that `vr` wrote.
@@ -254,17 +216,19 @@ TEST(Vr, EyeImagesShowTheSceneFromTwoEyes)
     for (int frame : {0, 50, 100}) {
         char name[64];
         std::snprintf(name, sizeof name, "/eyes/frame_%06d_eye", frame);
-        const Rgba left = read_png(dir + name + "0.png"), right = read_png(dir + name + "1.png");
-        ASSERT_EQ(left.w, 64) << dir + name << "0.png\n" << r.out;
-        ASSERT_EQ(right.w, 64);
-        ASSERT_EQ(left.h, 64);
+        // 16384: at full size (read_picture_file scales down only past it).
+        const RgbaImage left = read_picture_file(dir + name + "0.png", 16384),
+                        right = read_picture_file(dir + name + "1.png", 16384);
+        ASSERT_EQ(left.width, 64) << dir + name << "0.png\n" << r.out;
+        ASSERT_EQ(right.width, 64);
+        ASSERT_EQ(left.height, 64);
         // Not one colour: sky and ground at least.
         std::size_t differing = 0;
-        for (std::size_t i = 4; i < left.px.size(); i += 4)
-            differing += !std::equal(left.px.begin() + std::ptrdiff_t(i), left.px.begin() + std::ptrdiff_t(i) + 3,
-                                     left.px.begin());
-        EXPECT_GT(differing, left.px.size() / 4 / 20) << "frame " << frame << ": nearly one colour";
-        EXPECT_NE(left.px, right.px) << "frame " << frame << ": both eyes see the same picture";
+        for (std::size_t i = 4; i < left.pixels.size(); i += 4)
+            differing += !std::equal(left.pixels.begin() + std::ptrdiff_t(i), left.pixels.begin() + std::ptrdiff_t(i) + 3,
+                                     left.pixels.begin());
+        EXPECT_GT(differing, left.pixels.size() / 4 / 20) << "frame " << frame << ": nearly one colour";
+        EXPECT_NE(left.pixels, right.pixels) << "frame " << frame << ": both eyes see the same picture";
         ++pairs;
     }
     EXPECT_EQ(pairs, 3);
