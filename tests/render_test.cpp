@@ -1512,7 +1512,8 @@ TEST(RenderXr, RenderToASymmetricEyeDrawsWhatRenderDrawsForTheSameCameraInEveryF
     // The linear formats get linear colours: sRGB 220 is linear 0.716, byte 183.
     TestImage unorm(r.vulkan_handles(), VK_FORMAT_R8G8B8A8_UNORM, kEw, kEh);
     r.render_to(eye_view(), unorm.target());
-    const std::uint8_t* p = pixel(unorm.read(), 25, 25);
+    const RgbaImage linear = unorm.read();
+    const std::uint8_t* p = pixel(linear, 25, 25);
     EXPECT_NEAR(double(p[0]), srgb_to_linear(kTopLeft[0]) * 255.0, 1.0);
 }
 
