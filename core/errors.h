@@ -9,10 +9,17 @@
 
 namespace lobe {
 
-/// Base of all Lobesketch errors.
+/// `what` as one line: control characters a file put into a name or key quoted in the
+/// message are escaped (\n, \t, \xHH), and a message longer than 1000 bytes is cut there
+/// (at a character boundary) and ends in "…".
+std::string one_line_message(const std::string& what);
+
+/// Base of all Lobesketch errors. Every message is one line (one_line_message), whatever
+/// the input quoted in it held.
 class Error : public std::runtime_error {
 public:
-    using std::runtime_error::runtime_error;
+    explicit Error(const std::string& what) : std::runtime_error(one_line_message(what)) {}
+    explicit Error(const char* what) : Error(std::string(what)) {}
 };
 
 /// Input data (a stroke, a setting, a parameter) is unusable.
