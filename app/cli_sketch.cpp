@@ -2,19 +2,14 @@
 // the live VrSession one by one (panel, scene grab, pipeline, document, recording, autosave,
 // regrowth), as `lobesketch vr` feeds it tracked hands. For benchmarks of the live session and
 // for the crash-safety tests (docs/crash-safety.md).
-#include <algorithm>
-#include <chrono>
-#include <cmath>
 #include <memory>
 #include <string>
-#include <thread>
-#include <vector>
 
 #include <CLI/CLI.hpp>
 
 #include "app/cli.h"
 #include "app/cli_common.h"
-#include "app/vr_session.h"
+#include "app/sketch_run.h"
 #include "core/document.h"
 #include "core/errors.h"
 
@@ -48,58 +43,16 @@ void add_sketch_command(CLI::App& app, int& exit_code)
         doc.seed = a->seed;
         if (!a->settings.empty()) doc.settings = load_settings_file(a->settings);
 
-        // The session counts time from the first frame.
-        const double t0 = rec.frames.front().time;
-        VrOptions o;
+        SketchRunOptions o;
         o.session_path = a->session;
         o.autosave_path = a->autosave;
         o.record_path = a->record;
+        o.realtime = a->realtime;
+        o.events_from_recording = a->events;
         o.background_regrowth = !a->inline_regrowth;
-        o.runtime_name = "sketch";
-        o.device_name = rec.header.device;
-        o.nominal_rate_hz = rec.header.nominal_rate_hz;
-        if (a->events) {
-            o.events = rec.events;
-            for (InputEvent& e : o.events) e.time = std::max(0.0, e.time - t0);
-        }
-        VrSession session(std::move(doc), std::move(o));
-
-        using Clock = std::chrono::steady_clock;
-        const Clock::time_point start = Clock::now();
-        std::vector<double> frame_ms;
-        frame_ms.reserve(rec.frames.size());
-        std::string last_message;
-        double time = 0.0;
-        for (const HandFrame& input : rec.frames) {
-            HandFrame f = input;
-            f.time = input.time - t0;
-            time = f.time;
-            if (a->realtime) std::this_thread::sleep_until(start + std::chrono::duration<double>(f.time));
-            const Clock::time_point before = Clock::now();
-            session.frame(f);
-            frame_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - before).count());
-            if (session.status().last_message != last_message) {
-                last_message = session.status().last_message;
-                if (!last_message.empty()) progress(last_message);
-            }
-            if (session.quit_requested()) break;
-        }
-        session.finish(time + 1e-3);
-        const double total_s = std::chrono::duration<double>(Clock::now() - start).count();
-
-        std::vector<double> sorted = frame_ms;
-        std::sort(sorted.begin(), sorted.end());
-        auto quantile = [&](double q) {
-            return sorted.empty() ? 0.0 : sorted[std::min(sorted.size() - 1, static_cast<std::size_t>(q * double(sorted.size())))];
-        };
-        double sum = 0.0;
-        for (double ms : frame_ms) sum += ms;
-        const Document& out = session.document();
-        char line[256];
-        std::snprintf(line, sizeof line, "%zu frames in %.2f s; frame %.2f ms mean, %.2f ms p99, %.2f ms max",
-                      frame_ms.size(), total_s, frame_ms.empty() ? 0.0 : sum / double(frame_ms.size()), quantile(0.99),
-                      sorted.empty() ? 0.0 : sorted.back());
-        progress(line);
+        const SketchRunResult run = run_sketch(rec, std::move(doc), o, [](const std::string& m) { progress(m); });
+        const Document& out = run.document;
+        progress(frame_time_summary(run));
         progress(std::to_string(out.strokes.size()) + " strokes, " + std::to_string(out.lobes.size()) +
                  " lobe group(s), " + std::to_string(out.edits.size()) + " edit(s)" +
                  (a->session.empty() ? std::string() : "; saved " + a->session));
