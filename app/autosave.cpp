@@ -1,5 +1,7 @@
 #include "app/autosave.h"
 
+#include <utility>
+
 #include "core/errors.h"
 
 namespace lobe {
@@ -21,6 +23,76 @@ std::string write_autosave(const std::string& path, RecordingWriter* recording, 
         return {};
     } catch (const Error& e) {
         return e.what();
+    }
+}
+
+AutosaveWriter::AutosaveWriter(std::string path) : path_(std::move(path)), thread_([this] { run(); }) {}
+
+AutosaveWriter::~AutosaveWriter()
+{
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        stop_ = true;
+    }
+    wake_.notify_all();
+    thread_.join();
+}
+
+void AutosaveWriter::submit(Document doc)
+{
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        pending_ = std::move(doc); // replaces a waiting one: newest wins
+    }
+    wake_.notify_one();
+}
+
+void AutosaveWriter::wait()
+{
+    std::unique_lock<std::mutex> lock(mutex_);
+    idle_.wait(lock, [&] { return !pending_ && !busy_; });
+}
+
+std::vector<std::string> AutosaveWriter::take_failures()
+{
+    std::lock_guard<std::mutex> lock(mutex_);
+    return std::exchange(failures_, {});
+}
+
+std::uint64_t AutosaveWriter::written() const
+{
+    std::lock_guard<std::mutex> lock(mutex_);
+    return written_;
+}
+
+void AutosaveWriter::run()
+{
+    for (;;) {
+        Document doc;
+        {
+            std::unique_lock<std::mutex> lock(mutex_);
+            wake_.wait(lock, [&] { return stop_ || pending_.has_value(); });
+            // Stopping writes what is still waiting: it is the newest state of the session.
+            if (!pending_) return;
+            doc = std::move(*pending_);
+            pending_.reset();
+            busy_ = true;
+        }
+        std::string why;
+        try {
+            save_autosave(path_, doc);
+        } catch (const Error& e) {
+            why = e.what();
+        } catch (const std::bad_alloc&) {
+            why = path_ + ": out of memory while writing the autosave";
+        }
+        {
+            std::lock_guard<std::mutex> lock(mutex_);
+            busy_ = false;
+            if (why.empty()) ++written_;
+            else if (failures_.size() < 100) failures_.push_back(std::move(why));
+        }
+        idle_.notify_all();
     }
 }
 

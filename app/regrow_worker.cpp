@@ -3,9 +3,14 @@
 #include "app/tree_output.h"
 #include "core/errors.h"
 
+#include <utility>
+
 namespace lobe {
 
-RegrowWorker::RegrowWorker() : thread_([this] { run(); }) {}
+RegrowWorker::RegrowWorker(std::function<void(RegrowResult&)> prepare)
+    : prepare_(std::move(prepare)), thread_([this] { run(); })
+{
+}
 
 RegrowWorker::~RegrowWorker()
 {
@@ -73,6 +78,7 @@ void RegrowWorker::run()
             } else {
                 result.tree.lobes = build_document_lobes(doc, &result.tree.warnings);
             }
+            if (prepare_) prepare_(result);
         } catch (const Error& e) {
             result.error = e.what();
         } catch (const std::bad_alloc&) {

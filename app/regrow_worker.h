@@ -7,11 +7,13 @@
 
 #include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <thread>
 
+#include "app/renderer.h"
 #include "app/tree_pipeline.h"
 #include "growth/tree_geometry.h"
 
@@ -23,11 +25,17 @@ struct RegrowResult {
     BuiltTree tree;
     TreeGeometry geometry;
     std::string error; ///< non-empty when the document could not be grown (one line)
+    /// What the app draws of this result, when the worker was given a prepare hook: made on
+    /// the worker's thread with the rest, so that taking a result costs a frame nothing.
+    RenderScene scene;
 };
 
 class RegrowWorker {
 public:
-    RegrowWorker();
+    /// `prepare` (may be empty) runs on the worker's thread after each regrowth that worked,
+    /// before the result is handed out: the place for the app's own derived data
+    /// (RegrowResult::scene). An Error it throws becomes the result's error.
+    explicit RegrowWorker(std::function<void(RegrowResult&)> prepare = {});
     ~RegrowWorker(); ///< stops the worker thread (a running regrowth finishes first)
     RegrowWorker(const RegrowWorker&) = delete;
     RegrowWorker& operator=(const RegrowWorker&) = delete;
@@ -44,6 +52,7 @@ public:
 private:
     void run();
 
+    std::function<void(RegrowResult&)> prepare_;
     std::mutex mutex_;
     std::condition_variable wake_, done_;
     std::optional<Document> pending_;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 
 #include <glm/geometric.hpp>
 #include <glm/gtc/constants.hpp>
@@ -147,12 +148,40 @@ VrPanel vr_panel_layout(const Pose& head)
     return panel;
 }
 
+/// FNV-1a over a stroke's points: equal points, equal tube.
+std::uint64_t points_fingerprint(const std::vector<glm::vec3>& pts)
+{
+    std::uint64_t h = 1469598103934665603ull;
+    const auto* p = reinterpret_cast<const unsigned char*>(pts.data());
+    for (std::size_t i = 0; i < pts.size() * sizeof(glm::vec3); ++i) h = (h ^ p[i]) * 1099511628211ull;
+    return (h ^ pts.size()) * 1099511628211ull;
+}
+
+/// The regrowth's part of the VR scene (lobes; the tree's middle LOD once grown: the full one
+/// is for export and pictures, docs/vr.md), made on the regrowth worker's thread
+/// (RegrowWorker's prepare hook) with its bounds in ground_area, so that taking a new tree
+/// costs the frame only moves.
+void prepare_grown_scene(RegrowResult& r)
+{
+    std::vector<TriangleMesh> lobes;
+    lobes.reserve(r.tree.lobes.size());
+    for (const BuiltLobe& l : r.tree.lobes) lobes.push_back(l.mesh);
+    RenderContent content;
+    content.tree = content.leaves = r.grown && !r.geometry.lods.empty();
+    content.lobes = true;
+    content.strokes = false;
+    content.lod = content.tree ? std::min(1, int(r.geometry.lods.size()) - 1) : 0;
+    r.scene = tree_render_scene(r.geometry, lobes, {}, 0.0f, content);
+    r.scene.ground_area = scene_bounds(r.scene);
+}
+
 // ---------------------------------------------------------------------------------------------
 struct VrSession::Impl {
     VrSession& self;
     VrOptions options;
     InputPipeline pipeline;
     std::unique_ptr<RecordingWriter> recording;
+    std::unique_ptr<AutosaveWriter> autosaver;
     std::unique_ptr<RegrowWorker> worker;
 
     std::vector<InputEvent> pending;  ///< panel presses and scene moves, applied by the next frame
@@ -188,7 +217,15 @@ struct VrSession::Impl {
     std::uint64_t revision = 0, requested_generation = 0, dynamic_version = 0;
     std::optional<RegrowResult> built;
     std::size_t builder_messages_seen = 0;
-    std::size_t static_items = 0;
+    // The scene's items: [0, grown_items) the regrowth's lobes and tree (made on the worker),
+    // [grown_items, static_items) the strokes, then the hands, panel and labels of this frame.
+    std::size_t grown_items = 0, static_items = 0;
+    Bounds grown_bounds;
+    struct StrokeItem {
+        std::uint64_t fingerprint = 0; ///< of the points the tube was made from
+        RenderItem item;
+    };
+    std::map<std::int64_t, StrokeItem> stroke_items; ///< by stroke id: a tube is made again only when its stroke changed
     HandFrame last_frame;
 
     Impl(VrSession& s, VrOptions o, const Document& doc) : self(s), options(std::move(o)), pipeline(doc.settings.input) {}
@@ -220,6 +257,8 @@ struct VrSession::Impl {
     void request_regrowth();
     void take_regrowth(std::optional<RegrowResult> result);
     void rebuild_static_scene();
+    void autosave();
+    void report_autosave_failures();
     void add_dynamic_items();
     void update_status();
 };
@@ -261,6 +300,7 @@ void VrSession::Impl::frame(const HandFrame& input)
     grab_scene(f);
 
     if (options.background_regrowth) take_regrowth(worker->take());
+    report_autosave_failures();
     last_frame = f;
     update_status();
     add_dynamic_items();
@@ -443,12 +483,31 @@ void VrSession::Impl::grab_scene(const HandFrame& f)
 void VrSession::Impl::document_changed()
 {
     ++revision;
-    if (!options.autosave_path.empty()) {
-        const std::string why = write_autosave(options.autosave_path, recording.get(), document(), frames_recorded, finished);
-        if (!why.empty()) note("autosave failed: " + why);
-    }
+    autosave();
     request_regrowth();
     rebuild_static_scene(); // strokes show at once; lobes and the tree follow the regrowth
+}
+
+void VrSession::Impl::autosave()
+{
+    if (!autosaver) return;
+    // The recording first, on this thread (a write of at most 9 frames, no sync): whichever
+    // autosave is on disk when the program dies, the recording holds all it holds. The JSON
+    // and the disk are the writer thread's (app/autosave.h).
+    try {
+        if (recording) recording->flush();
+    } catch (const Error& e) {
+        note(std::string("autosave failed: ") + e.what());
+        return;
+    }
+    autosaver->submit(at_recording_position(document(), recording != nullptr, frames_recorded, finished));
+    if (!options.background_regrowth) autosaver->wait(); // deterministic: on disk before the frame ends
+}
+
+void VrSession::Impl::report_autosave_failures()
+{
+    if (!autosaver) return;
+    for (const std::string& why : autosaver->take_failures()) note("autosave failed: " + why);
 }
 
 void VrSession::Impl::request_regrowth()
@@ -464,36 +523,61 @@ void VrSession::Impl::take_regrowth(std::optional<RegrowResult> result)
     self.status_.tree_error = result->error;
     if (!result->error.empty()) note("tree: " + result->error);
     for (const std::string& w : result->tree.warnings) note(w);
+    RenderScene& scene = self.scene_;
+    // The regrowth's items, made on the worker (prepare_grown_scene), replace the old ones.
+    scene.items.erase(scene.items.begin(), scene.items.begin() + std::ptrdiff_t(grown_items));
+    static_items -= grown_items;
+    grown_items = result->scene.items.size();
+    static_items += grown_items;
+    scene.items.insert(scene.items.begin(), std::make_move_iterator(result->scene.items.begin()),
+                       std::make_move_iterator(result->scene.items.end()));
+    result->scene.items.clear();
+    scene.leaf_texture = std::move(result->scene.leaf_texture);
+    scene.leaf_texture_version = result->scene.leaf_texture_version;
+    grown_bounds = result->scene.ground_area;
     built = std::move(result);
     rebuild_static_scene();
 }
 
 void VrSession::Impl::rebuild_static_scene()
 {
-    std::vector<TriangleMesh> lobes;
-    const TreeGeometry empty;
-    const TreeGeometry* geometry = &empty;
-    if (built) {
-        for (const BuiltLobe& l : built->tree.lobes) lobes.push_back(l.mesh);
-        if (built->grown && grown && !built->geometry.lods.empty()) geometry = &built->geometry;
+    // The strokes: a tube only for a stroke that is new or changed (most changes add one).
+    RenderScene& scene = self.scene_;
+    std::vector<RenderItem> strokes;
+    std::map<std::int64_t, StrokeItem> kept;
+    Bounds area = grown_bounds;
+    for (const Stroke& st : effective_strokes(document())) {
+        std::vector<glm::vec3> pts;
+        pts.reserve(st.points.size() + 1);
+        for (const StrokePoint& p : st.points) pts.push_back(p.position);
+        if (st.closed && pts.size() > 2) pts.push_back(pts.front());
+        const std::uint64_t fingerprint = points_fingerprint(pts);
+        auto it = stroke_items.find(st.id);
+        StrokeItem item;
+        if (it != stroke_items.end() && it->second.fingerprint == fingerprint) item = std::move(it->second);
+        else {
+            RenderContent content;
+            content.tree = content.leaves = content.lobes = false;
+            content.strokes = true;
+            RenderScene one = tree_render_scene(TreeGeometry{}, {}, {st}, 0.0f, content);
+            if (one.items.empty()) continue;
+            item.fingerprint = fingerprint;
+            item.item = std::move(one.items.front());
+        }
+        for (const glm::vec3& p : item.item.geometry.positions) area.add(p);
+        strokes.push_back(item.item);
+        kept.emplace(st.id, std::move(item));
     }
-    RenderContent content;
-    content.tree = content.leaves = geometry != &empty;
-    content.lobes = content.strokes = true;
-    // VR draws the middle LOD: the full one is for export and pictures (docs/vr.md).
-    content.lod = content.tree ? std::min(1, int(geometry->lods.size()) - 1) : 0;
-    RgbaImage photo_texture = std::move(self.scene_.photo_texture);
-    const std::uint64_t photo_texture_version = self.scene_.photo_texture_version;
-    self.scene_ = tree_render_scene(*geometry, lobes, effective_strokes(document()), 0.0f, content);
-    self.scene_.photo_texture = std::move(photo_texture);
-    self.scene_.photo_texture_version = photo_texture_version;
-    Bounds area = scene_bounds(self.scene_);
+    stroke_items = std::move(kept);
+    scene.items.resize(grown_items);
+    scene.items.insert(scene.items.end(), std::make_move_iterator(strokes.begin()), std::make_move_iterator(strokes.end()));
+    static_items = scene.items.size();
+    scene.ground_y = 0.0f;
     if (area.empty()) {
         area.add(glm::vec3(-0.5f, 0.0f, -0.5f));
         area.add(glm::vec3(0.5f, 1.0f, 0.5f));
     }
-    self.scene_.ground_area = area;
-    static_items = self.scene_.items.size();
+    scene.ground_area = area;
 }
 
 void VrSession::Impl::update_status()
@@ -503,7 +587,7 @@ void VrSession::Impl::update_status()
     s.grown = grown;
     s.drawing = pipeline.drawing(Hand::Right) || pipeline.drawing(Hand::Left);
     s.scaling = grabbing_scene;
-    s.regrowing = !built || built->generation < requested_generation;
+    s.regrowing = requested_generation > 0 && (!built || built->generation < requested_generation);
     for (int h = 0; h < kHandCount; ++h) s.hands_tracked[h] = pipeline.gestures().hand(static_cast<Hand>(h)).tracked;
     s.strokes = document().strokes.size();
     s.lobes = document().lobes.size();
@@ -651,7 +735,8 @@ VrSession::VrSession(Document doc, VrOptions options)
     doc.recording_frames.reset();
     doc.recording_finished = false;
     builder_ = std::make_unique<SessionBuilder>(std::move(doc), EditPickOptions{}, std::move(hooks));
-    impl_->worker = std::make_unique<RegrowWorker>();
+    if (!o.autosave_path.empty()) impl_->autosaver = std::make_unique<AutosaveWriter>(o.autosave_path);
+    impl_->worker = std::make_unique<RegrowWorker>(prepare_grown_scene);
     if (!document().strokes.empty() || !document().lobes.empty()) impl_->request_regrowth();
     impl_->rebuild_static_scene();
     impl_->update_status();
@@ -760,10 +845,10 @@ void VrSession::finish(double time)
     im.run_commands(commands, im.last_frame);
     // The end changed nothing: the last autosave still says so, for `recover` to see that
     // nothing of the recording is left to replay.
-    if (im.revision == revision && im.revision > 0 && !im.options.autosave_path.empty()) {
-        const std::string why = write_autosave(im.options.autosave_path, im.recording.get(), document(),
-                                               im.frames_recorded, true);
-        if (!why.empty()) im.note("autosave failed: " + why);
+    if (im.revision == revision && im.revision > 0) im.autosave();
+    if (im.autosaver) {
+        im.autosaver->wait();
+        im.report_autosave_failures();
     }
     if (im.recording) im.recording->close();
     if (!im.options.session_path.empty()) save();

@@ -24,6 +24,7 @@
 
 #include <gtest/gtest.h>
 
+#include "app/autosave.h"
 #include "app/desktop_session.h"
 #include "app/edit_hooks.h"
 #include "core/atomic_file.h"
@@ -198,6 +199,49 @@ TEST(CrashSafetyDocument, AutosaveKeepsThePreviousGenerationWhole)
         }
     }
     EXPECT_FALSE(fs::exists(previous_autosave_path(path) + ".tmp"));
+}
+
+// The live apps' autosaves are written on a thread of their own (app/autosave.h).
+TEST(CrashSafetyDocument, AutosaveWriterWritesTheNewestDocumentAndWaitMeansItIsOnDisk)
+{
+    const std::string dir = temp_dir("autosave-writer");
+    const std::string path = dir + "/a.json";
+    {
+        AutosaveWriter w(path);
+        Document doc;
+        for (std::uint64_t seed = 1; seed <= 50; ++seed) {
+            doc.seed = seed;
+            w.submit(doc);
+        }
+        w.wait();
+        EXPECT_EQ(load_document(path).seed, 50u); // the newest, whatever was skipped
+        EXPECT_GE(w.written(), 1u);
+        EXPECT_LE(w.written(), 50u);
+        EXPECT_TRUE(w.take_failures().empty());
+        doc.seed = 51;
+        w.submit(doc); // not waited for: the destructor writes it
+    }
+    EXPECT_EQ(load_document(path).seed, 51u);
+    EXPECT_FALSE(fs::exists(path + ".tmp"));
+}
+
+TEST(CrashSafetyDocument, AutosaveWriterReportsAFailedWriteInOneLineAndGoesOn)
+{
+    const std::string dir = temp_dir("autosave-writer-fails");
+    const std::string path = dir + "/no-such-folder/a.json";
+    AutosaveWriter w(path);
+    w.submit(Document{});
+    w.wait();
+    const std::vector<std::string> failures = w.take_failures();
+    ASSERT_EQ(failures.size(), 1u);
+    EXPECT_NE(failures[0].find("no-such-folder/a.json"), std::string::npos) << failures[0];
+    EXPECT_EQ(failures[0].find('\n'), std::string::npos);
+    EXPECT_TRUE(w.take_failures().empty());
+    fs::create_directories(dir + "/no-such-folder");
+    w.submit(Document{});
+    w.wait();
+    EXPECT_TRUE(w.take_failures().empty());
+    EXPECT_EQ(w.written(), 1u);
 }
 
 TEST(CrashSafetyDocument, KilledWhileSavingLeavesTheOldOrTheNewFileWhole)

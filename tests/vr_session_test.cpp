@@ -1,6 +1,7 @@
 // The VR session without a headset: scripted hands (tests/vr_script.h) poke the panel, draw,
 // edit, grab the scene with both hands and undo; every change is checked on the document, and
 // the recording the session wrote replays to the same document.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <string>
@@ -9,9 +10,13 @@
 #include <glm/gtc/constants.hpp>
 
 #include "app/cli_common.h"
+#include "app/render_scene.h"
+#include "app/tree_output.h"
+#include "app/tree_pipeline.h"
 #include "app/vr_session.h"
 #include "core/document.h"
 #include "input/recording.h"
+#include "meshing/edit_ops.h"
 #include "tests/vr_script.h"
 
 namespace lobe {
@@ -204,6 +209,92 @@ TEST(VrSession, ScriptedSessionExercisesEveryInteractionAndItsRecordingReplaysTo
     EXPECT_EQ(document_to_json(replayed).dump(), document_to_json(live).dump());
 }
 
+// The live path: regrowth and autosave off the frame thread. What it draws once the regrowth
+// arrived is what a scene built in one go from the same document draws (the tree's items are
+// made on the worker, each stroke's tube only when the stroke changed), and the autosave on
+// disk when the session ends is its last document.
+TEST(VrSession, OffTheFrameThreadTheSceneIsTheOneBuiltInOneGoAndTheAutosaveIsTheLastDocument)
+{
+    const fs::path dir = scratch("background");
+    VrOptions o;
+    o.record_path = (dir / "vr.lrec").string();
+    o.autosave_path = (dir / "autosave.json").string();
+    o.background_regrowth = true;
+    VrSession s(Document{}, o);
+    VrScript script([&](const HandFrame& f) { s.frame(f); });
+    script.hand(Hand::Right) = {true, HandPose::Open, {0.25f, 1.3f, -0.3f}, 0.05f};
+    script.wait(0.3);
+    const glm::vec3 c(0.15f, 1.45f, -0.45f);
+    const glm::vec3 X(1, 0, 0), Y(0, 1, 0), Z(0, 0, 1);
+    script.pinch_along(Hand::Right, circle(c, X, Z, 0.12f));
+    script.pinch_along(Hand::Right, circle(c, X, Y, 0.12f));
+    script.pinch_along(Hand::Right, circle(c, Z, Y, 0.12f));
+    poke(script, s, "TRUNK");
+    script.pinch_along(Hand::Right, {c + glm::vec3(0, -0.45f, 0), c + glm::vec3(0.005f, -0.30f, 0), c + glm::vec3(0, -0.12f, 0)});
+    poke(script, s, "GROW");
+    // A stroke bent after the growth: its tube is made again, the others are kept.
+    poke(script, s, "BEND");
+    script.pinch_along(Hand::Right, {c + glm::vec3(0, 0, 0.12f), c + glm::vec3(0, 0, 0.16f)}, 0.1);
+    ASSERT_EQ(s.document().edits.size(), 1u);
+    s.wait_for_regrowth();
+    script.wait(0.05); // one more frame: the hands and panel are drawn again
+
+    const Document& doc = s.document();
+    const BuiltTree tree = build_document_tree(doc);
+    const TreeGeometry geometry = document_tree_geometry(doc, tree);
+    std::vector<TriangleMesh> lobes;
+    for (const BuiltLobe& l : tree.lobes) lobes.push_back(l.mesh);
+    RenderContent content;
+    content.lobes = content.strokes = true;
+    content.lod = 1;
+    const RenderScene expected = tree_render_scene(geometry, lobes, effective_strokes(doc), 0.0f, content);
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> want, got;
+    for (const RenderItem& i : expected.items) want.emplace_back(i.key, i.version);
+    for (const RenderItem& i : s.scene().items)
+        if ((i.key >> 56) != 10) got.emplace_back(i.key, i.version); // 10: the hands, panel, labels
+    std::sort(want.begin(), want.end());
+    std::sort(got.begin(), got.end());
+    EXPECT_EQ(got, want);
+    EXPECT_GT(want.size(), 6u); // branches, leaves, a lobe, four strokes
+    EXPECT_EQ(s.scene().leaf_texture.pixels, expected.leaf_texture.pixels);
+    const Bounds area = scene_bounds(expected);
+    EXPECT_LT(glm::distance(s.scene().ground_area.lo, area.lo), 1e-5f);
+    EXPECT_LT(glm::distance(s.scene().ground_area.hi, area.hi), 1e-5f);
+
+    const Document live = s.document();
+    s.finish(script.time() + 0.01);
+    Document saved = load_document(o.autosave_path);
+    EXPECT_TRUE(saved.recording_finished);
+    saved.recording_frames.reset();
+    saved.recording_finished = false;
+    EXPECT_EQ(document_to_json(saved).dump(), document_to_json(live).dump());
+    for (const std::string& m : s.messages()) EXPECT_EQ(m.find("autosave failed"), std::string::npos) << m;
+}
+
+TEST(VrSession, AnAutosaveThatCannotBeWrittenIsReportedAndTheSessionGoesOn)
+{
+    const fs::path dir = scratch("autosave_fails");
+    VrOptions o;
+    o.autosave_path = (dir / "missing-folder" / "autosave.json").string();
+    o.background_regrowth = true;
+    VrSession s(Document{}, o);
+    VrScript script([&](const HandFrame& f) { s.frame(f); });
+    script.hand(Hand::Right) = {true, HandPose::Open, {0.25f, 1.3f, -0.3f}, 0.05f};
+    script.wait(0.3);
+    script.pinch_along(Hand::Right, circle({0.15f, 1.45f, -0.45f}, {1, 0, 0}, {0, 0, 1}, 0.12f));
+    ASSERT_EQ(s.document().strokes.size(), 1u);
+    s.finish(script.time() + 0.01);
+    int failures = 0;
+    for (const std::string& m : s.messages())
+        if (m.rfind("autosave failed: ", 0) == 0) {
+            ++failures;
+            EXPECT_NE(m.find("missing-folder"), std::string::npos) << m;
+            EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+        }
+    EXPECT_GE(failures, 1);
+    EXPECT_EQ(s.document().strokes.size(), 1u);
+}
+
 TEST(VrSession, HandsThatAreNeverTrackedMakeNoStrokesAndNoMessages)
 {
     VrOptions o;
@@ -220,6 +311,7 @@ TEST(VrSession, HandsThatAreNeverTrackedMakeNoStrokesAndNoMessages)
     EXPECT_TRUE(s.document().strokes.empty());
     EXPECT_TRUE(s.messages().empty()) << s.messages().front();
     EXPECT_FALSE(s.status().hands_tracked[0] || s.status().hands_tracked[1]);
+    EXPECT_FALSE(s.status().regrowing) << "nothing was asked to regrow";
 }
 
 TEST(VrSession, EventTrackGivenIsAppliedAtItsTimesAndRecorded)
