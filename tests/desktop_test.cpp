@@ -230,11 +230,11 @@ TEST(DesktopSession, SketchBuildsLobeAndTreeAndEveryChangeIsAutosaved)
     EXPECT_GT(s.status().tree_triangles, 1000u);
     // The autosave holds exactly the document as it is now, stamped with how much of the
     // recording it holds (docs/crash-safety.md).
-    const auto unstamped = [](Document d) {
-        EXPECT_TRUE(d.recording_frames.has_value());
-        d.recording_frames.reset();
-        d.recording_finished = false;
-        return document_to_json(d);
+    const auto unstamped = [](Document saved) {
+        EXPECT_TRUE(saved.recording_frames.has_value());
+        saved.recording_frames.reset();
+        saved.recording_finished = false;
+        return document_to_json(saved);
     };
     EXPECT_EQ(unstamped(load_document(dir + "/session.autosave.json")), document_to_json(doc));
     EXPECT_FALSE(fs::exists(dir + "/session.json")) << "only Save writes the session file";
