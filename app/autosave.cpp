@@ -14,18 +14,6 @@ Document at_recording_position(const Document& doc, bool recorded, std::uint64_t
     return out;
 }
 
-std::string write_autosave(const std::string& path, RecordingWriter* recording, const Document& doc,
-                           std::uint64_t frames, bool finished)
-{
-    try {
-        if (recording) recording->flush();
-        save_autosave(path, at_recording_position(doc, recording != nullptr, frames, finished));
-        return {};
-    } catch (const Error& e) {
-        return e.what();
-    }
-}
-
 AutosaveWriter::AutosaveWriter(std::string path) : path_(std::move(path)), thread_([this] { run(); }) {}
 
 AutosaveWriter::~AutosaveWriter()

@@ -13,18 +13,12 @@
 #include <vector>
 
 #include "core/document.h"
-#include "input/recording.h"
 
 namespace lobe {
 
 /// `doc` stamped with how much of the session's recording it holds: `frames` hand frames,
 /// and the end of the recording when `finished` (Document::recording_frames).
 Document at_recording_position(const Document& doc, bool recorded, std::uint64_t frames, bool finished);
-
-/// The autosave after a change: the recording flushed first, so that it always covers what the
-/// autosave holds. Empty when it worked, else why not (one line).
-std::string write_autosave(const std::string& path, RecordingWriter* recording, const Document& doc,
-                           std::uint64_t frames, bool finished);
 
 /// Autosaves written on a thread of their own, so that the frame that completes a stroke never
 /// waits for the JSON and the disk (a few milliseconds for a large session, more on a slow

@@ -93,6 +93,7 @@ DesktopSession::DesktopSession(Document doc, DesktopOptions options)
         return it->second;
     };
     builder_ = std::make_unique<SessionBuilder>(std::move(doc), EditPickOptions{}, std::move(hooks));
+    if (!options_.autosave_path.empty()) autosaver_ = std::make_unique<AutosaveWriter>(options_.autosave_path);
     worker_ = std::make_unique<RegrowWorker>();
     if (!document().strokes.empty()) request_regrowth();
     rebuild_static_scene();
@@ -289,13 +290,14 @@ void DesktopSession::frame(double time, int width, int height)
     }
 
     if (options_.background_regrowth) take_regrowth(worker_->take());
+    report_autosave_failures();
 
     const HandGesture& g = pipeline_.gestures().hand(Hand::Right);
     status_.tool = pipeline_.tool();
     status_.grown = grown_;
     status_.pinching = g.pinching;
     status_.drawing = pipeline_.drawing(Hand::Right);
-    status_.regrowing = !built_ || built_->generation < requested_generation_;
+    status_.regrowing = requested_generation_ > 0 && (!built_ || built_->generation < requested_generation_);
     status_.depth_m = depth;
     status_.tip = pose.tip;
     status_.strokes = document().strokes.size();
@@ -327,13 +329,30 @@ void DesktopSession::apply_actions()
 void DesktopSession::document_changed()
 {
     ++revision_;
-    if (!options_.autosave_path.empty()) {
-        const std::string why =
-            write_autosave(options_.autosave_path, recording_.get(), document(), frames_recorded_, finished_);
-        if (!why.empty()) note("autosave failed: " + why);
-    }
+    autosave();
     request_regrowth();
     rebuild_static_scene(); // strokes show at once; lobes and the tree follow the regrowth
+}
+
+void DesktopSession::autosave()
+{
+    if (!autosaver_) return;
+    // As in the VR session: the recording flushed here, the JSON and the disk on the writer's
+    // thread, so the window never waits for them (docs/crash-safety.md).
+    try {
+        if (recording_) recording_->flush();
+    } catch (const Error& e) {
+        note(std::string("autosave failed: ") + e.what());
+        return;
+    }
+    autosaver_->submit(at_recording_position(document(), recording_ != nullptr, frames_recorded_, finished_));
+    if (!options_.background_regrowth) autosaver_->wait(); // deterministic: on disk before the frame ends
+}
+
+void DesktopSession::report_autosave_failures()
+{
+    if (!autosaver_) return;
+    for (const std::string& why : autosaver_->take_failures()) note("autosave failed: " + why);
 }
 
 void DesktopSession::request_regrowth()
@@ -495,10 +514,10 @@ void DesktopSession::finish(double time)
     apply_actions();
     // The end changed nothing: the last autosave still says so, for `recover` to see that
     // nothing of the recording is left to replay.
-    if (revision_ == revision && revision_ > 0 && !options_.autosave_path.empty()) {
-        const std::string why =
-            write_autosave(options_.autosave_path, recording_.get(), document(), frames_recorded_, finished_);
-        if (!why.empty()) note("autosave failed: " + why);
+    if (revision_ == revision && revision_ > 0) autosave();
+    if (autosaver_) {
+        autosaver_->wait();
+        report_autosave_failures();
     }
     if (recording_) recording_->close();
 }

@@ -17,6 +17,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "app/autosave.h"
 #include "app/regrow_worker.h"
 #include "app/renderer.h"
 #include "core/document.h"
@@ -141,6 +142,8 @@ private:
     void handle(const InputEvent& e, int width, int height);
     void apply_actions();
     void document_changed();
+    void autosave();
+    void report_autosave_failures();
     void request_regrowth();
     void take_regrowth(std::optional<RegrowResult> result);
     void rebuild_static_scene();
@@ -153,6 +156,7 @@ private:
     InputPipeline pipeline_;
     std::unique_ptr<SessionBuilder> builder_;
     std::unique_ptr<RecordingWriter> recording_;
+    std::unique_ptr<AutosaveWriter> autosaver_; ///< writes the autosaves beside the frames (app/autosave.h)
     std::unique_ptr<RegrowWorker> worker_;
 
     std::vector<InputEvent> pending_;
