@@ -3,6 +3,7 @@
 #include <utility>
 
 #include "core/errors.h"
+#include "input/recording.h"
 
 namespace lobe {
 
@@ -33,6 +34,19 @@ void AutosaveWriter::submit(Document doc)
         pending_ = std::move(doc); // replaces a waiting one: newest wins
     }
     wake_.notify_one();
+}
+
+std::string AutosaveWriter::submit_after_change(RecordingWriter* recording, const Document& doc, std::uint64_t frames,
+                                                bool finished, bool wait_for_disk)
+{
+    try {
+        if (recording) recording->flush();
+    } catch (const Error& e) {
+        return e.what();
+    }
+    submit(at_recording_position(doc, recording != nullptr, frames, finished));
+    if (wait_for_disk) wait();
+    return {};
 }
 
 void AutosaveWriter::wait()

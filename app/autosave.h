@@ -16,6 +16,8 @@
 
 namespace lobe {
 
+class RecordingWriter;
+
 /// `doc` stamped with how much of the session's recording it holds: `frames` hand frames,
 /// and the end of the recording when `finished` (Document::recording_frames).
 Document at_recording_position(const Document& doc, bool recorded, std::uint64_t frames, bool finished);
@@ -42,6 +44,14 @@ public:
     /// How many documents were written (not counting the ones a newer one replaced).
     std::uint64_t written() const;
     const std::string& path() const { return path_; }
+
+    /// The autosave after a change of a live session: the session's `recording` (may be null)
+    /// flushed on the calling thread, so that it covers what the autosave holds, then `doc`
+    /// stamped with that position (at_recording_position) queued. With `wait`, returns once
+    /// it is on disk. Empty when queued, else why not (one line: the recording could not be
+    /// flushed, and no autosave is queued that it would not cover).
+    std::string submit_after_change(RecordingWriter* recording, const Document& doc, std::uint64_t frames,
+                                    bool finished, bool wait);
 
 private:
     void run();

@@ -338,15 +338,11 @@ void DesktopSession::autosave()
 {
     if (!autosaver_) return;
     // As in the VR session: the recording flushed here, the JSON and the disk on the writer's
-    // thread, so the window never waits for them (docs/crash-safety.md).
-    try {
-        if (recording_) recording_->flush();
-    } catch (const Error& e) {
-        note(std::string("autosave failed: ") + e.what());
-        return;
-    }
-    autosaver_->submit(at_recording_position(document(), recording_ != nullptr, frames_recorded_, finished_));
-    if (!options_.background_regrowth) autosaver_->wait(); // deterministic: on disk before the frame ends
+    // thread, so the window never waits for them (docs/crash-safety.md). Without background
+    // regrowth (scripted runs) it is on disk before the frame ends.
+    const std::string why = autosaver_->submit_after_change(recording_.get(), document(), frames_recorded_, finished_,
+                                                            !options_.background_regrowth);
+    if (!why.empty()) note("autosave failed: " + why);
 }
 
 void DesktopSession::report_autosave_failures()

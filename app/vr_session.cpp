@@ -491,17 +491,13 @@ void VrSession::Impl::document_changed()
 void VrSession::Impl::autosave()
 {
     if (!autosaver) return;
-    // The recording first, on this thread (a write of at most 9 frames, no sync): whichever
-    // autosave is on disk when the program dies, the recording holds all it holds. The JSON
-    // and the disk are the writer thread's (app/autosave.h).
-    try {
-        if (recording) recording->flush();
-    } catch (const Error& e) {
-        note(std::string("autosave failed: ") + e.what());
-        return;
-    }
-    autosaver->submit(at_recording_position(document(), recording != nullptr, frames_recorded, finished));
-    if (!options.background_regrowth) autosaver->wait(); // deterministic: on disk before the frame ends
+    // The recording is flushed on this thread (a write of at most 9 frames, no sync), so that
+    // whichever autosave is on disk when the program dies, the recording holds all it holds;
+    // the JSON and the disk are the writer thread's (app/autosave.h). Without background
+    // regrowth (tests) it is on disk before the frame ends.
+    const std::string why = autosaver->submit_after_change(recording.get(), document(), frames_recorded, finished,
+                                                           !options.background_regrowth);
+    if (!why.empty()) note("autosave failed: " + why);
 }
 
 void VrSession::Impl::report_autosave_failures()
