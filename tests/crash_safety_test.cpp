@@ -266,6 +266,9 @@ TEST(CrashSafetyDocument, KilledWhileSavingLeavesTheOldOrTheNewFileWhole)
         }
     }
     const std::string autosave = dir + "/a.json", session = dir + "/s.json";
+    // Two autosaves, so that the previous generation exists before the first kill (a kill
+    // before the child's first save would otherwise find none).
+    save_autosave(autosave, docs[1]);
     save_autosave(autosave, docs[0]);
     save_document(session, docs[0]);
     std::mt19937 rng(7);
