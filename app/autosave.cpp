@@ -87,6 +87,10 @@ void AutosaveWriter::run()
             why = e.what();
         } catch (const std::bad_alloc&) {
             why = path_ + ": out of memory while writing the autosave";
+        } catch (const std::exception& e) {
+            // Nothing may escape the thread (it would end the program): e.g. a JSON library
+            // error for a name that is not UTF-8.
+            why = one_line_message(path_ + ": " + e.what());
         }
         {
             std::lock_guard<std::mutex> lock(mutex_);
