@@ -17,7 +17,10 @@ SubtreeLibrary parse_subtree_library(const std::string& text, const std::string&
 {
     const json j = json::parse(text, nullptr, /*allow_exceptions=*/false);
     if (j.is_discarded()) throw InvalidInput(where + ": not valid JSON");
-    if (!j.is_object() || j.value("format", std::string()) != "lobesketch-subtrees")
+    // "format" is checked to be a string before it is compared: json::value throws for
+    // another type (the species preset's fuzz finding, docs/fuzzing.md).
+    const auto format = j.is_object() ? j.find("format") : j.end();
+    if (!j.is_object() || format == j.end() || !format->is_string() || format->get<std::string>() != "lobesketch-subtrees")
         throw InvalidInput(where + ": not a subtree library (missing \"format\": \"lobesketch-subtrees\")");
     if (!j.contains("version") || !j["version"].is_number_integer() || j["version"].get<int>() != 1)
         throw InvalidInput(where + ": unsupported subtree library version (this program reads version 1)");

@@ -147,6 +147,9 @@ TEST(Growth, ShippedSubtreesAreUnitLengthAndParentsPrecedeChildren)
 TEST(Growth, SubtreeLibraryRefusesMalformedFiles)
 {
     EXPECT_THROW(parse_subtree_library("{", "x.json"), InvalidInput);
+    EXPECT_THROW(parse_subtree_library(R"({"format":7,"version":1,"subtrees":[]})", "x"), InvalidInput);
+    EXPECT_THROW(parse_subtree_library(R"({"format":{"a":1},"version":1,"subtrees":[]})", "x"), InvalidInput);
+    EXPECT_THROW(parse_subtree_library("[1,2]", "x"), InvalidInput);
     EXPECT_THROW(parse_subtree_library(R"({"format":"lobesketch-subtrees","version":2,"subtrees":[]})", "x"),
                  InvalidInput);
     EXPECT_THROW(parse_subtree_library(
