@@ -56,6 +56,14 @@ void add_item(RenderScene& scene, std::uint64_t key, RenderMaterial material, st
 
 } // namespace
 
+std::uint64_t bytes_hash(const void* data, std::size_t bytes)
+{
+    std::uint64_t h = 1469598103934665603ull;
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (std::size_t i = 0; i < bytes; ++i) h = (h ^ p[i]) * 1099511628211ull;
+    return h;
+}
+
 RenderContent parse_show_list(const std::string& text)
 {
     RenderContent c;

@@ -4,6 +4,8 @@
 /// level of detail, its lobes and its strokes, from the pipeline's own data or from a .glb
 /// the program exported (docs/rendering.md).
 
+#include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -22,6 +24,9 @@ struct RenderContent {
     bool strokes = false; ///< the sketch's strokes as tubes
     int lod = 0;          ///< level of detail of the tree
 };
+
+/// FNV-1a over `bytes` bytes: the content hashes that scene items' versions are made of.
+std::uint64_t bytes_hash(const void* data, std::size_t bytes);
 
 /// Parses a comma-separated `--show` list of tree, leaves, lobes, strokes.
 /// \throw InvalidInput naming an unknown or empty item.

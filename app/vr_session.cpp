@@ -148,15 +148,6 @@ VrPanel vr_panel_layout(const Pose& head)
     return panel;
 }
 
-/// FNV-1a over a stroke's points: equal points, equal tube.
-std::uint64_t points_fingerprint(const std::vector<glm::vec3>& pts)
-{
-    std::uint64_t h = 1469598103934665603ull;
-    const auto* p = reinterpret_cast<const unsigned char*>(pts.data());
-    for (std::size_t i = 0; i < pts.size() * sizeof(glm::vec3); ++i) h = (h ^ p[i]) * 1099511628211ull;
-    return (h ^ pts.size()) * 1099511628211ull;
-}
-
 /// The regrowth's part of the VR scene (lobes; the tree's middle LOD once grown: the full one
 /// is for export and pictures, docs/vr.md), made on the regrowth worker's thread
 /// (RegrowWorker's prepare hook) with its bounds in ground_area, so that taking a new tree
@@ -220,12 +211,14 @@ struct VrSession::Impl {
     // The scene's items: [0, grown_items) the regrowth's lobes and tree (made on the worker),
     // [grown_items, static_items) the strokes, then the hands, panel and labels of this frame.
     std::size_t grown_items = 0, static_items = 0;
-    Bounds grown_bounds;
-    struct StrokeItem {
+    Bounds grown_bounds, stroke_bounds;
+    struct StrokeTube {
+        std::int64_t id = 0;
         std::uint64_t fingerprint = 0; ///< of the points the tube was made from
-        RenderItem item;
     };
-    std::map<std::int64_t, StrokeItem> stroke_items; ///< by stroke id: a tube is made again only when its stroke changed
+    /// What scene_.items[grown_items, static_items) were made from, in order: a stroke's tube
+    /// is made again only when its points changed.
+    std::vector<StrokeTube> stroke_tubes;
     HandFrame last_frame;
 
     Impl(VrSession& s, VrOptions o, const Document& doc) : self(s), options(std::move(o)), pipeline(doc.settings.input) {}
@@ -256,7 +249,8 @@ struct VrSession::Impl {
     void document_changed();
     void request_regrowth();
     void take_regrowth(std::optional<RegrowResult> result);
-    void rebuild_static_scene();
+    void rebuild_stroke_items();
+    void update_ground_area();
     void autosave();
     void report_autosave_failures();
     void add_dynamic_items();
@@ -485,7 +479,7 @@ void VrSession::Impl::document_changed()
     ++revision;
     autosave();
     request_regrowth();
-    rebuild_static_scene(); // strokes show at once; lobes and the tree follow the regrowth
+    rebuild_stroke_items(); // strokes show at once; lobes and the tree follow the regrowth
 }
 
 void VrSession::Impl::autosave()
@@ -520,7 +514,9 @@ void VrSession::Impl::take_regrowth(std::optional<RegrowResult> result)
     if (!result->error.empty()) note("tree: " + result->error);
     for (const std::string& w : result->tree.warnings) note(w);
     RenderScene& scene = self.scene_;
-    // The regrowth's items, made on the worker (prepare_grown_scene), replace the old ones.
+    // The regrowth's items, made on the worker (prepare_grown_scene), replace the old ones;
+    // the strokes' items stay as they are.
+    scene.items.resize(static_items); // this frame's hands and panel are added again
     scene.items.erase(scene.items.begin(), scene.items.begin() + std::ptrdiff_t(grown_items));
     static_items -= grown_items;
     grown_items = result->scene.items.size();
@@ -532,48 +528,58 @@ void VrSession::Impl::take_regrowth(std::optional<RegrowResult> result)
     scene.leaf_texture_version = result->scene.leaf_texture_version;
     grown_bounds = result->scene.ground_area;
     built = std::move(result);
-    rebuild_static_scene();
+    update_ground_area();
 }
 
-void VrSession::Impl::rebuild_static_scene()
+void VrSession::Impl::rebuild_stroke_items()
 {
-    // The strokes: a tube only for a stroke that is new or changed (most changes add one).
+    // A tube only for a stroke that is new or changed (most changes add one); the others are
+    // moved from the scene's stroke items as they are.
     RenderScene& scene = self.scene_;
-    std::vector<RenderItem> strokes;
-    std::map<std::int64_t, StrokeItem> kept;
-    Bounds area = grown_bounds;
+    std::map<std::int64_t, std::pair<std::uint64_t, RenderItem>> old;
+    for (std::size_t i = 0; i < stroke_tubes.size(); ++i)
+        old.emplace(stroke_tubes[i].id,
+                    std::make_pair(stroke_tubes[i].fingerprint, std::move(scene.items[grown_items + i])));
+    scene.items.resize(grown_items);
+    stroke_tubes.clear();
+    stroke_bounds = Bounds{};
     for (const Stroke& st : effective_strokes(document())) {
         std::vector<glm::vec3> pts;
         pts.reserve(st.points.size() + 1);
         for (const StrokePoint& p : st.points) pts.push_back(p.position);
         if (st.closed && pts.size() > 2) pts.push_back(pts.front());
-        const std::uint64_t fingerprint = points_fingerprint(pts);
-        auto it = stroke_items.find(st.id);
-        StrokeItem item;
-        if (it != stroke_items.end() && it->second.fingerprint == fingerprint) item = std::move(it->second);
+        const std::uint64_t fingerprint = bytes_hash(pts.data(), pts.size() * sizeof(glm::vec3));
+        const auto it = old.find(st.id);
+        RenderItem item;
+        if (it != old.end() && it->second.first == fingerprint) item = std::move(it->second.second);
         else {
             RenderContent content;
             content.tree = content.leaves = content.lobes = false;
             content.strokes = true;
             RenderScene one = tree_render_scene(TreeGeometry{}, {}, {st}, 0.0f, content);
             if (one.items.empty()) continue;
-            item.fingerprint = fingerprint;
-            item.item = std::move(one.items.front());
+            item = std::move(one.items.front());
         }
-        for (const glm::vec3& p : item.item.geometry.positions) area.add(p);
-        strokes.push_back(item.item);
-        kept.emplace(st.id, std::move(item));
+        for (const glm::vec3& p : item.geometry.positions) stroke_bounds.add(p);
+        scene.items.push_back(std::move(item));
+        stroke_tubes.push_back({st.id, fingerprint});
     }
-    stroke_items = std::move(kept);
-    scene.items.resize(grown_items);
-    scene.items.insert(scene.items.end(), std::make_move_iterator(strokes.begin()), std::make_move_iterator(strokes.end()));
     static_items = scene.items.size();
-    scene.ground_y = 0.0f;
+    update_ground_area();
+}
+
+void VrSession::Impl::update_ground_area()
+{
+    Bounds area = grown_bounds;
+    if (!stroke_bounds.empty()) {
+        area.add(stroke_bounds.lo);
+        area.add(stroke_bounds.hi);
+    }
     if (area.empty()) {
         area.add(glm::vec3(-0.5f, 0.0f, -0.5f));
         area.add(glm::vec3(0.5f, 1.0f, 0.5f));
     }
-    scene.ground_area = area;
+    self.scene_.ground_area = area;
 }
 
 void VrSession::Impl::update_status()
@@ -734,7 +740,7 @@ VrSession::VrSession(Document doc, VrOptions options)
     if (!o.autosave_path.empty()) impl_->autosaver = std::make_unique<AutosaveWriter>(o.autosave_path);
     impl_->worker = std::make_unique<RegrowWorker>(prepare_grown_scene);
     if (!document().strokes.empty() || !document().lobes.empty()) impl_->request_regrowth();
-    impl_->rebuild_static_scene();
+    impl_->rebuild_stroke_items();
     impl_->update_status();
 }
 

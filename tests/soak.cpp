@@ -46,14 +46,6 @@ using namespace lobe;
 
 namespace {
 
-std::uint64_t fnv1a(const void* data, std::size_t size)
-{
-    std::uint64_t h = 1469598103934665603ull;
-    const auto* p = static_cast<const unsigned char*>(data);
-    for (std::size_t i = 0; i < size; ++i) h = (h ^ p[i]) * 1099511628211ull;
-    return h;
-}
-
 std::string hex(std::uint64_t v)
 {
     char s[17];
@@ -96,7 +88,7 @@ PartDigest run_part(const std::string& rec_path, const std::string& dir, Rendere
 
     PartDigest d;
     const std::string json = document_to_json(doc).dump();
-    d.document = hex(fnv1a(json.data(), json.size()));
+    d.document = hex(bytes_hash(json.data(), json.size()));
     std::vector<std::string> warnings;
     std::vector<BuiltLobe> lobes;
     write_document_lobes(doc, dir, warnings, &lobes);
@@ -105,7 +97,7 @@ PartDigest run_part(const std::string& rec_path, const std::string& dir, Rendere
     const TreeGeometry geometry = document_tree_geometry(doc, tree);
     write_tree_file(dir + "/tree.glb", doc, tree, geometry, ExportOptions{});
     const std::string glb = read_bytes(dir + "/tree.glb");
-    d.glb = hex(fnv1a(glb.data(), glb.size()));
+    d.glb = hex(bytes_hash(glb.data(), glb.size()));
 
     RenderContent content;
     content.lobes = true;
@@ -113,7 +105,7 @@ PartDigest run_part(const std::string& rec_path, const std::string& dir, Rendere
     renderer.set_scene(scene);
     const int w = 320, h = 240;
     const RgbaImage image = renderer.render(frame_view(scene_bounds(scene), front_view(), float(w) / float(h)), w, h);
-    d.picture = hex(fnv1a(image.pixels.data(), image.pixels.size()));
+    d.picture = hex(bytes_hash(image.pixels.data(), image.pixels.size()));
     const std::vector<std::uint8_t> png = encode_png(image);
     write_file_atomic(dir + "/tree.png", std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
     return d;
