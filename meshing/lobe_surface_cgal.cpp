@@ -12,6 +12,7 @@
 #include <limits>
 #include <map>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -28,6 +29,9 @@
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
 #include <CGAL/Constrained_triangulation_face_base_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Spatial_sort_traits_adapter_2.h>
+#include <CGAL/property_map.h>
+#include <CGAL/spatial_sort.h>
 #include <CGAL/Triangulation_face_base_with_info_2.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
 #include <Eigen/Dense>
@@ -625,8 +629,25 @@ void Builder::triangulate()
 {
     node_vertex_.assign(nodes_.size(), VH());
     VH hint;
-    for (Index s = 0; s < chains_.size(); ++s)
-        for (int id : chains_[s]) hint = node_vertex_[static_cast<Index>(id)] = insert_node(id, hint);
+    {
+        // Inserted in a space-filling-curve order: points taken in drawing order along a
+        // curve make every insertion flip a long fan.
+        std::vector<K::Point_2> where(nodes_.size());
+        std::vector<std::size_t> order;
+        std::vector<char> seen(nodes_.size(), 0);
+        for (const auto& chain : chains_)
+            for (int id : chain)
+                if (!seen[static_cast<Index>(id)]) {
+                    seen[static_cast<Index>(id)] = 1;
+                    const glm::dvec2 x = stereo_.to_plane(nodes_[static_cast<Index>(id)].dir);
+                    where[static_cast<Index>(id)] = K::Point_2(x.x, x.y);
+                    order.push_back(static_cast<std::size_t>(id));
+                }
+        using Map = CGAL::Pointer_property_map<K::Point_2>::type;
+        CGAL::spatial_sort(order.begin(), order.end(),
+                           CGAL::Spatial_sort_traits_adapter_2<K, Map>(CGAL::make_property_map(where)));
+        for (std::size_t id : order) hint = node_vertex_[id] = insert_node(static_cast<int>(id), hint);
+    }
     // A small ring around the pole closes the planar triangulation's outside: the ring
     // encloses every stroke point, and the pole vertex fans the ring.
     const double ring_angle = ring_angle_ = std::min(empty_angle_ * 0.5, 2.0 * M_PI / 180.0);
@@ -796,12 +817,8 @@ void Builder::seed_fill(double max_edge, int& added)
     const double ring_keep = std::cos(ring_angle_ + clearance);
     const int count = static_cast<int>(std::ceil(4.0 * M_PI / (spacing * spacing * 0.866)));
     const double golden = M_PI * (3.0 - std::sqrt(5.0));
-    struct Candidate {
-        glm::dvec3 dir;
-        int region; ///< -1: not located inside a face
-    };
-    std::vector<Candidate> candidates;
-    FH hint_face;
+    std::vector<glm::dvec3> lattice;
+    std::vector<K::Point_2> where;
     for (int i = 0; i < count; ++i) {
         const double z = 1.0 - (2.0 * i + 1.0) / count;
         const double rr = std::sqrt(std::max(0.0, 1.0 - z * z));
@@ -820,9 +837,27 @@ void Builder::seed_fill(double max_edge, int& added)
                         }
                 }
         if (near) continue;
-        // Located before any fill vertex goes in.
         const glm::dvec2 x = stereo_.to_plane(d);
-        const K::Point_2 p(x.x, x.y);
+        lattice.push_back(d);
+        where.emplace_back(x.x, x.y);
+    }
+    // Located and inserted in a space-filling-curve order (the lattice's own order jumps
+    // across the sphere at every step).
+    std::vector<std::size_t> order(lattice.size());
+    for (Index i = 0; i < order.size(); ++i) order[i] = i;
+    using Map = CGAL::Pointer_property_map<K::Point_2>::type;
+    CGAL::spatial_sort(order.begin(), order.end(),
+                       CGAL::Spatial_sort_traits_adapter_2<K, Map>(CGAL::make_property_map(where)));
+    struct Candidate {
+        glm::dvec3 dir;
+        int region; ///< -1: not located inside a face
+    };
+    std::vector<Candidate> candidates;
+    FH hint_face;
+    for (std::size_t i : order) {
+        const glm::dvec3& d = lattice[i];
+        const K::Point_2& p = where[i];
+        // Located before any fill vertex goes in.
         CDT::Locate_type lt;
         int li = 0;
         hint_face = cdt_.locate(p, lt, li, hint_face);
@@ -947,8 +982,8 @@ void Builder::solve_fill_radii(const std::vector<std::array<int, 3>>& triangles)
     //   degree 3), penalised by degree so it stays smooth where no stroke is: an ellipsoid
     //   or an off-centre sphere is nearly exact, so an automatic cap rounds off as the
     //   strokes around it suggest;
-    // - the residuals (stroke radius − model) are interpolated harmonically (uniform
-    //   weights), so the surface passes through every stroke and stays within their range.
+    // - the residuals (stroke radius − model) are interpolated harmonically, so the surface
+    //   passes through every stroke and stays within their range.
     // When the model is implausible (it leaves 0.5–1.5 times the strokes' radii), the
     // radius itself is interpolated harmonically.
     const Index n = nodes_.size();
@@ -958,55 +993,6 @@ void Builder::solve_fill_radii(const std::vector<std::array<int, 3>>& triangles)
         if (nodes_[i].origin.kind == LobeVertexKind::Fill) unknown[i] = count++;
     if (count == 0) return;
     const Adjacency adj(n, triangles);
-    // Rows of L over the free columns (b: the fixed columns' part of each row), weighted by
-    // inverse angular edge length so long strip edges and short cap edges measure slope alike.
-    auto solve = [&](bool biharmonic, Eigen::VectorXd& x) {
-        std::vector<Eigen::Triplet<double>> entries;
-        std::vector<double> fixed_part, sums, w;
-        int rows = 0;
-        for (Index i = 0; i < n; ++i) {
-            const auto& nb = adj[i];
-            if (nb.empty()) continue;
-            if (!biharmonic && unknown[i] < 0) continue;
-            bool touches_free = unknown[i] >= 0;
-            for (int j : nb) touches_free = touches_free || unknown[static_cast<Index>(j)] >= 0;
-            if (!touches_free) continue;
-            w.assign(nb.size(), 0.0);
-            double sum = 0;
-            for (Index k = 0; k < nb.size(); ++k) {
-                w[k] = 1.0 / std::max(1e-6, angle_between(nodes_[i].dir, nodes_[static_cast<Index>(nb[k])].dir));
-                sum += w[k];
-            }
-            double b = 0;
-            if (unknown[i] >= 0) entries.emplace_back(rows, unknown[i], 1.0);
-            else b += nodes_[i].radius;
-            for (Index k = 0; k < nb.size(); ++k) {
-                const int j = nb[k];
-                if (unknown[static_cast<Index>(j)] >= 0) entries.emplace_back(rows, unknown[static_cast<Index>(j)], -w[k] / sum);
-                else b -= w[k] / sum * nodes_[static_cast<Index>(j)].radius;
-            }
-            fixed_part.push_back(b);
-            sums.push_back(sum);
-            ++rows;
-        }
-        const Eigen::VectorXd row_scale = Eigen::Map<const Eigen::VectorXd>(sums.data(), rows);
-        Eigen::SparseMatrix<double> l(rows, count);
-        l.setFromTriplets(entries.begin(), entries.end());
-        const Eigen::Map<const Eigen::VectorXd> b(fixed_part.data(), rows);
-        if (biharmonic) {
-            const Eigen::SparseMatrix<double> m = l.transpose() * l;
-            Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(m);
-            if (solver.info() != Eigen::Success) return false;
-            x = solver.solve(-(l.transpose() * b));
-        } else {
-            // Rows scaled back by their weight sums: symmetric positive definite.
-            Eigen::SparseMatrix<double> sym = row_scale.asDiagonal() * l;
-            Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(sym);
-            if (solver.info() != Eigen::Success) return false;
-            x = solver.solve(-(row_scale.asDiagonal() * b));
-        }
-        return solver_ok(x);
-    };
     double lo = std::numeric_limits<double>::infinity(), hi = 0;
     for (Index i = 0; i < n; ++i)
         if (unknown[i] < 0 && !adj[i].empty()) {
@@ -1014,21 +1000,38 @@ void Builder::solve_fill_radii(const std::vector<std::array<int, 3>>& triangles)
             hi = std::max(hi, nodes_[i].radius);
         }
     std::vector<double> model(n, 0.0);
-    bool use_model = fit_radius_model(adj, model) ;
+    bool use_model = fit_radius_model(adj, model);
     if (use_model)
         for (Index i = 0; i < n; ++i)
             if (unknown[i] >= 0 && !(model[i] >= 0.5 * lo && model[i] <= 1.5 * hi)) use_model = false;
     if (!use_model) std::fill(model.begin(), model.end(), 0.0);
-    // Harmonic interpolation of the residuals (of the radii without a model).
-    std::vector<double> saved(n);
+    // The harmonic interpolation of the residuals: (Σ_j w_ij) x_i − Σ_j w_ij x_j = 0 at every
+    // free vertex, with w_ij the inverse angular length of edge ij (so long strip edges and
+    // short cap edges measure slope alike). Symmetric positive definite; only its lower
+    // triangle is stored, which is all SimplicialLDLT reads.
+    std::vector<Eigen::Triplet<double>> entries;
+    entries.reserve(static_cast<Index>(count) * 4);
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(count);
     for (Index i = 0; i < n; ++i) {
-        saved[i] = nodes_[i].radius;
-        if (unknown[i] < 0) nodes_[i].radius -= model[i];
+        const int row = unknown[i];
+        if (row < 0) continue;
+        double sum = 0;
+        for (int j : adj[i]) {
+            const double w = 1.0 / std::max(1e-6, angle_between(nodes_[i].dir, nodes_[static_cast<Index>(j)].dir));
+            sum += w;
+            const int col = unknown[static_cast<Index>(j)];
+            if (col < 0) rhs[row] += w * (nodes_[static_cast<Index>(j)].radius - model[static_cast<Index>(j)]);
+            else if (col < row) entries.emplace_back(row, col, -w);
+        }
+        entries.emplace_back(row, row, sum);
     }
+    Eigen::SparseMatrix<double> system(count, count);
+    system.setFromTriplets(entries.begin(), entries.end());
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(system);
     Eigen::VectorXd x;
-    const bool ok = solve(false, x);
-    for (Index i = 0; i < n; ++i) nodes_[i].radius = saved[i];
-    if (!ok) throw InvalidInput("the lobe's strokes leave a gap that cannot be closed around its centre");
+    if (solver.info() == Eigen::Success) x = solver.solve(rhs);
+    if (solver.info() != Eigen::Success || !solver_ok(x))
+        throw InvalidInput("the lobe's strokes leave a gap that cannot be closed around its centre");
     for (Index i = 0; i < n; ++i)
         if (unknown[i] >= 0) {
             const double r = x[unknown[i]] + model[i];
@@ -1041,59 +1044,56 @@ bool Builder::fit_radius_model(const Adjacency& adj, std::vector<double>& model)
 {
     // Monomials x^a y^b z^c of the direction, a + b + c ≤ 3: 20 functions spanning the
     // spherical harmonics up to degree 3 on the sphere.
+    constexpr int kTerms = 20;
     struct Mono {
         int a, b, c;
     };
-    static const std::vector<Mono> monos = [] {
-        std::vector<Mono> m;
+    static const std::array<Mono, kTerms> monos = [] {
+        std::array<Mono, kTerms> m{};
+        Index j = 0;
         for (int d = 0; d <= 3; ++d)
             for (int a = d; a >= 0; --a)
-                for (int b = d - a; b >= 0; --b) m.push_back({a, b, d - a - b});
+                for (int b = d - a; b >= 0; --b) m[j++] = {a, b, d - a - b};
         return m;
     }();
-    const Index k = monos.size();
-    auto basis = [&](const glm::dvec3& u, Eigen::VectorXd& out) {
+    using Row = Eigen::Matrix<double, 1, kTerms>;
+    using Basis = Eigen::Matrix<double, Eigen::Dynamic, kTerms, Eigen::RowMajor>;
+    auto basis = [&](const glm::dvec3& u, auto&& out) {
         const double px[4] = {1, u.x, u.x * u.x, u.x * u.x * u.x};
         const double py[4] = {1, u.y, u.y * u.y, u.y * u.y * u.y};
         const double pz[4] = {1, u.z, u.z * u.z, u.z * u.z * u.z};
-        for (Index j = 0; j < k; ++j) out[static_cast<Eigen::Index>(j)] = px[monos[j].a] * py[monos[j].b] * pz[monos[j].c];
+        for (Index j = 0; j < static_cast<Index>(kTerms); ++j)
+            out(static_cast<Eigen::Index>(j)) = px[monos[j].a] * py[monos[j].b] * pz[monos[j].c];
     };
-    Eigen::MatrixXd ata = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k));
-    Eigen::VectorXd atb = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(k));
-    Eigen::VectorXd phi(static_cast<Eigen::Index>(k));
-    double samples = 0;
-    // The normal equations, upper triangle only (the products are symmetric exactly).
-    std::array<double, 20 * 20> upper{};
-    std::array<double, 20> rhs{};
+    // The basis at every sample (stroke, crossing and segment vertices in the surface), then
+    // the normal equations as one matrix product.
+    Index samples = 0;
+    for (Index i = 0; i < nodes_.size(); ++i)
+        if (nodes_[i].origin.kind != LobeVertexKind::Fill && !adj[i].empty()) ++samples;
+    if (samples < static_cast<Index>(kTerms)) return false;
+    Basis phi(static_cast<Eigen::Index>(samples), kTerms);
+    Eigen::VectorXd radius(static_cast<Eigen::Index>(samples));
+    Eigen::Index row = 0;
     for (Index i = 0; i < nodes_.size(); ++i) {
         if (nodes_[i].origin.kind == LobeVertexKind::Fill || adj[i].empty()) continue;
-        basis(nodes_[i].dir, phi);
-        const double* f = phi.data();
-        for (Index c = 0; c < k; ++c) {
-            for (Index r = 0; r <= c; ++r) upper[c * k + r] += f[c] * f[r];
-            rhs[c] += f[c] * nodes_[i].radius;
-        }
-        samples += 1;
+        basis(nodes_[i].dir, phi.row(row));
+        radius[row++] = nodes_[i].radius;
     }
-    for (Index c = 0; c < k; ++c) {
-        for (Index r = 0; r <= c; ++r)
-            ata(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) =
-                ata(static_cast<Eigen::Index>(c), static_cast<Eigen::Index>(r)) = upper[c * k + r];
-        atb(static_cast<Eigen::Index>(c)) = rhs[c];
-    }
-    if (samples < static_cast<double>(k)) return false;
+    Eigen::Matrix<double, kTerms, kTerms> ata = phi.transpose() * phi;
+    const Eigen::Matrix<double, kTerms, 1> atb = phi.transpose() * radius;
     // Penalty growing with degree (d(d+1))², scaled to the number of samples.
-    for (Index j = 0; j < k; ++j) {
+    for (Index j = 0; j < static_cast<Index>(kTerms); ++j) {
         const int d = monos[j].a + monos[j].b + monos[j].c;
         const double w = d == 0 ? 1e-6 : 1e-3 * static_cast<double>(d * (d + 1)) * static_cast<double>(d * (d + 1));
-        ata(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(j)) += w * samples;
+        ata(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(j)) += w * static_cast<double>(samples);
     }
-    const Eigen::VectorXd coef = ata.ldlt().solve(atb);
+    const Eigen::Matrix<double, kTerms, 1> coef = ata.ldlt().solve(atb);
     if (!coef.allFinite()) return false;
+    Row at;
     for (Index i = 0; i < nodes_.size(); ++i) {
         if (adj[i].empty()) continue;
-        basis(nodes_[i].dir, phi);
-        model[i] = phi.dot(coef);
+        basis(nodes_[i].dir, at);
+        model[i] = at.dot(coef.transpose());
     }
     return true;
 }
@@ -1170,6 +1170,32 @@ void Builder::emit(LobeSurface& out)
             std::swap(t[1], t[2]);
         tris.push_back(t);
     }
+    // Canonical order: the stroke nodes keep theirs (it follows the strokes alone), the
+    // interpolated nodes are sorted by direction, and below the triangles are sorted too, so
+    // the output depends on the strokes alone and not on the order the triangulation made
+    // things in (its faces, and the refinement's insertions that follow them).
+    std::vector<int> new_id(nodes_.size());
+    {
+        std::vector<int> order(nodes_.size());
+        for (Index i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+        const auto fill_begin = std::stable_partition(order.begin(), order.end(), [&](int id) {
+            return nodes_[static_cast<Index>(id)].origin.kind != LobeVertexKind::Fill;
+        });
+        std::stable_sort(fill_begin, order.end(), [&](int a, int b) {
+            const glm::dvec3& u = nodes_[static_cast<Index>(a)].dir;
+            const glm::dvec3& v = nodes_[static_cast<Index>(b)].dir;
+            return std::tie(u.x, u.y, u.z) < std::tie(v.x, v.y, v.z);
+        });
+        std::vector<Node> sorted;
+        sorted.reserve(nodes_.size());
+        for (Index k = 0; k < order.size(); ++k) {
+            new_id[static_cast<Index>(order[k])] = static_cast<int>(k);
+            sorted.push_back(nodes_[static_cast<Index>(order[k])]);
+        }
+        nodes_ = std::move(sorted);
+        for (auto& t : tris)
+            for (int& id : t) id = new_id[static_cast<Index>(id)];
+    }
     solve_fill_radii(tris);
 
     // Output: only nodes used by triangles, in node order (samples first, by stroke).
@@ -1199,12 +1225,16 @@ void Builder::emit(LobeSurface& out)
         const glm::dvec3 mid = (p0 + p1 + p2) / 3.0 - centre_;
         if (!(orient3(d0, d1, d2) > 0.0) || !(glm::dot(normal, mid) > 0.0))
             throw InvalidInput("the lobe's strokes fold over each other as seen from its centre (draw around the lobe)");
-        out.mesh.triangles.push_back(o);
+        // Each triangle starts at its lowest index (same orientation).
+        const Index first = static_cast<Index>(std::min_element(o.begin(), o.end()) - o.begin());
+        out.mesh.triangles.push_back({o[first], o[(first + 1) % 3], o[(first + 2) % 3]});
     }
+    std::sort(out.mesh.triangles.begin(), out.mesh.triangles.end());
     // Stroke segments (split at crossings) are the constraints of remeshing.
+    auto out_of = [&](VH v) { return out_index[static_cast<Index>(new_id[static_cast<Index>(node_of(v))])]; };
     for (const auto& e : cdt_.constrained_edges()) {
-        const int a = out_index[static_cast<Index>(node_of(e.first->vertex(CDT::ccw(e.second))))];
-        const int b = out_index[static_cast<Index>(node_of(e.first->vertex(CDT::cw(e.second))))];
+        const int a = out_of(e.first->vertex(CDT::ccw(e.second)));
+        const int b = out_of(e.first->vertex(CDT::cw(e.second)));
         if (a >= 0 && b >= 0 && a != b) out.mesh.feature_edges.push_back({std::min(a, b), std::max(a, b)});
     }
     std::sort(out.mesh.feature_edges.begin(), out.mesh.feature_edges.end());

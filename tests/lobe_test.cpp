@@ -167,6 +167,7 @@ TEST(Lobes, EveryShippedRecordingGivesClosedManifoldOutwardLobesThroughEveryStro
             EXPECT_LE(std::max(to_truth, from_truth), 0.01)
                 << what << ": Hausdorff " << to_truth * 1000 << " / " << from_truth * 1000 << " mm";
             RecordProperty(what + " hausdorff_mm", std::to_string(1000 * std::max(to_truth, from_truth)));
+            RecordProperty(what + " stroke_mm", std::to_string(1000 * worst));
             EXPECT_LE(worst, 0.005) << what << ": a ground-truth stroke point is " << worst * 1000 << " mm off the lobe";
         }
     }
