@@ -155,7 +155,7 @@ void draw_panel(DesktopSession& session, const std::string& session_name, int& t
     // Status first: what the hand does now.
     ImGui::Text("%s%s", tool_name(st.tool), st.pinching ? "  - pinching" : "");
     ImGui::Text("%zu strokes, %zu lobes, %zu edits", st.strokes, st.lobes, st.edits);
-    ImGui::Text("depth %.2f m%s", st.depth_m, st.regrowing ? "  building..." : "");
+    ImGui::Text("depth %.2f m%s%s", st.depth_m, st.regrowing ? "  building..." : "", st.importing ? "  importing..." : "");
     if (st.tree_triangles) ImGui::Text("tree: LOD%d, %zu triangles", st.lod, st.tree_triangles);
     if (!st.last_message.empty()) ImGui::TextWrapped("%s", st.last_message.c_str());
 
@@ -220,8 +220,8 @@ void draw_panel(DesktopSession& session, const std::string& session_name, int& t
         if (ImGui::InputInt("seed", &seed, 1, 10) && seed >= 1 && seed < (1 << 24)) send(SettingId::Seed, seed);
     }
     if (ImGui::CollapsingHeader("Import a mesh as a lobe")) {
-        // OBJ, PLY or OFF; the lobe appears centred on the fingertip (the cursor's point on
-        // the depth plane when the button was pressed).
+        // OBJ, PLY or OFF, made on a thread of its own; the lobe appears centred on the
+        // fingertip (the cursor's point on the depth plane) when the import is done.
         static char path[1024] = "";
         static float size_m = 1.5f;
         ImGui::InputText("file", path, sizeof path);
@@ -437,7 +437,10 @@ void add_desktop_command(CLI::App& app, int& exit_code)
                     break;
                 }
                 case ScriptStep::Kind::Set: ds.setting(s.code, s.lobe, s.value); break;
-                case ScriptStep::Kind::Import: ds.import_mesh(s.name, s.value); break;
+                case ScriptStep::Kind::Import:
+                    // A script waits for its import, so that its run is the same every time.
+                    if (ds.import_mesh(s.name, s.value)) ds.wait_for_import();
+                    break;
                 case ScriptStep::Kind::Wait: wait = true; break;
                 case ScriptStep::Kind::Mark:
                     if (log) *log << summary(ds, s.name, frame).dump() << "\n" << std::flush;

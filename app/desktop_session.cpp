@@ -1,8 +1,11 @@
 #include "app/desktop_session.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <exception>
 #include <filesystem>
+#include <system_error>
 
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
@@ -175,9 +178,19 @@ bool DesktopSession::import_mesh(const std::string& path, double size_m)
     o.size_m = size_m;
     o.target_edge_length_m = doc.settings.lobes.edge_length_m;
     o.iterations = static_cast<unsigned>(doc.settings.lobes.remesh_iterations);
-    const int n = static_cast<int>(imports_.size()) + 1;
     try {
+        if (import_) throw InvalidInput("another import is still being made");
         if (!(size_m > 0.01 && size_m <= 100.0)) throw InvalidInput("the size must be in (0.01, 100] m");
+        std::error_code ec;
+        if (!std::filesystem::is_regular_file(path, ec)) throw FileError(path, "not found, or not a file");
+    } catch (const Error& e) {
+        note(std::string("import: ") + e.what());
+        return false;
+    }
+    const int n = static_cast<int>(imports_.size()) + 1;
+    // Beside the recording, so that replaying it imports the same mesh.
+    const std::string beside = recording_ ? import_mesh_path(options_.record_path, n) : std::string();
+    auto make = [path, o, beside]() {
         TriangleMesh mesh = lobe_from_model(path, o);
         // Centred on the origin; the import event places it at the fingertip.
         glm::dvec3 lo, hi;
@@ -185,24 +198,47 @@ bool DesktopSession::import_mesh(const std::string& path, double size_m)
         const glm::dvec3 centre = 0.5 * (lo + hi);
         for (glm::vec3& p : mesh.positions) p = glm::vec3(glm::dvec3(p) - centre);
         std::string source = std::filesystem::path(path).filename().string();
-        if (recording_) {
-            // Beside the recording, so that replaying it imports the same mesh.
-            const std::string beside = import_mesh_path(options_.record_path, n);
+        if (!beside.empty()) {
             write_ply(beside, mesh);
             source = std::filesystem::path(beside).filename().string();
         }
-        imports_[n] = std::make_shared<const LobeModel>(LobeModel{source, std::move(mesh)});
+        return std::make_shared<const LobeModel>(LobeModel{source, std::move(mesh)});
+    };
+    try {
+        import_ = PendingImport{n, path, std::async(std::launch::async, std::move(make))};
+    } catch (const std::system_error& e) {
+        note(std::string("import: no thread to make it on: ") + e.what());
+        return false;
+    }
+    status_.importing = true;
+    note("importing " + path + " ...");
+    return true;
+}
+
+void DesktopSession::take_import(bool wait)
+{
+    if (!import_) return;
+    if (!wait && import_->model.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
+    PendingImport done = std::move(*import_);
+    import_.reset();
+    status_.importing = false;
+    try {
+        imports_[done.number] = done.model.get();
     } catch (const Error& e) {
         note(std::string("import: ") + e.what());
-        return false;
+        return;
+    } catch (const std::exception& e) {
+        note("import: " + one_line_message(done.path + ": " + e.what()));
+        return;
     }
     InputEvent e;
     e.kind = InputEventKind::ImportMesh;
-    e.code = n;
+    e.code = done.number;
     pending_.push_back(e);
-    note("imported " + path + " as a lobe at the fingertip");
-    return true;
+    note("imported " + done.path + " as a lobe at the fingertip");
 }
+
+void DesktopSession::wait_for_import() { take_import(true); }
 
 void DesktopSession::handle(const InputEvent& e, int width, int height)
 {
@@ -258,6 +294,7 @@ void DesktopSession::frame(double time, int width, int height)
 {
     if (finished_) return;
     time_ = time > time_ ? time : time_ + 1e-4;
+    take_import(false); // a finished import goes in with this frame's input
     std::vector<int> commands;
     for (InputEvent& e : pending_) {
         e.time = time_;
@@ -498,6 +535,7 @@ void DesktopSession::frame_view_on_scene()
 void DesktopSession::finish(double time)
 {
     if (finished_) return;
+    take_import(true); // an import still being made goes in last, not lost
     for (InputEvent& e : pending_) {
         e.time = std::max(time, time_);
         record(e);

@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <future>
 #include <map>
 #include <memory>
 #include <optional>
@@ -71,6 +72,7 @@ struct DesktopStatus {
     bool pinching = false;   ///< the simulated hand pinches (left button down, not over the panel)
     bool drawing = false;    ///< a stroke or drag is being made
     bool regrowing = false;  ///< a regrowth has been asked for and not yet arrived
+    bool importing = false;  ///< a mesh import (import_mesh) is being made
     float depth_m = 0.0f;    ///< distance of the fingertip plane from the eye
     glm::vec3 tip{0.0f};
     std::size_t strokes = 0, lobes = 0, edits = 0;
@@ -98,11 +100,17 @@ public:
     /// A setting from the panel (recorded as an InputEventKind::Setting event).
     void setting(int id, std::int64_t lobe_id, double value);
     /// Imports a mesh file (OBJ, PLY, OFF) as a lobe: repaired, scaled so that its bounding
-    /// box's largest side is `size_m`, remeshed to the attractor spacing, then placed centred
-    /// on the fingertip by the next frame (one undo step). The mesh is written beside the
-    /// recording (import_mesh_path) and recorded as an ImportMesh event, so replay makes the
-    /// same lobe. False, with the reason in messages(), when the file cannot be made a lobe.
+    /// box's largest side is `size_m` and remeshed to the attractor spacing on a thread of
+    /// its own (a large mesh takes seconds; the frames go on), then placed centred on the
+    /// fingertip by the first frame after it is done (one undo step). The mesh is written
+    /// beside the recording (import_mesh_path) and recorded as an ImportMesh event, so replay
+    /// makes the same lobe. False, with the reason in messages(), when the file does not
+    /// exist, the size is out of range or another import is still being made; a file that
+    /// cannot be made a lobe is reported in messages() when its import ends.
     bool import_mesh(const std::string& path, double size_m = 1.5);
+    /// Waits until the import being made (if any) is done; the next frame places it (scripted
+    /// runs, tests).
+    void wait_for_import();
     /// The cursor is over the panel: the left button does not pinch while it is.
     void set_ui_capture(bool capture) { ui_capture_ = capture; }
     void set_cursor_inside(bool inside) { cursor_inside_ = inside; }
@@ -150,6 +158,7 @@ private:
     void add_dynamic_items();
     void note(std::string line);
     void record(const InputEvent& e);
+    void take_import(bool wait);
 
     DesktopOptions options_;
     OrbitCamera orbit_;
@@ -161,6 +170,13 @@ private:
 
     std::vector<InputEvent> pending_;
     std::map<int, std::shared_ptr<const LobeModel>> imports_; ///< this session's imports by number
+    /// The import being made on its own thread: its number, file and result.
+    struct PendingImport {
+        int number = 0;
+        std::string path;
+        std::future<std::shared_ptr<const LobeModel>> model;
+    };
+    std::optional<PendingImport> import_;
     glm::vec2 cursor_{0.0f};
     bool cursor_seen_ = false, cursor_inside_ = true, ui_capture_ = false;
     bool left_down_ = false, right_down_ = false, middle_down_ = false, shift_ = false, pinch_ = false;

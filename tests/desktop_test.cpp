@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #include <gtest/gtest.h>
 #include <glm/common.hpp>
@@ -280,6 +281,11 @@ TEST(DesktopSession, ImportedMeshIsALobeAtTheFingertipAndTheRecordingReplaysIt)
         EXPECT_FALSE(s.import_mesh(dir + "/missing.obj"));
         EXPECT_EQ(s.status().last_message.rfind("import: ", 0), 0u) << s.status().last_message;
         ASSERT_TRUE(s.import_mesh(test::shared_path("data/models/spot.obj"), 0.5)) << s.status().last_message;
+        // Made on its own thread: it goes in with the first frame after it is done.
+        EXPECT_TRUE(s.status().importing);
+        EXPECT_TRUE(s.document().lobes.empty());
+        s.wait_for_import();
+        EXPECT_FALSE(s.status().importing);
         tip = s.status().tip;
         d.step();
         ASSERT_EQ(s.document().lobes.size(), 1u) << s.status().last_message;
@@ -314,6 +320,42 @@ TEST(DesktopSession, ImportedMeshIsALobeAtTheFingertipAndTheRecordingReplaysIt)
     EXPECT_EQ(replayed.lobes[0].mesh_file, "lobes/lobe_1.ply"); // replay writes the lobe's mesh
     replayed.lobes[0].mesh_file.clear();
     EXPECT_EQ(document_to_json(replayed)["lobes"], document_to_json(live)["lobes"]);
+}
+
+TEST(DesktopSession, AnImportIsMadeBesideTheFramesOneAtATimeAndABadFileIsReportedWhenItEnds)
+{
+    const std::string dir = temp_dir("desktop_import_async");
+    DesktopSession s(Document{}, quiet_options(dir));
+    Driver d{s};
+    d.move(320, 180);
+    d.step(3);
+    // A file that exists but is no mesh: the import starts, and says why when it ends.
+    const std::string bad = dir + "/bad.obj";
+    {
+        std::ofstream out(bad);
+        out << "v 0 0 0\nv 1 0 0\nf 1 2 7\n";
+    }
+    ASSERT_TRUE(s.import_mesh(bad));
+    // One import at a time: a second one while the first is being made is refused.
+    EXPECT_FALSE(s.import_mesh(test::shared_path("data/models/cow.obj")));
+    EXPECT_EQ(s.status().last_message, "import: another import is still being made");
+    s.wait_for_import();
+    d.step(2);
+    EXPECT_FALSE(s.status().importing);
+    EXPECT_EQ(s.status().last_message.rfind("import: ", 0), 0u) << s.status().last_message;
+    EXPECT_EQ(s.status().last_message.find('\n'), std::string::npos);
+    EXPECT_TRUE(s.document().lobes.empty());
+    // The next import works; frames drawn while it is being made go on as usual.
+    ASSERT_TRUE(s.import_mesh(test::shared_path("data/models/cow.obj"), 0.8)) << s.status().last_message;
+    const std::uint64_t revision = s.status().revision;
+    while (s.status().importing) {
+        d.step();
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    d.step();
+    EXPECT_GT(s.status().revision, revision);
+    ASSERT_EQ(s.document().lobes.size(), 1u) << s.status().last_message;
+    EXPECT_TRUE(s.document().lobes[0].model);
 }
 
 // ---------------------------------------------------------------------------------------------
