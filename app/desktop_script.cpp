@@ -16,6 +16,9 @@ namespace {
 constexpr std::size_t kMaxSteps = 200000;
 constexpr int kMaxFrame = 10000000;
 constexpr int kMaxMacroFrames = 100000;
+constexpr double kMaxPixel = 1e6;         ///< |x|, |y| of a cursor position, a circle's radius
+constexpr double kMaxNotches = 1e4;       ///< |wheel notches| of one step
+constexpr double kMaxSettingValue = 1e9;  ///< |value| of `set` (validated again when applied)
 
 std::string lower(std::string s)
 {
@@ -126,6 +129,13 @@ std::vector<ScriptStep> parse_desktop_script(const std::string& text, const std:
             if (used != w[i].size() || !std::isfinite(v)) fail(std::string("bad ") + what + " '" + w[i] + "'");
             return v;
         };
+        // Pixels, notches and setting values become the floats of input events: a number
+        // beyond these bounds would not fit (and no window or setting needs it).
+        auto bounded = [&](std::size_t i, const char* what, double limit) {
+            const double v = number(i, what);
+            if (std::abs(v) > limit) fail(std::string(what) + " '" + w[i] + "' is out of range");
+            return v;
+        };
         const double f = number(0, "frame number");
         if (f < 0 || f > kMaxFrame || f != std::floor(f)) fail("frame '" + w[0] + "' is not a whole number in 0..10^7");
         const int frame = static_cast<int>(f);
@@ -143,8 +153,8 @@ std::vector<ScriptStep> parse_desktop_script(const std::string& text, const std:
         if (cmd == "move") {
             expect_args(2, 2);
             s.kind = ScriptStep::Kind::Move;
-            s.x = float(number(2, "x"));
-            s.y = float(number(3, "y"));
+            s.x = float(bounded(2, "x", kMaxPixel));
+            s.y = float(bounded(3, "y", kMaxPixel));
             push(s);
         } else if (cmd == "down" || cmd == "up") {
             expect_args(1, 1);
@@ -155,7 +165,7 @@ std::vector<ScriptStep> parse_desktop_script(const std::string& text, const std:
         } else if (cmd == "wheel") {
             expect_args(1, 1);
             s.kind = ScriptStep::Kind::Wheel;
-            s.y = float(number(2, "wheel notches"));
+            s.y = float(bounded(2, "wheel notches", kMaxNotches));
             push(s);
         } else if (cmd == "key" || cmd == "press" || cmd == "release") {
             expect_args(1, 1);
@@ -182,7 +192,7 @@ std::vector<ScriptStep> parse_desktop_script(const std::string& text, const std:
             for (const PanelSetting& p : panel_settings())
                 if (lower(w[2]) == p.name) s.code = p.id;
             if (s.code < 0) fail("unknown setting '" + w[2] + "'");
-            s.value = number(3, "setting value");
+            s.value = bounded(3, "setting value", kMaxSettingValue);
             if (w.size() == 6) {
                 if (lower(w[4]) != "lobe") fail("expected 'lobe ID' after the value");
                 const double id = number(5, "lobe id");
@@ -217,7 +227,8 @@ std::vector<ScriptStep> parse_desktop_script(const std::string& text, const std:
             const std::size_t n_num = circle ? 4 : 5;
             expect_args(n_num, n_num + 1);
             std::vector<double> a;
-            for (std::size_t i = 0; i < n_num; ++i) a.push_back(number(2 + i, "coordinate"));
+            for (std::size_t i = 0; i + 1 < n_num; ++i) a.push_back(bounded(2 + i, "coordinate", kMaxPixel));
+            a.push_back(number(2 + n_num - 1, "frame count"));
             const double frames_d = a.back();
             if (frames_d < 2 || frames_d > kMaxMacroFrames || frames_d != std::floor(frames_d))
                 fail("the frame count of '" + cmd + "' must be a whole number in 2..100000");

@@ -220,17 +220,29 @@ def session_seeds(lobesketch):
     put("settings", "settings.json", json.dumps(doc["settings"], indent=1))
 
 
+def desktop_script_seeds():
+    for name, src in [("every-tool.script", "desktop_every_tool.script"), ("save.script", "desktop_save.script")]:
+        put("desktop_script", name, (ROOT / "tests" / "data" / src).read_bytes())
+    put("desktop_script", "every-command.script",
+        "# every command and macro once\n0 move 320 180\n1 down left\n2 up left\n3 wheel -2\n4 key L\n"
+        "5 press z\n6 release z\n7 ui draw-lobe\n8 set split-angle 35\n9 set leaves 4 lobe 1\n"
+        "10 import models/cow.obj 0.8\n11 wait\n12 mark after-import\n13 circle 320 200 60 24\n"
+        "40 line 100 100 300 120 12 right\n60 circle 200 200 30 8 none\n80 quit\n")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--lobesketch", help="a built lobesketch, to remake the text-recording and session seeds")
     a = ap.parse_args()
-    for t in ["import_leap", "import_webxr", "recording_binary", "mesh_obj", "mesh_ply", "mesh_off", "species"]:
+    for t in ["import_leap", "import_webxr", "recording_binary", "mesh_obj", "mesh_ply", "mesh_off", "species",
+              "desktop_script"]:
         shutil.rmtree(OUT / t, ignore_errors=True)
     leap_seeds()
     webxr_seeds()
     recording_binary_seeds()
     mesh_seeds()
     species_seeds()
+    desktop_script_seeds()
     text_recording_seeds(a.lobesketch)
     session_seeds(a.lobesketch)
     for d in sorted(OUT.iterdir()):

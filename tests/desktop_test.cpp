@@ -375,9 +375,18 @@ TEST(DesktopScript, ParsesMacrosAndRefusesBadLinesWithTheirLineNumber)
     EXPECT_EQ(imports[0].name, "models/cow.obj");
     EXPECT_EQ(imports[0].value, 0.8);
     EXPECT_EQ(imports[1].value, 1.5);
+    // The bounds themselves are accepted.
+    const auto far = parse_desktop_script("0 move 1000000 -1000000\n1 wheel -10000\n2 set seed 1000000000\n", "s.script");
+    ASSERT_EQ(far.size(), 3u);
+    EXPECT_EQ(far[0].x, 1e6f);
+    EXPECT_EQ(far[1].y, -1e4f);
     for (const char* bad : {"0 fly 1 2", "x move 1 2", "5 move 1 2\n4 move 1 2", "0 move 1", "0 key nosuchkey",
                             "0 set split-angle nan", "0 circle 1 2 3 1", "0 ui nothing", "0 move 1e999 2", "0 import",
-                            "0 import a.obj 0", "0 import a.obj 2 3"}) {
+                            "0 import a.obj 0", "0 import a.obj 2 3",
+                            // Finite, but beyond what the input events' floats hold (found by
+                            // the desktop_script fuzz target: a circle centre of 5.5e107).
+                            "0 move 1e300 0", "0 move 0 -2e6", "0 wheel 1e5", "0 set seed 1e12",
+                            "0 circle 360 5e107 60 50", "0 line 0 0 3e38 0 8"}) {
         try {
             parse_desktop_script(bad, "s.script");
             ADD_FAILURE() << "accepted: " << bad;

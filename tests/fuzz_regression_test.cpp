@@ -12,6 +12,8 @@
 #include <vector>
 
 #include "app/cli_common.h"
+#include "app/desktop_script.h"
+#include "core/atomic_file.h"
 #include "core/document.h"
 #include "core/errors.h"
 #include "growth/species.h"
@@ -39,6 +41,7 @@ const std::map<std::string, std::function<void(const std::string&)>>& readers()
         {"mesh_obj", [](const std::string& p) { read_mesh(p); }},
         {"mesh_ply", [](const std::string& p) { read_mesh(p); }},
         {"mesh_off", [](const std::string& p) { read_mesh(p); }},
+        {"desktop_script", [](const std::string& p) { parse_desktop_script(read_file_limited(p, 16u << 20), p); }},
     };
     return r;
 }
