@@ -2,8 +2,11 @@
 
 #include "app/tree_output.h"
 #include "core/errors.h"
+#include "meshing/lobe_cache.h"
 
+#include <string>
 #include <utility>
+#include <vector>
 
 namespace lobe {
 
@@ -55,6 +58,9 @@ RegrowResult RegrowWorker::wait_for(std::uint64_t generation)
 
 void RegrowWorker::run()
 {
+    // What the last regrowth built of each lobe: a lobe whose strokes did not change is not
+    // built again, and one that gained a stroke joins only that stroke (meshing/lobe_cache.h).
+    LobeBuildCache cache;
     for (;;) {
         Document doc;
         std::uint64_t generation = 0;
@@ -71,12 +77,18 @@ void RegrowWorker::run()
         RegrowResult result;
         result.generation = generation;
         try {
+            std::vector<std::string> warnings;
+            std::vector<BuiltLobe> lobes = build_document_lobes(doc, &warnings, cache);
             if (grow) {
-                result.tree = build_document_tree(doc);
+                // build_document_tree, with the kept lobes.
+                result.tree = grow_document_tree(doc, std::move(lobes));
+                warnings.insert(warnings.end(), result.tree.warnings.begin(), result.tree.warnings.end());
+                result.tree.warnings = std::move(warnings);
                 result.geometry = document_tree_geometry(doc, result.tree);
                 result.grown = true;
             } else {
-                result.tree.lobes = build_document_lobes(doc, &result.tree.warnings);
+                result.tree.lobes = std::move(lobes);
+                result.tree.warnings = std::move(warnings);
             }
             if (prepare_) prepare_(result);
         } catch (const Error& e) {

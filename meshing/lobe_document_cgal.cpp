@@ -1,9 +1,12 @@
 // Lives in lobe_meshing_cgal (hence the name): it builds lobe surfaces and remeshes them.
 #include "meshing/lobe_document.h"
 
+#include <array>
 #include <cmath>
 #include <limits>
 #include <map>
+#include <set>
+#include <utility>
 
 #include <glm/geometric.hpp>
 #include <glm/matrix.hpp>
@@ -11,6 +14,7 @@
 #include "core/errors.h"
 #include "meshing/edit_ops.h"
 #include "meshing/laplacian_edit.h"
+#include "meshing/lobe_cache.h"
 #include "meshing/lobe_transform.h"
 #include "meshing/mesh_quality.h"
 #include "meshing/remesh.h"
@@ -139,9 +143,49 @@ LobeOptions lobe_options_from(const Settings& settings)
     return o;
 }
 
-std::vector<BuiltLobe> build_document_lobes(const Document& doc, std::vector<std::string>* warnings)
+struct LobeBuildCache::Impl {
+    /// One entry of a lobe's stroke list: the stroke as edited, or a stroke that is missing.
+    struct Step {
+        std::int64_t id = 0;
+        bool missing = false;
+        std::vector<glm::vec3> raw;
+        bool operator==(const Step& o) const { return id == o.id && missing == o.missing && raw == o.raw; }
+    };
+    /// A lobe after its steps: the joined strokes, what joining said, and the remeshed mesh.
+    struct Entry {
+        std::array<double, 4> key{}; ///< the settings the lobe is built with (options_key)
+        std::vector<Step> steps;
+        Lobe lobe;
+        std::vector<std::int64_t> accepted;
+        std::vector<std::string> warnings; ///< of the steps, in order
+        bool remeshed = false;             ///< mesh / remesh_error are those of `steps`
+        TriangleMesh mesh;
+        std::string remesh_error;
+    };
+    std::map<std::int64_t, Entry> lobes;
+};
+
+LobeBuildCache::LobeBuildCache() : impl_(std::make_unique<Impl>()) {}
+LobeBuildCache::~LobeBuildCache() = default;
+
+namespace {
+
+/// The settings a stroke lobe is built and remeshed with (lobe_options_from, RemeshOptions).
+std::array<double, 4> options_key(const Settings& settings)
 {
+    return {settings.lobes.closed_gap_fraction, settings.lobes.closed_gap_max_m, settings.lobes.edge_length_m,
+            static_cast<double>(settings.lobes.remesh_iterations)};
+}
+
+/// Every lobe of `doc`, before pinch edits and transforms; with `cache`, lobes are taken from
+/// it or continued where their strokes only grew, and it is left holding this build.
+std::vector<BuiltLobe> build_lobes(const Document& doc, std::vector<std::string>* warnings, LobeBuildCache::Impl* cache,
+                                   LobeBuildCache::Counts* counts)
+{
+    using Entry = LobeBuildCache::Impl::Entry;
+    using Step = LobeBuildCache::Impl::Step;
     const LobeOptions options = lobe_options_from(doc.settings);
+    const std::array<double, 4> key = options_key(doc.settings);
     RemeshOptions remesh;
     remesh.target_edge_length_m = doc.settings.lobes.edge_length_m;
     remesh.iterations = static_cast<unsigned>(doc.settings.lobes.remesh_iterations);
@@ -152,6 +196,7 @@ std::vector<BuiltLobe> build_document_lobes(const Document& doc, std::vector<std
     for (const SkippedEdit& e : skipped)
         if (warnings) warnings->push_back(e.message);
     std::vector<BuiltLobe> out;
+    std::set<std::int64_t> seen;
     for (const LobeRecord& rec : doc.lobes) {
         if (rec.model) {
             try {
@@ -161,49 +206,100 @@ std::vector<BuiltLobe> build_document_lobes(const Document& doc, std::vector<std
             }
             continue;
         }
-        Lobe lobe(options);
-        BuiltLobe built;
-        built.lobe_id = rec.id;
-        for (std::size_t k = 0; k < rec.stroke_ids.size(); ++k) {
-            const std::int64_t id = rec.stroke_ids[k];
-            if (k == kMaxStrokesPerLobe) {
-                if (warnings)
-                    warnings->push_back("lobe " + std::to_string(rec.id) + ": " +
-                                        std::to_string(rec.stroke_ids.size() - k) + " strokes beyond the first " +
-                                        std::to_string(kMaxStrokesPerLobe) + " are left out");
-                break;
+        seen.insert(rec.id);
+        std::vector<Step> steps;
+        for (std::size_t k = 0; k < rec.stroke_ids.size() && k < kMaxStrokesPerLobe; ++k) {
+            Step step;
+            step.id = rec.stroke_ids[k];
+            const Stroke* s = find_stroke(strokes, step.id);
+            step.missing = s == nullptr;
+            if (s) {
+                step.raw.reserve(s->points.size());
+                for (const StrokePoint& p : s->points) step.raw.push_back(p.position);
             }
-            const Stroke* s = find_stroke(strokes, id);
-            if (!s) {
-                if (warnings) warnings->push_back("lobe " + std::to_string(rec.id) + ": stroke " + std::to_string(id) + " is missing");
+            steps.push_back(std::move(step));
+        }
+        // The kept state of this lobe when its steps begin this lobe's steps (taken out of the
+        // cache while it is worked on: an exception leaves no half-made entry behind).
+        Entry work{key, {}, Lobe(options), {}, {}, false, {}, {}};
+        if (cache) {
+            const auto it = cache->lobes.find(rec.id);
+            if (it != cache->lobes.end() && it->second.key == key && it->second.steps.size() <= steps.size() &&
+                std::equal(it->second.steps.begin(), it->second.steps.end(), steps.begin())) {
+                work = std::move(it->second);
+            }
+            if (it != cache->lobes.end()) cache->lobes.erase(it);
+        }
+        const std::size_t from = work.steps.size();
+        if (counts) ++(from == steps.size() && work.remeshed ? counts->kept : from > 0 ? counts->continued : counts->built);
+        for (std::size_t k = from; k < steps.size(); ++k) {
+            const Step& step = steps[k];
+            if (step.missing) {
+                work.warnings.push_back("lobe " + std::to_string(rec.id) + ": stroke " + std::to_string(step.id) + " is missing");
                 continue;
             }
-            std::vector<glm::vec3> raw;
-            raw.reserve(s->points.size());
-            for (const StrokePoint& p : s->points) raw.push_back(p.position);
             try {
-                lobe.add_stroke(id, raw);
-                built.stroke_ids.push_back(id);
+                work.lobe.add_stroke(step.id, step.raw);
+                work.accepted.push_back(step.id);
             } catch (const InvalidInput& e) {
-                if (warnings)
-                    warnings->push_back("lobe " + std::to_string(rec.id) + ": " + e.what() + "; the stroke is left out of the lobe");
+                work.warnings.push_back("lobe " + std::to_string(rec.id) + ": " + e.what() +
+                                        "; the stroke is left out of the lobe");
             }
         }
-        if (lobe.empty()) continue;
-        built.surface = lobe.surface();
+        if (from < steps.size()) work.remeshed = false;
+        work.steps = std::move(steps);
+        if (warnings) {
+            warnings->insert(warnings->end(), work.warnings.begin(), work.warnings.end());
+            if (rec.stroke_ids.size() > kMaxStrokesPerLobe)
+                warnings->push_back("lobe " + std::to_string(rec.id) + ": " +
+                                    std::to_string(rec.stroke_ids.size() - kMaxStrokesPerLobe) + " strokes beyond the first " +
+                                    std::to_string(kMaxStrokesPerLobe) + " are left out");
+        }
+        auto keep = [&] {
+            if (cache) cache->lobes.insert_or_assign(rec.id, std::move(work));
+        };
+        if (work.lobe.empty()) {
+            keep();
+            continue;
+        }
+        BuiltLobe built;
+        built.lobe_id = rec.id;
+        built.stroke_ids = work.accepted;
+        built.surface = work.lobe.surface();
         if (remesh.iterations > 0) {
-            try {
-                built.mesh = remesh_isotropic(built.surface.mesh, remesh);
-            } catch (const InvalidInput& e) {
-                // Too large for the spacing (kMaxRemeshTriangles), or a surface remeshing refuses.
-                if (warnings) warnings->push_back("lobe " + std::to_string(rec.id) + ": " + e.what() + "; the lobe is left out");
+            if (!work.remeshed) {
+                try {
+                    work.mesh = remesh_isotropic(built.surface.mesh, remesh);
+                    work.remesh_error.clear();
+                } catch (const InvalidInput& e) {
+                    // Too large for the spacing (kMaxRemeshTriangles), or a surface remeshing refuses.
+                    work.mesh = TriangleMesh{};
+                    work.remesh_error = e.what();
+                }
+                work.remeshed = true;
+            }
+            if (!work.remesh_error.empty()) {
+                if (warnings)
+                    warnings->push_back("lobe " + std::to_string(rec.id) + ": " + work.remesh_error + "; the lobe is left out");
+                keep();
                 continue;
             }
+            built.mesh = work.mesh;
         } else {
             built.mesh = built.surface.mesh;
         }
+        keep();
         out.push_back(std::move(built));
     }
+    if (cache)
+        for (auto it = cache->lobes.begin(); it != cache->lobes.end();)
+            it = seen.count(it->first) ? std::next(it) : cache->lobes.erase(it);
+    return out;
+}
+
+/// Pinch edits, then moves, rotations and scales, on lobes as build_lobes made them.
+std::vector<BuiltLobe> finish_lobes(const Document& doc, std::vector<BuiltLobe> out, std::vector<std::string>* warnings)
+{
     // Edits in document order. A pinch edit goes to its target lobe, or (no target) to the
     // lobe with a vertex nearest the pinch.
     for (std::size_t k = 0; k < doc.edits.size(); ++k) {
@@ -254,6 +350,19 @@ std::vector<BuiltLobe> build_document_lobes(const Document& doc, std::vector<std
         placed.push_back(std::move(b));
     }
     return placed;
+}
+
+} // namespace
+
+std::vector<BuiltLobe> build_document_lobes(const Document& doc, std::vector<std::string>* warnings)
+{
+    return finish_lobes(doc, build_lobes(doc, warnings, nullptr, nullptr), warnings);
+}
+
+std::vector<BuiltLobe> build_document_lobes(const Document& doc, std::vector<std::string>* warnings, LobeBuildCache& cache)
+{
+    cache.counts_ = {};
+    return finish_lobes(doc, build_lobes(doc, warnings, cache.impl_.get(), &cache.counts_), warnings);
 }
 
 std::size_t apply_pinch_edits(const Document& doc, std::int64_t lobe_id, TriangleMesh& mesh,

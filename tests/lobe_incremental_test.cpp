@@ -12,8 +12,10 @@
 
 #include "core/errors.h"
 #include "meshing/lobe.h"
+#include "meshing/lobe_cache.h"
 #include "meshing/mesh_quality.h"
 #include "meshing/repair.h"
+#include "tests/replay_fixture.h"
 
 namespace lobe {
 namespace {
@@ -176,4 +178,83 @@ TEST(LobeIncremental, ARefusedStrokeLeavesTheSurfaceAsItWas)
 }
 
 } // namespace
+
+namespace {
+
+/// The lobes of two builds are the same, byte for byte, and so are their warnings.
+void expect_same_build(const std::vector<BuiltLobe>& a, const std::vector<std::string>& wa,
+                       const std::vector<BuiltLobe>& b, const std::vector<std::string>& wb, const std::string& what)
+{
+    EXPECT_EQ(wa, wb) << what;
+    ASSERT_EQ(a.size(), b.size()) << what;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        const std::string lobe = what + ", lobe " + std::to_string(a[i].lobe_id);
+        EXPECT_EQ(a[i].lobe_id, b[i].lobe_id) << lobe;
+        EXPECT_EQ(a[i].stroke_ids, b[i].stroke_ids) << lobe;
+        EXPECT_EQ(a[i].edits_applied, b[i].edits_applied) << lobe;
+        EXPECT_TRUE(a[i].surface.mesh.positions == b[i].surface.mesh.positions) << lobe;
+        EXPECT_EQ(a[i].surface.mesh.triangles, b[i].surface.mesh.triangles) << lobe;
+        EXPECT_EQ(a[i].surface.mesh.feature_edges, b[i].surface.mesh.feature_edges) << lobe;
+        EXPECT_TRUE(a[i].mesh.positions == b[i].mesh.positions) << lobe;
+        EXPECT_EQ(a[i].mesh.triangles, b[i].mesh.triangles) << lobe;
+    }
+}
+
+/// `doc` with each lobe cut to its first `k` strokes.
+Document first_strokes(Document doc, std::size_t k)
+{
+    for (LobeRecord& l : doc.lobes)
+        if (l.stroke_ids.size() > k) l.stroke_ids.resize(k);
+    return doc;
+}
+
+} // namespace
+
+TEST(LobeIncremental, AKeptBuildGivesTheLobesAndWarningsOfABuildFromScratchAndRebuildsOnlyWhatChanged)
+{
+    const Document full = test::replay_document("table1-3lobes-16strokes");
+    ASSERT_EQ(full.lobes.size(), 3u);
+    std::size_t most = 0;
+    for (const LobeRecord& l : full.lobes) most = std::max(most, l.stroke_ids.size());
+    LobeBuildCache cache;
+    auto check = [&](const Document& doc, const std::string& what, bool compare = true) {
+        std::vector<std::string> wa, wb;
+        const std::vector<BuiltLobe> kept = build_document_lobes(doc, &wa, cache);
+        if (compare) expect_same_build(kept, wa, build_document_lobes(doc, &wb), wb, what);
+        return cache.last_build();
+    };
+    // Strokes drawn one at a time: a lobe that gained one continues, the others are kept.
+    // (Compared with a build from scratch after the first, second, fourth and last strokes.)
+    for (std::size_t k = 1; k <= most; ++k) {
+        const Document doc = first_strokes(full, k);
+        const LobeBuildCache::Counts c =
+            check(doc, "first " + std::to_string(k) + " strokes of each lobe", k <= 2 || k == 4 || k == most);
+        std::size_t grew = 0;
+        for (const LobeRecord& l : full.lobes) grew += l.stroke_ids.size() >= k ? 1 : 0;
+        EXPECT_EQ(c.built, k == 1 ? 3u : 0u) << k;
+        EXPECT_EQ(c.continued, k == 1 ? 0u : grew) << k;
+        EXPECT_EQ(c.kept, 3u - c.built - c.continued) << k;
+    }
+    // The same document again: nothing is built.
+    EXPECT_EQ(check(full, "the same document").kept, 3u);
+    // Undo down to two strokes: those lobes are built again.
+    EXPECT_EQ(check(first_strokes(full, 2), "two strokes").built, 3u);
+    // A stroke of the first lobe moved by a millimetre: that lobe is built again, not the others.
+    Document moved = full;
+    const std::int64_t second = moved.lobes[0].stroke_ids[1];
+    for (Stroke& s : moved.strokes)
+        if (s.id == second)
+            for (StrokePoint& p : s.points) p.position.x += 0.001f;
+    check(full, "all strokes");
+    const LobeBuildCache::Counts c = check(moved, "a moved stroke");
+    EXPECT_EQ(c.built, 1u);
+    EXPECT_EQ(c.kept, 2u);
+    // Another attractor spacing rebuilds every lobe; a deleted lobe is forgotten.
+    Document spaced = moved;
+    spaced.settings.lobes.edge_length_m = 0.04;
+    EXPECT_EQ(check(spaced, "another spacing").built, 3u);
+    spaced.lobes.erase(spaced.lobes.begin() + 1);
+    EXPECT_EQ(check(spaced, "a deleted lobe").kept, 2u);
+}
+
 } // namespace lobe

@@ -10,10 +10,12 @@
 #include <glm/geometric.hpp>
 
 #include "meshing/lobe.h"
+#include "meshing/lobe_cache.h"
 #include "meshing/lobe_document.h"
 #include "meshing/mesh_quality.h"
 #include "meshing/remesh.h"
 #include "tests/bench/cgal_surface_mesh.h"
+#include "tests/replay_fixture.h"
 
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wconversion"
@@ -80,6 +82,36 @@ void BM_AddStrokeToTenStrokeLobe(benchmark::State& state)
     state.counters["crossings"] = static_cast<double>(s.crossings);
 }
 BENCHMARK(BM_AddStrokeToTenStrokeLobe)->Unit(benchmark::kMillisecond);
+
+/// What a regrowth does with the lobes after the person drew one more lobe stroke: every lobe
+/// of table1-4lobes-22strokes (4 lobes, 22 strokes) built from its strokes and remeshed.
+/// Arg 0: from scratch (replay, the CLI); arg 1: with the regrowth worker's kept build
+/// (meshing/lobe_cache.h), which joins the one stroke to its lobe and remeshes that lobe.
+void BM_LobesAfterOneMoreStroke(benchmark::State& state)
+{
+    const Document full = test::replay_document("table1-4lobes-22strokes");
+    Document before = full;
+    LobeRecord* last = nullptr; // the lobe of the last lobe stroke drawn
+    for (LobeRecord& l : before.lobes)
+        if (!l.stroke_ids.empty() && (!last || l.stroke_ids.back() > last->stroke_ids.back())) last = &l;
+    last->stroke_ids.pop_back();
+    LobeBuildCache cache;
+    for (auto _ : state) {
+        if (state.range(0)) {
+            state.PauseTiming();
+            build_document_lobes(before, nullptr, cache);
+            state.ResumeTiming();
+            benchmark::DoNotOptimize(build_document_lobes(full, nullptr, cache).size());
+        } else {
+            benchmark::DoNotOptimize(build_document_lobes(full, nullptr).size());
+        }
+    }
+    if (state.range(0)) {
+        state.counters["lobes_kept"] = static_cast<double>(cache.last_build().kept);
+        state.counters["lobes_continued"] = static_cast<double>(cache.last_build().continued);
+    }
+}
+BENCHMARK(BM_LobesAfterOneMoreStroke)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 /// Sampling and closing one raw stroke (part of adding a stroke from the pipeline).
 void BM_PrepareStroke(benchmark::State& state)
