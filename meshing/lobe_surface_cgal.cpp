@@ -145,6 +145,15 @@ double orient3(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c)
     return glm::dot(a, glm::cross(b, c));
 }
 
+/// Sorts `order` (indices into `where`) along a space-filling curve: points inserted into
+/// the triangulation in that order stay near the last one, where points taken along a
+/// stroke, or along the Fibonacci lattice, make insertions flip long fans or walk far.
+void spatially_sort(std::vector<std::size_t>& order, std::vector<K::Point_2>& where)
+{
+    using Map = CGAL::Pointer_property_map<K::Point_2>::type;
+    CGAL::spatial_sort(order.begin(), order.end(), CGAL::Spatial_sort_traits_adapter_2<K, Map>(CGAL::make_property_map(where)));
+}
+
 /// Segments of all strokes binned in a uniform grid over the plane, so crossings are
 /// found in time about linear in the number of segments.
 class SegmentGrid {
@@ -630,8 +639,6 @@ void Builder::triangulate()
     node_vertex_.assign(nodes_.size(), VH());
     VH hint;
     {
-        // Inserted in a space-filling-curve order: points taken in drawing order along a
-        // curve make every insertion flip a long fan.
         std::vector<K::Point_2> where(nodes_.size());
         std::vector<std::size_t> order;
         std::vector<char> seen(nodes_.size(), 0);
@@ -643,9 +650,7 @@ void Builder::triangulate()
                     where[static_cast<Index>(id)] = K::Point_2(x.x, x.y);
                     order.push_back(static_cast<std::size_t>(id));
                 }
-        using Map = CGAL::Pointer_property_map<K::Point_2>::type;
-        CGAL::spatial_sort(order.begin(), order.end(),
-                           CGAL::Spatial_sort_traits_adapter_2<K, Map>(CGAL::make_property_map(where)));
+        spatially_sort(order, where);
         for (std::size_t id : order) hint = node_vertex_[id] = insert_node(static_cast<int>(id), hint);
     }
     // A small ring around the pole closes the planar triangulation's outside: the ring
@@ -841,13 +846,10 @@ void Builder::seed_fill(double max_edge, int& added)
         lattice.push_back(d);
         where.emplace_back(x.x, x.y);
     }
-    // Located and inserted in a space-filling-curve order (the lattice's own order jumps
-    // across the sphere at every step).
+    // Located and inserted along a space-filling curve.
     std::vector<std::size_t> order(lattice.size());
     for (Index i = 0; i < order.size(); ++i) order[i] = i;
-    using Map = CGAL::Pointer_property_map<K::Point_2>::type;
-    CGAL::spatial_sort(order.begin(), order.end(),
-                       CGAL::Spatial_sort_traits_adapter_2<K, Map>(CGAL::make_property_map(where)));
+    spatially_sort(order, where);
     struct Candidate {
         glm::dvec3 dir;
         int region; ///< -1: not located inside a face
