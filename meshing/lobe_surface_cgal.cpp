@@ -251,18 +251,20 @@ struct Adjacency {
     };
     std::vector<int> start, list;
 
-    Adjacency(Index n, const std::vector<std::array<int, 3>>& triangles) : start(n + 1, 0)
+    /// Rows only for the nodes `rows` marks; the others are left empty.
+    Adjacency(Index n, const std::vector<std::array<int, 3>>& triangles, const std::vector<char>& rows) : start(n + 1, 0)
     {
         for (const auto& t : triangles)
-            for (int id : t) start[static_cast<Index>(id) + 1] += 2;
+            for (int id : t)
+                if (rows[static_cast<Index>(id)]) start[static_cast<Index>(id) + 1] += 2;
         for (Index i = 0; i < n; ++i) start[i + 1] += start[i];
         std::vector<int> raw(static_cast<Index>(start[n]));
         std::vector<int> next(start.begin(), start.end() - 1);
         for (const auto& t : triangles)
             for (Index k = 0; k < 3; ++k) {
                 const Index a = static_cast<Index>(t[k]), b = static_cast<Index>(t[(k + 1) % 3]);
-                raw[static_cast<Index>(next[a]++)] = t[(k + 1) % 3];
-                raw[static_cast<Index>(next[b]++)] = t[k];
+                if (rows[a]) raw[static_cast<Index>(next[a]++)] = t[(k + 1) % 3];
+                if (rows[b]) raw[static_cast<Index>(next[b]++)] = t[k];
             }
         list.reserve(raw.size());
         for (Index i = 0; i < n; ++i) {
@@ -304,7 +306,7 @@ private:
     void insert_fill(const Node& n, const glm::dvec2& x, int region, VH& hint, int& added);
     void emit(LobeSurface& out);
     void solve_fill_radii(const std::vector<std::array<int, 3>>& triangles);
-    bool fit_radius_model(const Adjacency& adj, std::vector<double>& model) const;
+    bool fit_radius_model(const std::vector<char>& used, std::vector<double>& model) const;
 
     int add_node(const Node& n)
     {
@@ -994,15 +996,21 @@ void Builder::solve_fill_radii(const std::vector<std::array<int, 3>>& triangles)
     for (Index i = 0; i < n; ++i)
         if (nodes_[i].origin.kind == LobeVertexKind::Fill) unknown[i] = count++;
     if (count == 0) return;
-    const Adjacency adj(n, triangles);
+    // Which nodes the triangles use, and the neighbours of the interpolated ones (the rows
+    // of the system; the other nodes' neighbours are not needed).
+    std::vector<char> used(n, 0), rows(n, 0);
+    for (const auto& t : triangles)
+        for (int id : t) used[static_cast<Index>(id)] = 1;
+    for (Index i = 0; i < n; ++i) rows[i] = unknown[i] >= 0 ? 1 : 0;
+    const Adjacency adj(n, triangles, rows);
     double lo = std::numeric_limits<double>::infinity(), hi = 0;
     for (Index i = 0; i < n; ++i)
-        if (unknown[i] < 0 && !adj[i].empty()) {
+        if (unknown[i] < 0 && used[i]) {
             lo = std::min(lo, nodes_[i].radius);
             hi = std::max(hi, nodes_[i].radius);
         }
     std::vector<double> model(n, 0.0);
-    bool use_model = fit_radius_model(adj, model);
+    bool use_model = fit_radius_model(used, model);
     if (use_model)
         for (Index i = 0; i < n; ++i)
             if (unknown[i] >= 0 && !(model[i] >= 0.5 * lo && model[i] <= 1.5 * hi)) use_model = false;
@@ -1042,7 +1050,7 @@ void Builder::solve_fill_radii(const std::vector<std::array<int, 3>>& triangles)
         }
 }
 
-bool Builder::fit_radius_model(const Adjacency& adj, std::vector<double>& model) const
+bool Builder::fit_radius_model(const std::vector<char>& used, std::vector<double>& model) const
 {
     // Monomials x^a y^b z^c of the direction, a + b + c ≤ 3: 20 functions spanning the
     // spherical harmonics up to degree 3 on the sphere.
@@ -1071,13 +1079,13 @@ bool Builder::fit_radius_model(const Adjacency& adj, std::vector<double>& model)
     // the normal equations as one matrix product.
     Index samples = 0;
     for (Index i = 0; i < nodes_.size(); ++i)
-        if (nodes_[i].origin.kind != LobeVertexKind::Fill && !adj[i].empty()) ++samples;
+        if (nodes_[i].origin.kind != LobeVertexKind::Fill && used[i]) ++samples;
     if (samples < static_cast<Index>(kTerms)) return false;
     Basis phi(static_cast<Eigen::Index>(samples), kTerms);
     Eigen::VectorXd radius(static_cast<Eigen::Index>(samples));
     Eigen::Index row = 0;
     for (Index i = 0; i < nodes_.size(); ++i) {
-        if (nodes_[i].origin.kind == LobeVertexKind::Fill || adj[i].empty()) continue;
+        if (nodes_[i].origin.kind == LobeVertexKind::Fill || !used[i]) continue;
         basis(nodes_[i].dir, phi.row(row));
         radius[row++] = nodes_[i].radius;
     }
@@ -1093,7 +1101,7 @@ bool Builder::fit_radius_model(const Adjacency& adj, std::vector<double>& model)
     if (!coef.allFinite()) return false;
     Row at;
     for (Index i = 0; i < nodes_.size(); ++i) {
-        if (adj[i].empty()) continue;
+        if (!used[i]) continue;
         basis(nodes_[i].dir, at);
         model[i] = at.dot(coef.transpose());
     }
@@ -1178,16 +1186,16 @@ void Builder::emit(LobeSurface& out)
     // things in (its faces, and the refinement's insertions that follow them).
     std::vector<int> new_id(nodes_.size());
     {
-        std::vector<int> order(nodes_.size());
-        for (Index i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
-        const auto fill_begin = std::stable_partition(order.begin(), order.end(), [&](int id) {
-            return nodes_[static_cast<Index>(id)].origin.kind != LobeVertexKind::Fill;
-        });
-        std::stable_sort(fill_begin, order.end(), [&](int a, int b) {
-            const glm::dvec3& u = nodes_[static_cast<Index>(a)].dir;
-            const glm::dvec3& v = nodes_[static_cast<Index>(b)].dir;
-            return std::tie(u.x, u.y, u.z) < std::tie(v.x, v.y, v.z);
-        });
+        std::vector<int> order;
+        order.reserve(nodes_.size());
+        std::vector<std::tuple<double, double, double, int>> fill; // (direction, id): ties keep id order
+        for (Index i = 0; i < nodes_.size(); ++i) {
+            const Node& n = nodes_[i];
+            if (n.origin.kind != LobeVertexKind::Fill) order.push_back(static_cast<int>(i));
+            else fill.emplace_back(n.dir.x, n.dir.y, n.dir.z, static_cast<int>(i));
+        }
+        std::sort(fill.begin(), fill.end());
+        for (const auto& f : fill) order.push_back(std::get<3>(f));
         std::vector<Node> sorted;
         sorted.reserve(nodes_.size());
         for (Index k = 0; k < order.size(); ++k) {
@@ -1231,7 +1239,18 @@ void Builder::emit(LobeSurface& out)
         const Index first = static_cast<Index>(std::min_element(o.begin(), o.end()) - o.begin());
         out.mesh.triangles.push_back({o[first], o[(first + 1) % 3], o[(first + 2) % 3]});
     }
-    std::sort(out.mesh.triangles.begin(), out.mesh.triangles.end());
+    // Sorted: bucketed by first (lowest) index, each bucket (a vertex's few triangles) sorted.
+    {
+        auto& tris_out = out.mesh.triangles;
+        std::vector<int> start(out.mesh.positions.size() + 1, 0);
+        for (const auto& t : tris_out) ++start[static_cast<Index>(t[0]) + 1];
+        for (Index i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+        std::vector<std::array<int, 3>> sorted(tris_out.size());
+        std::vector<int> next(start.begin(), start.end() - 1);
+        for (const auto& t : tris_out) sorted[static_cast<Index>(next[static_cast<Index>(t[0])]++)] = t;
+        for (Index i = 0; i + 1 < start.size(); ++i) std::sort(sorted.begin() + start[i], sorted.begin() + start[i + 1]);
+        tris_out = std::move(sorted);
+    }
     // Stroke segments (split at crossings) are the constraints of remeshing.
     auto out_of = [&](VH v) { return out_index[static_cast<Index>(new_id[static_cast<Index>(node_of(v))])]; };
     for (const auto& e : cdt_.constrained_edges()) {
