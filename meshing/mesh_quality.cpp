@@ -6,7 +6,6 @@
 #include <cstdint>
 #include <limits>
 #include <numeric>
-#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -117,42 +116,44 @@ MeshQuality measure_quality(const TriangleMesh& mesh)
     q.share_all_angles_ge_30 = static_cast<double>(good) / static_cast<double>(q.triangles);
     q.signed_volume_m3 = volume6 / 6.0;
 
-    // Edges: incidence counts and directions.
-    struct EdgeUse {
-        int count = 0;
-        int forward = 0; ///< uses running from the smaller to the larger index
-        int a = 0, b = 0;
-    };
-    std::unordered_map<std::uint64_t, EdgeUse> edges;
-    edges.reserve(mesh.triangles.size() * 2);
+    // Edges: incidence counts and directions. Every corner's outgoing edge as (undirected
+    // key, runs from the smaller index), sorted, so each edge's uses lie side by side.
+    std::vector<std::pair<std::uint64_t, bool>> uses;
+    uses.reserve(mesh.triangles.size() * 3);
     for (const auto& t : mesh.triangles)
         for (int k = 0; k < 3; ++k) {
             const int a = t[static_cast<std::size_t>(k)], b = t[static_cast<std::size_t>((k + 1) % 3)];
-            EdgeUse& e = edges[edge_key(a, b)];
-            e.a = std::min(a, b);
-            e.b = std::max(a, b);
-            ++e.count;
-            if (a < b) ++e.forward;
+            uses.emplace_back(edge_key(a, b), a < b);
         }
+    std::sort(uses.begin(), uses.end());
     double sum = 0, sum2 = 0;
+    std::size_t edge_count = 0;
     q.edge_min_m = std::numeric_limits<double>::max();
-    for (const auto& [key, e] : edges) {
-        const double len = glm::length(pos(mesh, e.a) - pos(mesh, e.b));
+    for (std::size_t i = 0; i < uses.size();) {
+        std::size_t j = i;
+        int forward = 0;
+        for (; j < uses.size() && uses[j].first == uses[i].first; ++j) forward += uses[j].second ? 1 : 0;
+        const int count = static_cast<int>(j - i);
+        const int ea = static_cast<int>(uses[i].first >> 32), eb = static_cast<int>(uses[i].first & 0xffffffffu);
+        const double len = glm::length(pos(mesh, ea) - pos(mesh, eb));
         q.edge_min_m = std::min(q.edge_min_m, len);
         q.edge_max_m = std::max(q.edge_max_m, len);
         sum += len;
         sum2 += len * len;
-        if (e.count == 1) ++q.boundary_edges;
-        if (e.count > 2) ++q.non_manifold_edges;
-        if (e.count == 2 && e.forward != 1) ++q.inconsistent_edges;
+        ++edge_count;
+        if (count == 1) ++q.boundary_edges;
+        if (count > 2) ++q.non_manifold_edges;
+        if (count == 2 && forward != 1) ++q.inconsistent_edges;
+        i = j;
     }
-    const double n = static_cast<double>(edges.size());
+    const double n = static_cast<double>(edge_count);
     q.edge_mean_m = sum / n;
     q.edge_stddev_m = std::sqrt(std::max(0.0, sum2 / n - q.edge_mean_m * q.edge_mean_m));
 
     // Vertex fans: the triangles around a vertex, joined through shared edges, must form one
     // fan. Count per vertex the incident triangles and the fan pieces (union-find over the
-    // triangle corners that share an edge at that vertex).
+    // triangle corners that share an edge at that vertex: corners listing the same other
+    // vertex, found side by side after sorting).
     const std::size_t nv = mesh.positions.size();
     std::vector<int> corner_start(nv + 1, 0);
     for (const auto& t : mesh.triangles)
@@ -165,25 +166,24 @@ MeshQuality measure_quality(const TriangleMesh& mesh)
             for (int v : mesh.triangles[f]) corner_tri[static_cast<std::size_t>(fill[static_cast<std::size_t>(v)]++)] = static_cast<int>(f);
     }
     std::vector<int> parent;
-    std::unordered_map<int, int> local;
+    std::vector<std::pair<int, int>> others; // (other vertex, local corner)
     for (std::size_t v = 0; v < nv; ++v) {
         const int b = corner_start[v], e = corner_start[v + 1];
         if (e - b == 0) continue;
-        // Other vertex -> first local fan piece that holds it.
-        local.clear();
+        others.clear();
         parent.resize(static_cast<std::size_t>(e - b));
         std::iota(parent.begin(), parent.end(), 0);
         for (int i = b; i < e; ++i) {
             const auto& t = mesh.triangles[static_cast<std::size_t>(corner_tri[static_cast<std::size_t>(i)])];
-            for (int w : t) {
-                if (w == static_cast<int>(v)) continue;
-                auto [it, inserted] = local.emplace(w, i - b);
-                if (!inserted) {
-                    const int ra = find_root(parent, it->second), rb = find_root(parent, i - b);
-                    if (ra != rb) parent[static_cast<std::size_t>(ra)] = rb;
-                }
-            }
+            for (int w : t)
+                if (w != static_cast<int>(v)) others.emplace_back(w, i - b);
         }
+        std::sort(others.begin(), others.end());
+        for (std::size_t k = 1; k < others.size(); ++k)
+            if (others[k].first == others[k - 1].first) {
+                const int ra = find_root(parent, others[k - 1].second), rb = find_root(parent, others[k].second);
+                if (ra != rb) parent[static_cast<std::size_t>(ra)] = rb;
+            }
         int pieces = 0;
         for (int i = 0; i < e - b; ++i)
             if (find_root(parent, i) == i) ++pieces;
