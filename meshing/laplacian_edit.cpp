@@ -177,57 +177,65 @@ struct PinchEditor::Impl {
     std::vector<Eigen::Vector3d> rest_points; ///< #local positions when the pinch starts
     // Rows of the energy: the local vertices 0 … rows−1 (F, handle, fixed ring).
     std::size_t rows = 0;
-    Eigen::MatrixX3d delta;                   ///< rows by 3: δ = L(x) when the pinch starts
-    SparseMatrix a_free_t;                    ///< nf by rows: A_Fᵀ, A = ∂L/∂x_F
-    Eigen::MatrixX3d fixed_part;              ///< rows by 3: L applied to the fixed vertices but the handle
-    Eigen::VectorXd handle_column;            ///< rows: ∂L/∂x_handle
-    Eigen::SimplicialLDLT<SparseMatrix> ldlt; ///< of A_FᵀA_F = Pᵀ L D Lᵀ P
-    // The factor copied out of ldlt, so that the three right-hand sides (x, y, z) are
-    // substituted together in one pass over L (Eigen's solve makes one pass per column).
-    std::vector<int> l_outer, l_inner; ///< L strictly below the diagonal, compressed columns
-    std::vector<double> l_values;
-    std::vector<double> inverse_d;
-    std::vector<int> permutation;      ///< P: row i of the system is row permutation[i] of the factor
+    std::vector<Eigen::Vector3d> delta;       ///< per row: δ = L(x) when the pinch starts
 
-    /// (A_FᵀA_F)⁻¹ rhs for nf by 3 rhs: P, forward substitution with L, D⁻¹, backward with Lᵀ, P⁻¹.
-    Eigen::MatrixX3d substitute(const Eigen::MatrixX3d& rhs) const
+    // Everything the per-frame solve touches is in the factor's order (the free vertex l is
+    // unknown factor_index[l]) and stored as 4 doubles per point (x, y, z, 0): two SSE2
+    // packets, so the substitutions below vectorise without gathers or permutations.
+    using Point4 = Eigen::Array4d;
+    std::vector<int> factor_index; ///< P: free vertex l is row factor_index[l] of the factor
+    // A = ∂L/∂x_F by rows: row r's entries a_offsets[r] … a_offsets[r + 1] − 1 are
+    // (factor index of a free vertex, coefficient).
+    std::vector<int> a_offsets, a_columns;
+    std::vector<double> a_values;
+    // Right-hand side for target t and rotated δ: Aᵀ(Rδ) − known_rhs − handle_rhs t, where
+    // known_rhs = Aᵀ L_C x_C (the fixed vertices but the handle) and handle_rhs = Aᵀ ∂L/∂x_handle.
+    std::vector<Point4> known_rhs;
+    std::vector<double> handle_rhs;
+    // The first solve (R = I) is affine in the target, so it is solved when the pinch starts:
+    // x_F = first_base − first_slope t.
+    std::vector<Point4> first_base;
+    std::vector<double> first_slope;
+    // LDLᵀ of A_FᵀA_F (Eigen's SimplicialLDLT, AMD ordering). L strictly below the diagonal is
+    // kept twice, by rows for the forward substitution and by columns for the backward one, so
+    // that both are gathers into a running sum: no store-to-load chains through y.
+    std::vector<int> l_row_offsets, l_row_columns;
+    std::vector<double> l_row_values;
+    std::vector<int> l_column_offsets, l_column_rows;
+    std::vector<double> l_column_values;
+    std::vector<double> inverse_d;
+
+    /// y ← (LDLᵀ)⁻¹ y in the factor's order, for x, y and z together.
+    void substitute(std::vector<Point4>& y) const
     {
+        // Two running sums per point halve the dependency chain of the additions.
         const std::size_t n = nf;
-        std::vector<double> y(3 * n);
-        for (std::size_t i = 0; i < n; ++i)
-            for (std::size_t c = 0; c < 3; ++c)
-                y[3 * std::size_t(permutation[i]) + c] = rhs(Eigen::Index(i), Eigen::Index(c));
-        for (std::size_t j = 0; j < n; ++j) {
-            const double y0 = y[3 * j], y1 = y[3 * j + 1], y2 = y[3 * j + 2];
-            for (int p = l_outer[j]; p < l_outer[j + 1]; ++p) {
-                double* yi = &y[3 * std::size_t(l_inner[std::size_t(p)])];
-                const double v = l_values[std::size_t(p)];
-                yi[0] -= v * y0;
-                yi[1] -= v * y1;
-                yi[2] -= v * y2;
+        for (std::size_t i = 0; i < n; ++i) {
+            Point4 s0 = y[i], s1 = Point4::Zero();
+            int p = l_row_offsets[i];
+            const int end = l_row_offsets[i + 1];
+            for (; p + 1 < end; p += 2) {
+                s0 -= l_row_values[std::size_t(p)] * y[std::size_t(l_row_columns[std::size_t(p)])];
+                s1 -= l_row_values[std::size_t(p) + 1] * y[std::size_t(l_row_columns[std::size_t(p) + 1])];
             }
+            if (p < end)
+                s0 -= l_row_values[std::size_t(p)] * y[std::size_t(l_row_columns[std::size_t(p)])];
+            y[i] = s0 + s1;
         }
-        for (std::size_t j = 0; j < n; ++j)
-            for (std::size_t c = 0; c < 3; ++c)
-                y[3 * j + c] *= inverse_d[j];
+        for (std::size_t i = 0; i < n; ++i)
+            y[i] *= inverse_d[i];
         for (std::size_t j = n; j-- > 0;) {
-            double y0 = y[3 * j], y1 = y[3 * j + 1], y2 = y[3 * j + 2];
-            for (int p = l_outer[j]; p < l_outer[j + 1]; ++p) {
-                const double* yi = &y[3 * std::size_t(l_inner[std::size_t(p)])];
-                const double v = l_values[std::size_t(p)];
-                y0 -= v * yi[0];
-                y1 -= v * yi[1];
-                y2 -= v * yi[2];
+            Point4 s0 = y[j], s1 = Point4::Zero();
+            int p = l_column_offsets[j];
+            const int end = l_column_offsets[j + 1];
+            for (; p + 1 < end; p += 2) {
+                s0 -= l_column_values[std::size_t(p)] * y[std::size_t(l_column_rows[std::size_t(p)])];
+                s1 -= l_column_values[std::size_t(p) + 1] * y[std::size_t(l_column_rows[std::size_t(p) + 1])];
             }
-            y[3 * j] = y0;
-            y[3 * j + 1] = y1;
-            y[3 * j + 2] = y2;
+            if (p < end)
+                s0 -= l_column_values[std::size_t(p)] * y[std::size_t(l_column_rows[std::size_t(p)])];
+            y[j] = s0 + s1;
         }
-        Eigen::MatrixX3d x(Eigen::Index(n), 3);
-        for (std::size_t i = 0; i < n; ++i)
-            for (std::size_t c = 0; c < 3; ++c)
-                x(Eigen::Index(i), Eigen::Index(c)) = y[3 * std::size_t(permutation[i]) + c];
-        return x;
     }
 
     // Rotation fit (rows only): 1-ring edges and incident triangles in local numbering, the
@@ -239,19 +247,24 @@ struct PinchEditor::Impl {
     std::vector<std::array<int, 3>> fan_triangles;   ///< incident triangles, local
     std::vector<Eigen::Vector3d> rest_normals;       ///< per row: unit normal × mean edge length
 
-    /// Free positions (nf by 3) for a handle target.
-    Eigen::MatrixX3d solve(const Eigen::Vector3d& target) const
+    /// Free positions for a handle target, in the factor's order.
+    std::vector<Point4> solve(const Eigen::Vector3d& target) const
     {
-        const Eigen::MatrixX3d base = fixed_part + handle_column * target.transpose();
-        Eigen::MatrixX3d x = substitute(a_free_t * (delta - base));
+        const Point4 t(target.x(), target.y(), target.z(), 0.0);
+        std::vector<Point4> x(nf);
+        for (std::size_t i = 0; i < nf; ++i)
+            x[i] = first_base[i] - first_slope[i] * t;
         if (!options.rotation_invariant || options.rotation_iterations == 0)
             return x;
+        std::vector<Point4> known(nf);
+        for (std::size_t i = 0; i < nf; ++i)
+            known[i] = -known_rhs[i] - handle_rhs[i] * t;
         std::vector<Eigen::Vector3d> current(rest_points);
         current[nf] = target;
-        Eigen::MatrixX3d rotated(Eigen::Index(rows), 3);
         for (int it = 0; it < options.rotation_iterations; ++it) {
             for (std::size_t l = 0; l < nf; ++l)
-                current[l] = x.row(Eigen::Index(l)).transpose();
+                current[l] = x[std::size_t(factor_index[l])].head<3>().matrix();
+            x = known;
             for (std::size_t r = 0; r < rows; ++r) {
                 // a = Σⱼ e′ⱼ eⱼᵀ + n′ nᵀ: the 1-ring edges and the normal, before and after.
                 Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
@@ -260,16 +273,19 @@ struct PinchEditor::Impl {
                                    rest_edges[std::size_t(k)].transpose();
                 Eigen::Vector3d n = Eigen::Vector3d::Zero();
                 for (int k = fan_offsets[r]; k < fan_offsets[r + 1]; ++k) {
-                    const auto& t = fan_triangles[std::size_t(k)];
-                    const Eigen::Vector3d& p0 = current[std::size_t(t[0])];
-                    n += (current[std::size_t(t[1])] - p0).cross(current[std::size_t(t[2])] - p0);
+                    const auto& t3 = fan_triangles[std::size_t(k)];
+                    const Eigen::Vector3d& p0 = current[std::size_t(t3[0])];
+                    n += (current[std::size_t(t3[1])] - p0).cross(current[std::size_t(t3[2])] - p0);
                 }
                 const double length = n.norm();
                 if (length > 0.0)
                     a.noalias() += (rest_normals[r].norm() / length) * n * rest_normals[r].transpose();
-                rotated.row(Eigen::Index(r)) = (fit_rotation(a) * delta.row(Eigen::Index(r)).transpose()).transpose();
+                const Eigen::Vector3d rotated = fit_rotation(a) * delta[r];
+                const Point4 d(rotated.x(), rotated.y(), rotated.z(), 0.0);
+                for (int p = a_offsets[r]; p < a_offsets[r + 1]; ++p)
+                    x[std::size_t(a_columns[std::size_t(p)])] += a_values[std::size_t(p)] * d;
             }
-            x = substitute(a_free_t * (rotated - base));
+            substitute(x);
         }
         return x;
     }
@@ -375,11 +391,12 @@ PinchEditor::PinchEditor(const TriangleMesh& mesh, int handle_vertex, const Pinc
     // Rows of L (Sorkine et al. 2004, Eq. 1 with weights): L(x)ᵢ = xᵢ − Σⱼ wᵢⱼ xⱼ / Σⱼ wᵢⱼ.
     // A vertex whose 1-ring weights add up to nothing (all triangles degenerate) has no row.
     std::vector<Eigen::Triplet<double>> free_entries;
+    std::vector<Eigen::Vector3d> fixed_part(m.rows, Eigen::Vector3d::Zero()); // L_C x_C per row
+    std::vector<double> handle_column(m.rows, 0.0);                           // ∂L/∂x_handle per row
     m.ring_offsets.push_back(0);
     m.fan_offsets.push_back(0);
-    m.fixed_part = Eigen::MatrixX3d::Zero(Eigen::Index(m.rows), 3);
-    m.handle_column = Eigen::VectorXd::Zero(Eigen::Index(m.rows));
-    Eigen::MatrixX3d full_lx = Eigen::MatrixX3d::Zero(Eigen::Index(m.rows), 3);
+    m.a_offsets.push_back(0);
+    m.delta.assign(m.rows, Eigen::Vector3d::Zero());
     for (std::size_t r = 0; r < m.rows; ++r) {
         const auto ri = Eigen::Index(r);
         const auto ring = one_ring(mesh, inc, m.local_to_global[r], options.weights);
@@ -405,31 +422,33 @@ PinchEditor::PinchEditor(const TriangleMesh& mesh, int handle_vertex, const Pinc
         const double mean_length = ring.empty() ? 0.0 : std::sqrt(squared_lengths / double(ring.size()));
         m.rest_normals.push_back(normal.norm() > 0.0 ? Eigen::Vector3d(normal.normalized() * mean_length)
                                                      : Eigen::Vector3d::Zero());
-        if (!(total > 0.0) || !std::isfinite(total))
-            continue;
-        auto add = [&](std::size_t col, double coef) {
-            full_lx.row(ri) += coef * m.rest_points[col].transpose();
-            if (col < m.nf)
-                free_entries.emplace_back(ri, Eigen::Index(col), coef);
-            else if (col == m.nf)
-                m.handle_column(ri) += coef;
-            else
-                m.fixed_part.row(ri) += coef * m.rest_points[col].transpose();
-        };
-        add(r, 1.0);
-        for (const auto& [j, w] : ring)
-            add(std::size_t(local[std::size_t(j)]), -w / total);
+        if (total > 0.0 && std::isfinite(total)) {
+            auto add = [&](std::size_t col, double coef) {
+                m.delta[r] += coef * m.rest_points[col];
+                if (col < m.nf) {
+                    free_entries.emplace_back(ri, Eigen::Index(col), coef);
+                    m.a_columns.push_back(int(col)); // local for now; factor order below
+                    m.a_values.push_back(coef);
+                } else if (col == m.nf) {
+                    handle_column[r] += coef;
+                } else {
+                    fixed_part[r] += coef * m.rest_points[col];
+                }
+            };
+            add(r, 1.0);
+            for (const auto& [j, w] : ring)
+                add(std::size_t(local[std::size_t(j)]), -w / total);
+        }
+        m.a_offsets.push_back(int(m.a_columns.size()));
     }
-    m.delta = full_lx;
     Impl::SparseMatrix a_free(Eigen::Index(m.rows), Eigen::Index(m.nf));
     a_free.setFromTriplets(free_entries.begin(), free_entries.end());
-    m.a_free_t = a_free.transpose();
-    const Impl::SparseMatrix normal = (m.a_free_t * a_free).pruned();
-    m.ldlt.compute(normal);
-    if (m.ldlt.info() != Eigen::Success)
+    const Impl::SparseMatrix normal = (Impl::SparseMatrix(a_free.transpose()) * a_free).pruned();
+    const Eigen::SimplicialLDLT<Impl::SparseMatrix> ldlt(normal);
+    if (ldlt.info() != Eigen::Success)
         throw SolverError("pinch edit: the Laplacian system of the ROI around vertex " + std::to_string(handle_vertex) +
                           " is singular (degenerate triangles?)");
-    const Eigen::VectorXd d = m.ldlt.vectorD();
+    const Eigen::VectorXd d = ldlt.vectorD();
     const double largest = d.cwiseAbs().maxCoeff();
     if (!(d.minCoeff() > 1e-13 * largest))
         throw SolverError("pinch edit: the Laplacian system of the ROI around vertex " + std::to_string(handle_vertex) +
@@ -437,18 +456,62 @@ PinchEditor::PinchEditor(const TriangleMesh& mesh, int handle_vertex, const Pinc
     m.inverse_d.resize(m.nf);
     for (std::size_t i = 0; i < m.nf; ++i)
         m.inverse_d[i] = 1.0 / d(Eigen::Index(i));
-    const Impl::SparseMatrix& l = m.ldlt.matrixL().nestedExpression();
+    const auto& p = ldlt.permutationP().indices();
+    m.factor_index.assign(p.data(), p.data() + p.size());
+
+    // L below the diagonal by columns (as Eigen stores it), then by rows (a counting sort).
+    const Impl::SparseMatrix& l = ldlt.matrixL().nestedExpression();
+    std::vector<int> per_row(m.nf + 1, 0);
     for (Eigen::Index j = 0; j < l.outerSize(); ++j) {
-        m.l_outer.push_back(int(m.l_inner.size()));
+        m.l_column_offsets.push_back(int(m.l_column_rows.size()));
         for (Impl::SparseMatrix::InnerIterator it(l, j); it; ++it)
             if (it.row() > j) {
-                m.l_inner.push_back(int(it.row()));
-                m.l_values.push_back(it.value());
+                m.l_column_rows.push_back(int(it.row()));
+                m.l_column_values.push_back(it.value());
+                ++per_row[std::size_t(it.row()) + 1];
             }
     }
-    m.l_outer.push_back(int(m.l_inner.size()));
-    const auto& p = m.ldlt.permutationP().indices();
-    m.permutation.assign(p.data(), p.data() + p.size());
+    m.l_column_offsets.push_back(int(m.l_column_rows.size()));
+    for (std::size_t i = 1; i <= m.nf; ++i)
+        per_row[i] += per_row[i - 1];
+    m.l_row_offsets = per_row;
+    m.l_row_columns.resize(m.l_column_rows.size());
+    m.l_row_values.resize(m.l_column_rows.size());
+    for (std::size_t j = 0; j < m.nf; ++j)
+        for (int q = m.l_column_offsets[j]; q < m.l_column_offsets[j + 1]; ++q) {
+            const auto slot = std::size_t(per_row[std::size_t(m.l_column_rows[std::size_t(q)])]++);
+            m.l_row_columns[slot] = int(j);
+            m.l_row_values[slot] = m.l_column_values[std::size_t(q)];
+        }
+
+    // A's columns in factor order, the known parts of the right-hand side, and the first
+    // (unrotated) solve as base and slope.
+    for (int& c : m.a_columns)
+        c = m.factor_index[std::size_t(c)];
+    m.known_rhs.assign(m.nf, Impl::Point4::Zero());
+    m.handle_rhs.assign(m.nf, 0.0);
+    std::vector<Impl::Point4> slope(m.nf, Impl::Point4::Zero());
+    m.first_base.assign(m.nf, Impl::Point4::Zero());
+    for (std::size_t r = 0; r < m.rows; ++r) {
+        const Impl::Point4 known(fixed_part[r].x(), fixed_part[r].y(), fixed_part[r].z(), 0.0);
+        const Impl::Point4 dr(m.delta[r].x(), m.delta[r].y(), m.delta[r].z(), 0.0);
+        for (int q = m.a_offsets[r]; q < m.a_offsets[r + 1]; ++q) {
+            const auto c = std::size_t(m.a_columns[std::size_t(q)]);
+            const double v = m.a_values[std::size_t(q)];
+            m.known_rhs[c] += v * known;
+            m.handle_rhs[c] += v * handle_column[r];
+            m.first_base[c] += v * dr;
+        }
+    }
+    for (std::size_t i = 0; i < m.nf; ++i) {
+        m.first_base[i] -= m.known_rhs[i];
+        slope[i] = Impl::Point4::Constant(m.handle_rhs[i]);
+    }
+    m.substitute(m.first_base);
+    m.substitute(slope);
+    m.first_slope.resize(m.nf);
+    for (std::size_t i = 0; i < m.nf; ++i)
+        m.first_slope[i] = slope[i](0);
 }
 
 PinchEditor::~PinchEditor() = default;
@@ -467,12 +530,13 @@ void PinchEditor::drag_to(const glm::vec3& handle_position, TriangleMesh& mesh) 
     if (mesh.vertex_count() != m.vertex_count)
         fail("the mesh has " + std::to_string(mesh.vertex_count()) + " vertices, the pinch started on " +
              std::to_string(m.vertex_count));
-    const Eigen::MatrixX3d x = m.solve(to_eigen(handle_position));
-    if (!x.allFinite())
-        throw SolverError("pinch edit: the solve gave non-finite positions");
+    const std::vector<Impl::Point4> x = m.solve(to_eigen(handle_position));
+    for (const Impl::Point4& p : x)
+        if (!p.isFinite().all())
+            throw SolverError("pinch edit: the solve gave non-finite positions");
     for (std::size_t l = 0; l < m.nf; ++l) {
-        const auto r = x.row(Eigen::Index(l));
-        mesh.positions[std::size_t(m.local_to_global[l])] = glm::vec3(float(r(0)), float(r(1)), float(r(2)));
+        const Impl::Point4& p = x[std::size_t(m.factor_index[l])];
+        mesh.positions[std::size_t(m.local_to_global[l])] = glm::vec3(float(p(0)), float(p(1)), float(p(2)));
     }
     mesh.positions[std::size_t(m.handle)] = handle_position;
 }
