@@ -22,9 +22,12 @@ struct RemeshOptions {
     /// collapsed, flipped nor moved. Otherwise they are ignored (and dropped in the output).
     bool protect_feature_edges = true;
     /// With protect_feature_edges: let remeshing also split and collapse feature edges along
-    /// their polyline (CGAL's protect_constraints(false)): they are never flipped, their
-    /// vertices never leave the polyline, and short pieces merge into target-length edges, so
-    /// densely sampled strokes do not force slivers. Whole-mesh remeshing only (`faces` empty).
+    /// their polyline (CGAL's protect_constraints(false)), so short pieces merge into
+    /// target-length edges and densely sampled strokes do not force slivers, and let their
+    /// vertices slide along it (CGAL's relax_constraints, each vertex put back onto the input
+    /// polyline after every round), so triangles along strokes get their shape too. Feature
+    /// edges are never flipped, and their vertices end on the input polylines. Whole-mesh
+    /// remeshing only (`faces` empty).
     bool relax_feature_edges = false;
     /// Triangle indices to remesh (incremental remeshing of a changed region); empty: all.
     /// The region's border edges are constrained too (split first when longer than the

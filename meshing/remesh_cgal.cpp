@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #pragma GCC diagnostic push
@@ -21,6 +22,9 @@
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 #include <CGAL/boost/graph/graph_traits_TriMesh_ArrayKernelT.h>
 #include <CGAL/boost/graph/properties_TriMesh_ArrayKernelT.h>
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/AABB_triangle_primitive.h>
 #include <CGAL/Polygon_mesh_processing/remesh.h>
 #pragma GCC diagnostic pop
 
@@ -96,6 +100,124 @@ void split_edge(OMesh& om, OMesh::EdgeHandle e, double t, OpenMesh::EPropHandleT
         for (OMesh::FaceVertexIter fv = om.fv_iter(f); fv.is_valid(); ++fv)
             if (*fv == opp[0]) has_opp0 = true;
         om.property(in_region, f) = has_opp0 ? flag[0] : flag[1];
+    }
+}
+
+/// The constrained edges of `om` (the input's strokes, split to at most 1.25 × target) in a
+/// uniform grid of cells of about the target length, so that a stroke vertex that CGAL's 1-D
+/// relaxation slid along (and so a little off) its stroke can be put back onto it.
+class FeatureSegments {
+public:
+    FeatureSegments(const OMesh& om, OpenMesh::EPropHandleT<bool> constrained, double cell) : cell_(cell)
+    {
+        for (auto e : om.edges()) {
+            if (!om.property(constrained, e)) continue;
+            const OMesh::HalfedgeHandle h = om.halfedge_handle(e, 0);
+            const glm::dvec3 a = to_glm(om.point(om.from_vertex_handle(h))), b = to_glm(om.point(om.to_vertex_handle(h)));
+            const int id = static_cast<int>(segments_.size());
+            segments_.push_back({a, b});
+            const auto lo = cell_of(glm::min(a, b)), hi = cell_of(glm::max(a, b));
+            for (long long x = lo[0]; x <= hi[0]; ++x)
+                for (long long y = lo[1]; y <= hi[1]; ++y)
+                    for (long long z = lo[2]; z <= hi[2]; ++z) grid_[key({x, y, z})].push_back(id);
+        }
+    }
+
+    /// The nearest point of a segment that passes within `radius` of x (in the cells that the
+    /// box of that radius around x overlaps); x itself when there is none.
+    glm::dvec3 nearest(const glm::dvec3& x, double radius) const
+    {
+        const auto lo = cell_of(x - radius), hi = cell_of(x + radius);
+        glm::dvec3 best = x;
+        double best_d2 = std::numeric_limits<double>::infinity();
+        for (long long cx = lo[0]; cx <= hi[0]; ++cx)
+            for (long long cy = lo[1]; cy <= hi[1]; ++cy)
+                for (long long cz = lo[2]; cz <= hi[2]; ++cz) {
+                    const auto it = grid_.find(key({cx, cy, cz}));
+                    if (it == grid_.end()) continue;
+                    for (int id : it->second) {
+                        const auto& [a, b] = segments_[static_cast<std::size_t>(id)];
+                        const glm::dvec3 ab = b - a;
+                        const double l2 = glm::dot(ab, ab);
+                        const double t = l2 > 0.0 ? std::clamp(glm::dot(x - a, ab) / l2, 0.0, 1.0) : 0.0;
+                        const glm::dvec3 q = a + t * ab;
+                        const double d2 = glm::dot(q - x, q - x);
+                        if (d2 < best_d2) {
+                            best_d2 = d2;
+                            best = q;
+                        }
+                    }
+                }
+        return best;
+    }
+
+    static glm::dvec3 to_glm(const OMesh::Point& p) { return {p[0], p[1], p[2]}; }
+
+private:
+    std::array<long long, 3> cell_of(const glm::dvec3& p) const
+    {
+        return {static_cast<long long>(std::floor(p.x / cell_)), static_cast<long long>(std::floor(p.y / cell_)),
+                static_cast<long long>(std::floor(p.z / cell_))};
+    }
+    // Distinct cells may share a key: that only adds candidates, the distances decide.
+    static long long key(const std::array<long long, 3>& c) { return (c[0] * 73856093LL) ^ (c[1] * 19349663LL) ^ (c[2] * 83492791LL); }
+
+    double cell_;
+    std::vector<std::pair<glm::dvec3, glm::dvec3>> segments_;
+    std::unordered_map<long long, std::vector<int>> grid_;
+};
+
+/// Remeshing with relaxed feature edges (RemeshOptions::relax_feature_edges) on the whole
+/// mesh: CGAL's rounds one at a time, with the stroke vertices relaxed along their strokes
+/// (relax_constraints) and put back onto the input strokes after every round, and every other
+/// vertex projected onto the input surface. CGAL's own 1-D relaxation moves a stroke vertex
+/// towards the midpoint of its two stroke neighbours, which on a bend is off the stroke, and
+/// it never projects stroke vertices back; without the relaxation stroke vertices stay where
+/// splits left them, and the triangles along strokes (above all where strokes run one target
+/// length apart) stay poorly shaped.
+void remesh_relaxing_features(OMesh& om, const TriangleMesh& input, double target, unsigned iterations,
+                              OpenMesh::EPropHandleT<bool> constrained)
+{
+    using K = CGAL::Epick;
+    std::vector<K::Triangle_3> triangles;
+    triangles.reserve(input.triangles.size());
+    auto point = [&](int i) {
+        const glm::vec3& p = input.positions[static_cast<std::size_t>(i)];
+        return K::Point_3(p.x, p.y, p.z);
+    };
+    for (const auto& t : input.triangles) triangles.emplace_back(point(t[0]), point(t[1]), point(t[2]));
+    using Primitive = CGAL::AABB_triangle_primitive<K, std::vector<K::Triangle_3>::const_iterator>;
+    CGAL::AABB_tree<CGAL::AABB_traits<K, Primitive>> surface(triangles.cbegin(), triangles.cend());
+    surface.accelerate_distance_queries();
+    const FeatureSegments strokes(om, constrained, target);
+    auto project = [&](OMesh::VertexHandle v) {
+        const OMesh::Point& p = om.point(v);
+        return surface.closest_point(K::Point_3(p[0], p[1], p[2]));
+    };
+    ConstrainedEdgeMap ecm{&om, constrained};
+    std::vector<int> stroke_edges;
+    for (unsigned round = 0; round < iterations; ++round) {
+        PMP::isotropic_remeshing(faces(om), target, om,
+                                 CGAL::parameters::number_of_iterations(1)
+                                     .edge_is_constrained_map(ecm)
+                                     .protect_constraints(false)
+                                     .relax_constraints(true)
+                                     .projection_functor(project));
+        om.garbage_collection();
+        // CGAL's relaxation moves the stroke vertices with exactly two stroke edges only, each
+        // by less than half a target length (towards the midpoint of its stroke neighbours).
+        stroke_edges.assign(om.n_vertices(), 0);
+        for (auto e : om.edges())
+            if (om.property(constrained, e)) {
+                const OMesh::HalfedgeHandle h = om.halfedge_handle(e, 0);
+                ++stroke_edges[static_cast<std::size_t>(om.from_vertex_handle(h).idx())];
+                ++stroke_edges[static_cast<std::size_t>(om.to_vertex_handle(h).idx())];
+            }
+        for (auto v : om.vertices()) {
+            if (stroke_edges[static_cast<std::size_t>(v.idx())] != 2) continue;
+            const glm::dvec3 q = strokes.nearest(FeatureSegments::to_glm(om.point(v)), 0.5 * target);
+            om.point(v) = OMesh::Point(q.x, q.y, q.z);
+        }
     }
 }
 
@@ -202,12 +324,16 @@ TriangleMesh remesh_isotropic(const TriangleMesh& mesh, const RemeshOptions& opt
     for (auto f : om.faces())
         if (om.property(in_region, f)) region.push_back(f);
 
-    ConstrainedEdgeMap ecm{&om, constrained};
-    PMP::isotropic_remeshing(region, target, om,
-                             CGAL::parameters::number_of_iterations(options.iterations)
-                                 .edge_is_constrained_map(ecm)
-                                 .protect_constraints(!(options.relax_feature_edges && whole)));
-    om.garbage_collection();
+    if (options.protect_feature_edges && options.relax_feature_edges && whole) {
+        remesh_relaxing_features(om, mesh, target, options.iterations, constrained);
+    } else {
+        ConstrainedEdgeMap ecm{&om, constrained};
+        PMP::isotropic_remeshing(region, target, om,
+                                 CGAL::parameters::number_of_iterations(options.iterations)
+                                     .edge_is_constrained_map(ecm)
+                                     .protect_constraints(!(options.relax_feature_edges && whole)));
+        om.garbage_collection();
+    }
 
     TriangleMesh out;
     out.positions.reserve(om.n_vertices());
