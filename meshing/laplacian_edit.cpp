@@ -205,37 +205,33 @@ struct PinchEditor::Impl {
     std::vector<double> l_column_values;
     std::vector<double> inverse_d;
 
-    /// y ← (LDLᵀ)⁻¹ y in the factor's order, for x, y and z together.
+    /// y[i] − Σ values[p] · y[indices[p]] over row or column i of a compressed L (p from
+    /// offsets[i] to offsets[i + 1] − 1). Two running sums halve the dependency chain.
+    static Point4 reduce(const std::vector<Point4>& y, std::size_t i, const std::vector<int>& offsets,
+                         const std::vector<int>& indices, const std::vector<double>& values)
+    {
+        Point4 s0 = y[i], s1 = Point4::Zero();
+        auto p = static_cast<std::size_t>(offsets[i]);
+        const auto end = static_cast<std::size_t>(offsets[i + 1]);
+        for (; p + 1 < end; p += 2) {
+            s0 -= values[p] * y[static_cast<std::size_t>(indices[p])];
+            s1 -= values[p + 1] * y[static_cast<std::size_t>(indices[p + 1])];
+        }
+        if (p < end)
+            s0 -= values[p] * y[static_cast<std::size_t>(indices[p])];
+        return s0 + s1;
+    }
+
+    /// y ← (LDLᵀ)⁻¹ y in the factor's order, for x, y and z together: forward substitution
+    /// with L by rows, D⁻¹, backward substitution with Lᵀ (L by columns).
     void substitute(std::vector<Point4>& y) const
     {
-        // Two running sums per point halve the dependency chain of the additions.
-        const std::size_t n = nf;
-        for (std::size_t i = 0; i < n; ++i) {
-            Point4 s0 = y[i], s1 = Point4::Zero();
-            int p = l_row_offsets[i];
-            const int end = l_row_offsets[i + 1];
-            for (; p + 1 < end; p += 2) {
-                s0 -= l_row_values[std::size_t(p)] * y[std::size_t(l_row_columns[std::size_t(p)])];
-                s1 -= l_row_values[std::size_t(p) + 1] * y[std::size_t(l_row_columns[std::size_t(p) + 1])];
-            }
-            if (p < end)
-                s0 -= l_row_values[std::size_t(p)] * y[std::size_t(l_row_columns[std::size_t(p)])];
-            y[i] = s0 + s1;
-        }
-        for (std::size_t i = 0; i < n; ++i)
+        for (std::size_t i = 0; i < nf; ++i)
+            y[i] = reduce(y, i, l_row_offsets, l_row_columns, l_row_values);
+        for (std::size_t i = 0; i < nf; ++i)
             y[i] *= inverse_d[i];
-        for (std::size_t j = n; j-- > 0;) {
-            Point4 s0 = y[j], s1 = Point4::Zero();
-            int p = l_column_offsets[j];
-            const int end = l_column_offsets[j + 1];
-            for (; p + 1 < end; p += 2) {
-                s0 -= l_column_values[std::size_t(p)] * y[std::size_t(l_column_rows[std::size_t(p)])];
-                s1 -= l_column_values[std::size_t(p) + 1] * y[std::size_t(l_column_rows[std::size_t(p) + 1])];
-            }
-            if (p < end)
-                s0 -= l_column_values[std::size_t(p)] * y[std::size_t(l_column_rows[std::size_t(p)])];
-            y[j] = s0 + s1;
-        }
+        for (std::size_t j = nf; j-- > 0;)
+            y[j] = reduce(y, j, l_column_offsets, l_column_rows, l_column_values);
     }
 
     // Rotation fit (rows only): 1-ring edges and incident triangles in local numbering, the
