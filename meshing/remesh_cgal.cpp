@@ -205,7 +205,8 @@ void remesh_relaxing_features(OMesh& om, const TriangleMesh& input, double targe
                                      .projection_functor(project));
         om.garbage_collection();
         // CGAL's relaxation moves the stroke vertices with exactly two stroke edges only, each
-        // by less than half a target length (towards the midpoint of its stroke neighbours).
+        // towards the midpoint of its stroke neighbours: off its stroke by the bend of the
+        // stroke there, millimetres, well within the half target length searched.
         stroke_edges.assign(om.n_vertices(), 0);
         for (auto e : om.edges())
             if (om.property(constrained, e)) {
