@@ -230,12 +230,34 @@ def desktop_script_seeds():
         "40 line 100 100 300 120 12 right\n60 circle 200 200 30 8 none\n80 quit\n")
 
 
+def scenario_seeds():
+    for p in sorted((ROOT / "recordings").glob("*.scenario.json")):
+        if p.stat().st_size <= 8192:
+            put("scenario", p.name, p.read_bytes())
+    # Short enough (under 30 s of hand motion) for the target to synthesize it, and touching
+    # every step type, a surface with a dent, a section stroke and a drag.
+    put("scenario", "short-every-step.json", json.dumps({
+        "format": "lobesketch-scenario", "version": 1, "name": "short", "seed": 3, "rate_hz": 60,
+        "surfaces": [{"center": [0, 1.3, -0.4], "radii": [0.12, 0.1, 0.11], "axes": [[1, 0, 0], [0, 1, 0]],
+                      "dents": [{"direction": [-1, 0, 0], "depth_mm": 20, "width_deg": 40}]}],
+        "steps": [
+            {"type": "stroke", "kind": "lobe", "hand": "right",
+             "section": {"surface": 0, "normal": [0, 1, 0], "start_angle_deg": 10, "sweep_deg": 120, "wobble_mm": 2}},
+            {"type": "near_pinch", "hand": "left", "at": [0.1, 1.2, -0.3], "duration": 0.6},
+            {"type": "grab", "hand": "right", "at": [0, 1.2, -0.3], "duration": 0.6},
+            {"type": "key", "key": "D"},
+            {"type": "drag", "hand": "right", "from": [0.12, 1.3, -0.4], "to": [0.16, 1.3, -0.4]},
+            {"type": "pause", "duration": 0.3},
+            {"type": "stroke", "kind": "trunk", "hand": "left", "curve": [[0, 0, -0.4], [0, 0.5, -0.4], [0.02, 1.0, -0.4]]}]},
+        indent=1))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--lobesketch", help="a built lobesketch, to remake the text-recording and session seeds")
     a = ap.parse_args()
     for t in ["import_leap", "import_webxr", "recording_binary", "mesh_obj", "mesh_ply", "mesh_off", "species",
-              "desktop_script"]:
+              "desktop_script", "scenario"]:
         shutil.rmtree(OUT / t, ignore_errors=True)
     leap_seeds()
     webxr_seeds()
@@ -243,6 +265,7 @@ def main():
     mesh_seeds()
     species_seeds()
     desktop_script_seeds()
+    scenario_seeds()
     text_recording_seeds(a.lobesketch)
     session_seeds(a.lobesketch)
     for d in sorted(OUT.iterdir()):

@@ -19,6 +19,7 @@
 #include "growth/species.h"
 #include "input/importers.h"
 #include "input/recording.h"
+#include "input/synth.h"
 #include "meshing/mesh_io.h"
 #include "tests/test_paths.h"
 
@@ -42,6 +43,7 @@ const std::map<std::string, std::function<void(const std::string&)>>& readers()
         {"mesh_ply", [](const std::string& p) { read_mesh(p); }},
         {"mesh_off", [](const std::string& p) { read_mesh(p); }},
         {"desktop_script", [](const std::string& p) { parse_desktop_script(read_file_limited(p, 16u << 20), p); }},
+        {"scenario", [](const std::string& p) { load_scenario(p); }},
     };
     return r;
 }
