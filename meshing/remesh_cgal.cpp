@@ -321,13 +321,12 @@ TriangleMesh remesh_isotropic(const TriangleMesh& mesh, const RemeshOptions& opt
         for (OMesh::EdgeHandle e : long_edges) split_edge(om, e, 0.5, constrained, in_region);
     }
 
-    std::vector<OMesh::FaceHandle> region;
-    for (auto f : om.faces())
-        if (om.property(in_region, f)) region.push_back(f);
-
     if (options.protect_feature_edges && options.relax_feature_edges && whole) {
         remesh_relaxing_features(om, mesh, target, options.iterations, constrained);
     } else {
+        std::vector<OMesh::FaceHandle> region;
+        for (auto f : om.faces())
+            if (om.property(in_region, f)) region.push_back(f);
         ConstrainedEdgeMap ecm{&om, constrained};
         PMP::isotropic_remeshing(region, target, om,
                                  CGAL::parameters::number_of_iterations(options.iterations)
