@@ -22,6 +22,7 @@
 #pragma GCC diagnostic pop
 
 #include "core/errors.h"
+#include "meshing/best_rotation.h"
 
 namespace lobe {
 
@@ -110,29 +111,6 @@ std::vector<std::pair<int, double>> one_ring(const TriangleMesh& mesh, const Inc
         for (auto& e : merged)
             e.second = 1.0;
     return merged;
-}
-
-/// The rotation R maximising tr(Rᵀa), i.e. minimising Σⱼ ‖e′ⱼ − R eⱼ‖² for a = Σⱼ e′ⱼ eⱼᵀ:
-/// the polar factor a (aᵀa)^(−1/2), from the closed-form eigen decomposition of aᵀa. Falls
-/// back to the SVD (a = UΣVᵀ, R = UVᵀ with the reflection removed) when a is near singular
-/// or a reflection.
-Eigen::Matrix3d fit_rotation(const Eigen::Matrix3d& a)
-{
-    if (a.determinant() > 0.0) {
-        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
-        eig.computeDirect(a.transpose() * a);
-        const Eigen::Vector3d lambda = eig.eigenvalues(); // ascending
-        if (lambda(0) > 1e-6 * lambda(2)) {
-            const Eigen::Matrix3d& v = eig.eigenvectors();
-            return a * (v * lambda.cwiseSqrt().cwiseInverse().asDiagonal() * v.transpose());
-        }
-    }
-    Eigen::JacobiSVD<Eigen::Matrix3d> svd(a, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    Eigen::Matrix3d u = svd.matrixU();
-    const Eigen::Matrix3d& v = svd.matrixV();
-    if ((u * v.transpose()).determinant() < 0.0)
-        u.col(2) = -u.col(2); // singular values are sorted: flip the least certain axis
-    return u * v.transpose();
 }
 
 } // namespace
@@ -276,7 +254,7 @@ struct PinchEditor::Impl {
                 const double length = n.norm();
                 if (length > 0.0)
                     a.noalias() += (rest_normals[r].norm() / length) * n * rest_normals[r].transpose();
-                const Eigen::Vector3d rotated = fit_rotation(a) * delta[r];
+                const Eigen::Vector3d rotated = best_rotation(a) * delta[r];
                 const Point4 d(rotated.x(), rotated.y(), rotated.z(), 0.0);
                 for (int p = a_offsets[r]; p < a_offsets[r + 1]; ++p)
                     x[std::size_t(a_columns[std::size_t(p)])] += a_values[std::size_t(p)] * d;
