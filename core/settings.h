@@ -52,10 +52,10 @@ struct LobeSettings {
     /// Attractor spacing: one absolute target edge length for every lobe, so small and
     /// large lobes carry the same attractor density.
     double edge_length_m = 0.03;
-    /// Rounds of isotropic remeshing. With the stroke vertices relaxed along their strokes,
-    /// the shipped recordings' triangle quality after 4 rounds is that after 5 or 6, and 3
-    /// leave an angle under 15° (docs/lobes.md, "Measured").
-    int remesh_iterations = 4;
+    /// Rounds of isotropic remeshing. With the stroke vertices relaxed along their strokes
+    /// and the small-angle repairs after the last round, 3 rounds give the shipped
+    /// recordings' lobes the triangle quality of 4 or 5 (docs/lobes.md, "Measured").
+    int remesh_iterations = 3;
     /// A stroke is closed when the gap between its ends is below this fraction of its length
     /// (and below closed_gap_max_m).
     double closed_gap_fraction = 0.15;

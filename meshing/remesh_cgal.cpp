@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -38,6 +39,8 @@ namespace lobe {
 namespace {
 
 namespace PMP = CGAL::Polygon_mesh_processing;
+
+constexpr double kDegree = 3.14159265358979323846 / 180.0;
 
 /// Double-precision points: CGAL's adapter converts them to Epick points without loss.
 struct OmTraits : public OpenMesh::DefaultTraits {
@@ -167,6 +170,151 @@ private:
     std::unordered_map<long long, std::vector<int>> grid_;
 };
 
+/// The smallest angle of the triangle (a, b, c), radians.
+double smallest_angle(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c)
+{
+    auto angle = [](const glm::dvec3& p, const glm::dvec3& q, const glm::dvec3& r) {
+        const glm::dvec3 u = q - p, w = r - p;
+        return std::atan2(glm::length(glm::cross(u, w)), glm::dot(u, w));
+    };
+    return std::min({angle(a, b, c), angle(b, c, a), angle(c, a, b)});
+}
+
+/// Local repairs of the angles CGAL's rounds leave under 30°, in a closed mesh whose
+/// constrained edges are strokes. CGAL only collapses an edge shorter than 4/5 of the target
+/// when no edge longer than 4/3 of it results, and it flips for valence, not for angles. So a
+/// cell of the stroke network about one target across (stacked loops one target apart,
+/// crossed by other loops) keeps a free vertex a centimetre from one of its corners, with
+/// two thin triangles beside it, and long diagonals stay where the other one is better.
+/// Two passes, each taken only where it raises the smallest angle of the triangles it
+/// changes by at least a degree:
+/// - a free vertex with a triangle under 30° collapses into the neighbour that gives its fan
+///   the best smallest angle (edges up to 1.6 × target; every new triangle within 30° of the
+///   one it replaces, so nothing folds);
+/// - a free edge is flipped where its two triangles are within 20° of coplanar.
+/// Stroke vertices never move and stroke edges stay; a removed vertex lay on the input
+/// surface, and the triangles that replace it span at most 1.6 × target.
+void improve_small_angles(OMesh& om, OpenMesh::EPropHandleT<bool> constrained, double target)
+{
+    const double poor = 30.0 * kDegree, gain = 1.0 * kDegree, longest2 = 1.6 * 1.6 * target * target;
+    const double fold_cos = std::cos(30.0 * kDegree), flat_cos = std::cos(20.0 * kDegree);
+    auto at = [&](OMesh::VertexHandle v) { return FeatureSegments::to_glm(om.point(v)); };
+    auto unit_normal = [](const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
+        const glm::dvec3 n = glm::cross(b - a, c - a);
+        const double l = glm::length(n);
+        return l > 0.0 ? n / l : glm::dvec3(0.0);
+    };
+    auto on_stroke = [&](OMesh::VertexHandle v) {
+        for (OMesh::VertexOHalfedgeIter h = om.voh_iter(v); h.is_valid(); ++h)
+            if (om.property(constrained, om.edge_handle(*h))) return true;
+        return false;
+    };
+    auto face_points = [&](OMesh::FaceHandle f) {
+        std::array<OMesh::VertexHandle, 3> t;
+        int k = 0;
+        for (OMesh::FaceVertexIter fv = om.fv_iter(f); fv.is_valid() && k < 3; ++fv) t[static_cast<std::size_t>(k++)] = *fv;
+        return t;
+    };
+    // Which faces have an angle under 30° (by cosines: no trigonometry for the many good ones).
+    const double poor_cos = std::cos(poor);
+    std::vector<char> poor_face;
+    auto mark_poor_faces = [&] {
+        poor_face.assign(om.n_faces(), 0);
+        for (auto f : om.faces()) {
+            const auto t = face_points(f);
+            const glm::dvec3 p[3] = {at(t[0]), at(t[1]), at(t[2])};
+            for (int k = 0; k < 3; ++k) {
+                const glm::dvec3 u = p[(k + 1) % 3] - p[k], w = p[(k + 2) % 3] - p[k];
+                if (glm::dot(u, w) > poor_cos * glm::length(u) * glm::length(w))
+                    poor_face[static_cast<std::size_t>(f.idx())] = 1;
+            }
+        }
+    };
+    auto is_poor = [&](OMesh::FaceHandle f) { return f.is_valid() && poor_face[static_cast<std::size_t>(f.idx())] != 0; };
+    for (int pass = 0; pass < 3; ++pass) {
+        bool changed = false;
+        mark_poor_faces();
+        for (auto v : om.vertices()) {
+            if (om.status(v).deleted() || om.is_boundary(v) || on_stroke(v)) continue;
+            bool any_poor = false;
+            for (OMesh::VertexFaceIter f = om.vf_iter(v); f.is_valid(); ++f) any_poor = any_poor || is_poor(*f);
+            if (!any_poor) continue;
+            double old_min = std::numeric_limits<double>::infinity();
+            for (OMesh::VertexFaceIter f = om.vf_iter(v); f.is_valid(); ++f) {
+                const auto t = face_points(*f);
+                old_min = std::min(old_min, smallest_angle(at(t[0]), at(t[1]), at(t[2])));
+            }
+            if (old_min >= poor) continue;
+            OMesh::HalfedgeHandle best;
+            double best_min = old_min + gain;
+            for (OMesh::VertexOHalfedgeIter h = om.voh_iter(v); h.is_valid(); ++h) {
+                const OMesh::VertexHandle u = om.to_vertex_handle(*h);
+                if (!om.is_collapse_ok(*h)) continue;
+                double new_min = std::numeric_limits<double>::infinity();
+                bool ok = true;
+                for (OMesh::VertexFaceIter f = om.vf_iter(v); ok && f.is_valid(); ++f) {
+                    auto t = face_points(*f);
+                    if (t[0] == u || t[1] == u || t[2] == u) continue;
+                    const glm::dvec3 before = unit_normal(at(t[0]), at(t[1]), at(t[2]));
+                    for (auto& x : t)
+                        if (x == v) x = u;
+                    const glm::dvec3 a = at(t[0]), b = at(t[1]), c = at(t[2]);
+                    const glm::dvec3 u_at = at(u);
+                    ok = glm::dot(unit_normal(a, b, c), before) > fold_cos;
+                    for (const glm::dvec3& w : {a, b, c}) ok = ok && glm::dot(w - u_at, w - u_at) <= longest2;
+                    new_min = std::min(new_min, smallest_angle(a, b, c));
+                }
+                if (ok && new_min > best_min) {
+                    best_min = new_min;
+                    best = *h;
+                }
+            }
+            if (!best.is_valid()) continue;
+            // The two triangles beside the collapsed edge go; of each, the edge (u, w) stays,
+            // and it keeps its stroke flag whichever of the two OpenMesh keeps.
+            const OMesh::VertexHandle u = om.to_vertex_handle(best);
+            std::vector<OMesh::VertexHandle> stroke_ends;
+            for (const OMesh::HalfedgeHandle side : {best, om.opposite_halfedge_handle(best)}) {
+                if (om.is_boundary(side)) continue;
+                const OMesh::HalfedgeHandle next = om.next_halfedge_handle(side);
+                const OMesh::VertexHandle w = om.to_vertex_handle(next);
+                const OMesh::HalfedgeHandle uw = om.find_halfedge(u, w);
+                if (uw.is_valid() && om.property(constrained, om.edge_handle(uw))) stroke_ends.push_back(w);
+            }
+            om.collapse(best);
+            for (const OMesh::VertexHandle w : stroke_ends) {
+                const OMesh::HalfedgeHandle uw = om.find_halfedge(u, w);
+                if (uw.is_valid()) om.property(constrained, om.edge_handle(uw)) = true;
+            }
+            changed = true;
+        }
+        mark_poor_faces();
+        for (auto e : om.edges()) {
+            if (om.status(e).deleted() || om.is_boundary(e) || om.property(constrained, e)) continue;
+            const OMesh::HalfedgeHandle h0 = om.halfedge_handle(e, 0), h1 = om.halfedge_handle(e, 1);
+            if (!is_poor(om.face_handle(h0)) && !is_poor(om.face_handle(h1))) continue;
+            const OMesh::VertexHandle a = om.from_vertex_handle(h0), b = om.to_vertex_handle(h0);
+            const OMesh::VertexHandle c = om.to_vertex_handle(om.next_halfedge_handle(h0));
+            const OMesh::VertexHandle d = om.to_vertex_handle(om.next_halfedge_handle(h1));
+            const glm::dvec3 pa = at(a), pb = at(b), pc = at(c), pd = at(d);
+            const double old_min = std::min(smallest_angle(pa, pb, pc), smallest_angle(pb, pa, pd));
+            if (old_min >= poor) continue;
+            // After the flip: (a, d, c) and (d, b, c).
+            const double new_min = std::min(smallest_angle(pa, pd, pc), smallest_angle(pd, pb, pc));
+            if (!(new_min > old_min + gain) || !om.is_flip_ok(e)) continue;
+            const glm::dvec3 n0 = unit_normal(pa, pb, pc), n1 = unit_normal(pb, pa, pd);
+            const glm::dvec3 mean = glm::normalize(n0 + n1);
+            if (glm::dot(n0, n1) < flat_cos || glm::dot(unit_normal(pa, pd, pc), mean) < flat_cos ||
+                glm::dot(unit_normal(pd, pb, pc), mean) < flat_cos)
+                continue;
+            om.flip(e);
+            changed = true;
+        }
+        if (!changed) break;
+    }
+    om.garbage_collection();
+}
+
 /// Remeshing with relaxed feature edges (RemeshOptions::relax_feature_edges) on the whole
 /// mesh: CGAL's rounds one at a time, with the stroke vertices relaxed along their strokes
 /// (relax_constraints) and put back onto the input strokes after every round, and every other
@@ -220,6 +368,7 @@ void remesh_relaxing_features(OMesh& om, const TriangleMesh& input, double targe
             om.point(v) = OMesh::Point(q.x, q.y, q.z);
         }
     }
+    if (iterations > 0) improve_small_angles(om, constrained, target);
 }
 
 } // namespace

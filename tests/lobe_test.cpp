@@ -191,9 +191,10 @@ TEST(Lobes, EveryShippedRecordingGivesClosedManifoldOutwardLobesThroughEveryStro
             expect_valid_lobe(b.surface.mesh, what + " (before remeshing)");
             expect_valid_lobe(b.mesh, what);
             const MeshQuality q = measure_quality(b.mesh);
-            // Issue goal: ≥ 95 % everywhere. The kidney lobe, whose stacked loops run 3 cm apart
-            // (one target edge) and are crossed by three loops, reaches about 94.4 %.
-            EXPECT_GE(q.share_all_angles_ge_30, 0.93) << what;
+            // Issue goal: ≥ 95 % of triangles with every angle ≥ 30°, in every lobe. The worst
+            // is the kidney lobe, whose stacked loops run 3 cm apart (one target edge) and are
+            // crossed by three loops: about 98.5 %, 94.4 % without the small-angle repairs.
+            EXPECT_GE(q.share_all_angles_ge_30, 0.95) << what;
             share_sum += q.share_all_angles_ge_30;
             ++share_count;
             RecordProperty(what + " angles>=30", std::to_string(q.share_all_angles_ge_30));
@@ -229,7 +230,7 @@ TEST(Lobes, EveryShippedRecordingGivesClosedManifoldOutwardLobesThroughEveryStro
         }
     }
     ASSERT_GT(share_count, 0);
-    EXPECT_GE(share_sum / share_count, 0.95) << "mean share of triangles with all angles ≥ 30°";
+    EXPECT_GE(share_sum / share_count, 0.98) << "mean share of triangles with all angles ≥ 30°";
 }
 
 TEST(Lobes, SurfaceBeforeRemeshingIsMadeOfStrokePointsStripsAndCaps)
