@@ -89,12 +89,12 @@ void expect_valid_lobe(const TriangleMesh& mesh, const std::string& what)
     EXPECT_FALSE(self_intersects(mesh)) << what;
 }
 
-/// Corners under 15° that strokes do not force. Two kinds are forced: a corner between two
+/// Corners under `limit_deg` that strokes do not force. Two kinds are forced: a corner between two
 /// stroke edges (strokes crossing or meeting at a smaller angle), and a corner facing a stroke
 /// edge that runs between two stroke crossings (both ends on three or more stroke edges) and is
 /// shorter than half the 3 cm target: neither end may move, so whatever vertex faces that
 /// edge from a target length away sees it under a small angle.
-std::size_t sharp_corners_off_strokes(const TriangleMesh& mesh)
+std::size_t sharp_corners_off_strokes(const TriangleMesh& mesh, double limit_deg = 15.0)
 {
     std::set<std::pair<int, int>> strokes;
     std::map<int, int> stroke_degree;
@@ -112,7 +112,7 @@ std::size_t sharp_corners_off_strokes(const TriangleMesh& mesh)
             const int v = t[c], a = t[(c + 1) % 3], b = t[(c + 2) % 3];
             const glm::dvec3 u = glm::normalize(at(a) - at(v)), w = glm::normalize(at(b) - at(v));
             const double angle = std::acos(std::clamp(glm::dot(u, w), -1.0, 1.0)) * 180.0 / kPi;
-            if (angle >= 15.0 || (on_stroke(v, a) && on_stroke(v, b))) continue;
+            if (angle >= limit_deg || (on_stroke(v, a) && on_stroke(v, b))) continue;
             if (on_stroke(a, b) && crossing(a) && crossing(b) && glm::distance(at(a), at(b)) < 0.015) continue;
             ++n;
         }
@@ -202,6 +202,9 @@ TEST(Lobes, EveryShippedRecordingGivesClosedManifoldOutwardLobesThroughEveryStro
             // No angle under 15° but between two stroke edges (strokes crossing or meeting at
             // a smaller angle).
             EXPECT_EQ(sharp_corners_off_strokes(b.mesh), 0u) << what << ": min angle " << q.min_angle_deg << "°";
+            // Stricter than the issue: after the small-angle repairs nothing unforced is under
+            // 20° (24.5° at worst, in the kidney lobe).
+            EXPECT_EQ(sharp_corners_off_strokes(b.mesh, 20.0), 0u) << what;
             // Every ground-truth point of the lobe's strokes lies on the lobe (before edits).
             if (std::string(name) == "pinch-edit") continue;
             // Remeshing slides stroke vertices along the strokes; they end on the drawn strokes.
