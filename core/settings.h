@@ -52,10 +52,11 @@ struct LobeSettings {
     /// Attractor spacing: one absolute target edge length for every lobe, so small and
     /// large lobes carry the same attractor density.
     double edge_length_m = 0.03;
-    /// Rounds of isotropic remeshing. With the stroke vertices relaxed along their strokes
-    /// and the small-angle repairs after the last round, 3 rounds give the shipped
-    /// recordings' lobes the triangle quality of 4 or 5 (docs/lobes.md, "Measured").
-    int remesh_iterations = 3;
+    /// Rounds of isotropic remeshing, of lobes from strokes and from models alike. With the
+    /// stroke vertices relaxed along their strokes and the small-angle repairs after the last
+    /// round, 3 rounds would do for stroke lobes, but the trees grown in model lobes (the cow
+    /// above all) change with the rounds (docs/lobes.md, "Measured").
+    int remesh_iterations = 4;
     /// A stroke is closed when the gap between its ends is below this fraction of its length
     /// (and below closed_gap_max_m).
     double closed_gap_fraction = 0.15;

@@ -193,7 +193,7 @@ TEST(Lobes, EveryShippedRecordingGivesClosedManifoldOutwardLobesThroughEveryStro
             const MeshQuality q = measure_quality(b.mesh);
             // Issue goal: ≥ 95 % of triangles with every angle ≥ 30°, in every lobe. The worst
             // is the kidney lobe, whose stacked loops run 3 cm apart (one target edge) and are
-            // crossed by three loops: about 98.5 %, 94.4 % without the small-angle repairs.
+            // crossed by three loops: about 98.3 %, 94.4 % without the small-angle repairs.
             EXPECT_GE(q.share_all_angles_ge_30, 0.95) << what;
             share_sum += q.share_all_angles_ge_30;
             ++share_count;
@@ -203,7 +203,7 @@ TEST(Lobes, EveryShippedRecordingGivesClosedManifoldOutwardLobesThroughEveryStro
             // a smaller angle).
             EXPECT_EQ(sharp_corners_off_strokes(b.mesh), 0u) << what << ": min angle " << q.min_angle_deg << "°";
             // Stricter than the issue: after the small-angle repairs nothing unforced is under
-            // 20° (24.5° at worst, in the kidney lobe).
+            // 20° (the kidney lobe comes closest).
             EXPECT_EQ(sharp_corners_off_strokes(b.mesh, 20.0), 0u) << what;
             // Every ground-truth point of the lobe's strokes lies on the lobe (before edits).
             if (std::string(name) == "pinch-edit") continue;
