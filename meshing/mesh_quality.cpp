@@ -12,6 +12,7 @@
 #include <glm/geometric.hpp>
 
 #include "core/errors.h"
+#include "meshing/triangle_distance.h"
 
 namespace lobe {
 
@@ -53,33 +54,6 @@ int find_root(std::vector<int>& parent, int x)
     return x;
 }
 
-/// Closest distance from p to triangle (a, b, c) (Voronoi-region walk over the triangle's
-/// vertices, edges and face).
-double point_triangle_distance(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c)
-{
-    const glm::dvec3 ab = b - a, ac = c - a, ap = p - a;
-    const double d1 = glm::dot(ab, ap), d2 = glm::dot(ac, ap);
-    if (d1 <= 0 && d2 <= 0) return glm::length(p - a);
-    const glm::dvec3 bp = p - b;
-    const double d3 = glm::dot(ab, bp), d4 = glm::dot(ac, bp);
-    if (d3 >= 0 && d4 <= d3) return glm::length(p - b);
-    const double vc = d1 * d4 - d3 * d2;
-    if (vc <= 0 && d1 >= 0 && d3 <= 0) return glm::length(p - (a + ab * (d1 / (d1 - d3))));
-    const glm::dvec3 cp = p - c;
-    const double d5 = glm::dot(ab, cp), d6 = glm::dot(ac, cp);
-    if (d6 >= 0 && d5 <= d6) return glm::length(p - c);
-    const double vb = d5 * d2 - d1 * d6;
-    if (vb <= 0 && d2 >= 0 && d6 <= 0) return glm::length(p - (a + ac * (d2 / (d2 - d6))));
-    const double va = d3 * d6 - d5 * d4;
-    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
-        return glm::length(p - (b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)))));
-    const double denom = va + vb + vc;
-    if (std::abs(denom) < 1e-300) // degenerate triangle: its edges hold the closest point
-        return std::min({glm::length(p - a), glm::length(p - b), glm::length(p - c)});
-    const double v = vb / denom, w = vc / denom;
-    return glm::length(p - (a + ab * v + ac * w));
-}
-
 } // namespace
 
 void bounding_box(const TriangleMesh& mesh, glm::dvec3& lo, glm::dvec3& hi)
@@ -105,8 +79,10 @@ MeshQuality measure_quality(const TriangleMesh& mesh)
     double volume6 = 0;
     for (const auto& t : mesh.triangles) {
         const glm::dvec3 a = pos(mesh, t[0]), b = pos(mesh, t[1]), c = pos(mesh, t[2]);
-        const double A = corner_angle(a, b, c), B = corner_angle(b, c, a), C = corner_angle(c, a, b);
-        const double lo = std::min({A, B, C}), hi = std::max({A, B, C});
+        // The smallest angle faces the shortest edge, the largest the longest.
+        const double ab = glm::dot(b - a, b - a), bc = glm::dot(c - b, c - b), ca = glm::dot(a - c, a - c);
+        const double lo = bc <= ab && bc <= ca ? corner_angle(a, b, c) : (ca <= ab ? corner_angle(b, c, a) : corner_angle(c, a, b));
+        const double hi = bc >= ab && bc >= ca ? corner_angle(a, b, c) : (ca >= ab ? corner_angle(b, c, a) : corner_angle(c, a, b));
         q.min_angle_deg = std::min(q.min_angle_deg, lo);
         q.max_angle_deg = std::max(q.max_angle_deg, hi);
         if (lo >= 30.0) ++good;

@@ -23,9 +23,6 @@
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 #include <CGAL/boost/graph/graph_traits_TriMesh_ArrayKernelT.h>
 #include <CGAL/boost/graph/properties_TriMesh_ArrayKernelT.h>
-#include <CGAL/AABB_traits.h>
-#include <CGAL/AABB_tree.h>
-#include <CGAL/AABB_triangle_primitive.h>
 #include <CGAL/Polygon_mesh_processing/remesh.h>
 #pragma GCC diagnostic pop
 
@@ -33,6 +30,7 @@
 
 #include "core/errors.h"
 #include "meshing/mesh_quality.h"
+#include "meshing/triangle_distance.h"
 
 namespace lobe {
 
@@ -168,6 +166,88 @@ private:
     double cell_;
     std::vector<std::pair<glm::dvec3, glm::dvec3>> segments_;
     std::unordered_map<long long, std::vector<int>> grid_;
+};
+
+/// Projection onto the input surface by a walk from a known triangle: the triangles that
+/// come within the distance of the best point found so far, reached from the start through
+/// shared corners. Near the surface that region is a disc, so the walk finds the nearest
+/// point of it; a sheet elsewhere that comes as close is not searched, which is what a
+/// projection for remeshing wants anyway. Every vertex keeps the triangle it was projected
+/// to, and its next move is a fraction of the target length, so a walk visits a few
+/// triangles. This replaces an AABB tree (CGAL's, with its k-d tree for hints), whose build
+/// alone cost as much as every query of a remeshing.
+class SurfaceProjector {
+public:
+    explicit SurfaceProjector(const TriangleMesh& surface) : surface_(surface), stamp_(surface.triangles.size(), 0)
+    {
+        offsets_.assign(surface.positions.size() + 1, 0);
+        for (const auto& t : surface.triangles)
+            for (int v : t) ++offsets_[static_cast<std::size_t>(v) + 1];
+        for (std::size_t i = 1; i < offsets_.size(); ++i) offsets_[i] += offsets_[i - 1];
+        triangles_of_.resize(static_cast<std::size_t>(offsets_.back()));
+        std::vector<int> fill(offsets_.begin(), offsets_.end() - 1);
+        for (std::size_t f = 0; f < surface.triangles.size(); ++f)
+            for (int v : surface.triangles[f]) triangles_of_[static_cast<std::size_t>(fill[static_cast<std::size_t>(v)]++)] = static_cast<int>(f);
+    }
+
+    /// A triangle of the surface at input vertex v (v in range, and on a triangle).
+    int triangle_at(int v) const { return triangles_of_[static_cast<std::size_t>(offsets_[static_cast<std::size_t>(v)])]; }
+
+    /// The nearest point to x of the surface around triangle `start`; `start` becomes the
+    /// triangle it lies on. Without a start (−1) every triangle is searched.
+    glm::dvec3 project(const glm::dvec3& x, int& start)
+    {
+        glm::dvec3 best_point(0.0);
+        double best = std::numeric_limits<double>::infinity();
+        auto visit = [&](int f) {
+            const glm::dvec3 q = closest(x, f);
+            const double d = glm::dot(q - x, q - x);
+            if (d < best) {
+                best = d;
+                best_point = q;
+                start = f;
+            }
+            return d <= best;
+        };
+        if (start < 0) {
+            for (std::size_t f = 0; f < surface_.triangles.size(); ++f) visit(static_cast<int>(f));
+            return best_point;
+        }
+        if (++generation_ == 0) { // wrapped: forget every old mark
+            std::fill(stamp_.begin(), stamp_.end(), 0u);
+            generation_ = 1;
+        }
+        stack_.clear();
+        stack_.push_back(start);
+        stamp_[static_cast<std::size_t>(start)] = generation_;
+        visit(start);
+        while (!stack_.empty()) {
+            const int f = stack_.back();
+            stack_.pop_back();
+            for (int v : surface_.triangles[static_cast<std::size_t>(f)])
+                for (int k = offsets_[static_cast<std::size_t>(v)]; k < offsets_[static_cast<std::size_t>(v) + 1]; ++k) {
+                    const int g = triangles_of_[static_cast<std::size_t>(k)];
+                    if (stamp_[static_cast<std::size_t>(g)] == generation_) continue;
+                    stamp_[static_cast<std::size_t>(g)] = generation_;
+                    if (visit(g)) stack_.push_back(g);
+                }
+        }
+        return best_point;
+    }
+
+private:
+    glm::dvec3 closest(const glm::dvec3& x, int f) const
+    {
+        const auto& t = surface_.triangles[static_cast<std::size_t>(f)];
+        auto at = [&](int v) { return glm::dvec3(surface_.positions[static_cast<std::size_t>(v)]); };
+        return closest_point_on_triangle(x, at(t[0]), at(t[1]), at(t[2]));
+    }
+
+    const TriangleMesh& surface_;
+    std::vector<int> offsets_, triangles_of_; ///< triangles around each vertex
+    std::vector<unsigned> stamp_;
+    unsigned generation_ = 0;
+    std::vector<int> stack_;
 };
 
 /// The smallest angle of the triangle (a, b, c), radians.
@@ -312,7 +392,99 @@ void improve_small_angles(OMesh& om, OpenMesh::EPropHandleT<bool> constrained, d
         }
         if (!changed) break;
     }
-    om.garbage_collection();
+}
+
+/// One step of tangential relaxation, as CGAL's (PMP::tangential_relaxation as
+/// isotropic_remeshing calls it, with relax_constraints): a free vertex moves to the mean of
+/// its neighbours, projected onto its tangent plane; a stroke vertex with two stroke edges
+/// whose stroke turns there by less than 60° or more than 120° moves halfway to the midpoint
+/// of its stroke neighbours; other stroke vertices stay. Every new place is computed from the
+/// old ones; the moves are then made one after another, each halved up to five times while
+/// two neighbouring triangles across a free edge would face apart (and dropped after that).
+/// Written here rather than called because CGAL's computes every vertex normal into a hash
+/// map by its "most visible normal" search and allocates per vertex: on a lobe that took
+/// a fifth of the whole remeshing. The normal here is the sum of the face normals weighted by
+/// the angle sines at the vertex (CGAL's own fallback); the tangent plane only steers the
+/// move, the projection onto the input surface follows.
+void relax_tangentially(OMesh& om, OpenMesh::EPropHandleT<bool> constrained, const std::vector<int>& stroke_edges,
+                        std::vector<glm::dvec3>& face_normal,
+                        std::vector<std::pair<OMesh::VertexHandle, glm::dvec3>>& moves)
+{
+    auto at = [&](OMesh::VertexHandle v) { return FeatureSegments::to_glm(om.point(v)); };
+    auto unit_face_normal = [&](OMesh::FaceHandle f) {
+        OMesh::ConstFaceVertexIter fv = om.cfv_iter(f);
+        const glm::dvec3 a = at(*fv), b = at(*++fv), c = at(*++fv);
+        const glm::dvec3 n = glm::cross(b - a, c - a);
+        const double l = glm::length(n);
+        return l > 0.0 ? n / l : glm::dvec3(0.0);
+    };
+    face_normal.resize(om.n_faces());
+    for (auto f : om.faces()) face_normal[static_cast<std::size_t>(f.idx())] = unit_face_normal(f);
+
+    moves.clear();
+    for (auto v : om.vertices()) {
+        const int c = stroke_edges[static_cast<std::size_t>(v.idx())];
+        if (om.is_isolated(v) || om.is_boundary(v)) continue;
+        const glm::dvec3 p = at(v);
+        if (c == 0) {
+            glm::dvec3 sum(0.0), normal(0.0);
+            int n = 0;
+            for (OMesh::ConstVertexOHalfedgeIter h = om.cvoh_iter(v); h.is_valid(); ++h) {
+                const glm::dvec3 q = at(om.to_vertex_handle(*h));
+                sum += q;
+                ++n;
+                // The face left of v → q, and its angle at v (between q and the next neighbour).
+                const OMesh::FaceHandle f = om.face_handle(*h);
+                if (!f.is_valid()) continue;
+                const glm::dvec3 r = at(om.to_vertex_handle(om.next_halfedge_handle(*h)));
+                const glm::dvec3 u = q - p, w = r - p;
+                const double lu = glm::length(u), lw = glm::length(w);
+                if (lu > 0.0 && lw > 0.0)
+                    normal += face_normal[static_cast<std::size_t>(f.idx())] * (glm::length(glm::cross(u, w)) / (lu * lw));
+            }
+            const double ln = glm::length(normal);
+            const glm::dvec3 nv = ln > 0.0 ? normal / ln : glm::dvec3(0.0);
+            const glm::dvec3 bary = sum / static_cast<double>(n);
+            moves.emplace_back(v, bary + glm::dot(nv, p - bary) * nv);
+        } else if (c == 2) {
+            std::array<glm::dvec3, 2> ends{};
+            int k = 0;
+            for (OMesh::ConstVertexOHalfedgeIter h = om.cvoh_iter(v); h.is_valid() && k < 2; ++h)
+                if (om.property(constrained, om.edge_handle(*h))) ends[static_cast<std::size_t>(k++)] = at(om.to_vertex_handle(*h));
+            const glm::dvec3 u = ends[0] - p, w = ends[1] - p;
+            const double d = glm::dot(u, w);
+            if (0.25 < d * d / (glm::dot(u, u) * glm::dot(w, w))) moves.emplace_back(v, 0.25 * ends[0] + 0.25 * ends[1] + 0.5 * p);
+        }
+    }
+
+    // Neighbouring triangles across a free edge must not face apart.
+    auto normals_agree = [&](OMesh::VertexHandle v) {
+        for (OMesh::ConstVertexOHalfedgeIter h = om.cvoh_iter(v); h.is_valid(); ++h) {
+            if (om.property(constrained, om.edge_handle(*h))) continue;
+            const OMesh::FaceHandle f0 = om.face_handle(*h), f1 = om.opposite_face_handle(*h);
+            if (!f0.is_valid() || !f1.is_valid()) continue;
+            const glm::dvec3 n0 = face_normal[static_cast<std::size_t>(f0.idx())];
+            const glm::dvec3 n1 = face_normal[static_cast<std::size_t>(f1.idx())];
+            if (n0 == glm::dvec3(0.0) || n1 == glm::dvec3(0.0)) continue; // degenerate
+            if (glm::dot(n0, n1) <= 0.0) return false;
+        }
+        return true;
+    };
+    auto place = [&](OMesh::VertexHandle v, const glm::dvec3& x) {
+        om.point(v) = OMesh::Point(x.x, x.y, x.z);
+        for (OMesh::ConstVertexFaceIter f = om.cvf_iter(v); f.is_valid(); ++f)
+            face_normal[static_cast<std::size_t>(f->idx())] = unit_face_normal(*f);
+    };
+    for (const auto& [v, target] : moves) {
+        const glm::dvec3 start = at(v), move = target - start;
+        place(v, target);
+        double frac = 1.0;
+        while (frac > 0.03 && !normals_agree(v)) {
+            frac *= 0.5;
+            place(v, start + frac * move);
+        }
+        if (frac <= 0.02) place(v, start);
+    }
 }
 
 /// Remeshing with relaxed feature edges (RemeshOptions::relax_feature_edges) on the whole
@@ -326,35 +498,45 @@ void improve_small_angles(OMesh& om, OpenMesh::EPropHandleT<bool> constrained, d
 void remesh_relaxing_features(OMesh& om, const TriangleMesh& input, double target, unsigned iterations,
                               OpenMesh::EPropHandleT<bool> constrained)
 {
-    using K = CGAL::Epick;
-    std::vector<K::Triangle_3> triangles;
-    triangles.reserve(input.triangles.size());
-    auto point = [&](int i) {
-        const glm::vec3& p = input.positions[static_cast<std::size_t>(i)];
-        return K::Point_3(p.x, p.y, p.z);
-    };
-    for (const auto& t : input.triangles) triangles.emplace_back(point(t[0]), point(t[1]), point(t[2]));
-    using Primitive = CGAL::AABB_triangle_primitive<K, std::vector<K::Triangle_3>::const_iterator>;
-    CGAL::AABB_tree<CGAL::AABB_traits<K, Primitive>> surface(triangles.cbegin(), triangles.cend());
-    surface.accelerate_distance_queries();
+    SurfaceProjector surface(input);
     const FeatureSegments strokes(om, constrained, target);
+    // The triangle of the input surface each vertex was last projected to (at first one at
+    // its own place: the first vertices are the input's), where its next walk starts.
+    // Vertices that splits made have none and start from a neighbour's.
+    struct SurfaceHint {
+        int triangle = -1;
+    };
+    OpenMesh::VPropHandleT<SurfaceHint> hint;
+    om.add_property(hint);
+    for (auto v : om.vertices())
+        if (static_cast<std::size_t>(v.idx()) < input.positions.size() && !om.is_isolated(v))
+            om.property(hint, v).triangle = surface.triangle_at(v.idx());
     auto project = [&](OMesh::VertexHandle v) {
+        int& start = om.property(hint, v).triangle;
+        for (OMesh::ConstVertexVertexIter w = om.cvv_iter(v); start < 0 && w.is_valid(); ++w)
+            start = om.property(hint, *w).triangle;
+        const glm::dvec3 q = surface.project(FeatureSegments::to_glm(om.point(v)), start);
+        return OMesh::Point(q.x, q.y, q.z);
+    };
+    auto stay = [&](OMesh::VertexHandle v) {
         const OMesh::Point& p = om.point(v);
-        return surface.closest_point(K::Point_3(p[0], p[1], p[2]));
+        return CGAL::Epick::Point_3(p[0], p[1], p[2]);
     };
     ConstrainedEdgeMap ecm{&om, constrained};
     std::vector<int> stroke_edges;
+    std::vector<glm::dvec3> face_normal;
+    std::vector<std::pair<OMesh::VertexHandle, glm::dvec3>> moves;
     for (unsigned round = 0; round < iterations; ++round) {
+        // CGAL's split, collapse and flip; the relaxation and the projection follow here.
         PMP::isotropic_remeshing(faces(om), target, om,
                                  CGAL::parameters::number_of_iterations(1)
                                      .edge_is_constrained_map(ecm)
                                      .protect_constraints(false)
-                                     .relax_constraints(true)
-                                     .projection_functor(project));
-        om.garbage_collection();
-        // CGAL's relaxation moves the stroke vertices with exactly two stroke edges only, each
-        // towards the midpoint of its stroke neighbours: off its stroke by the bend of the
-        // stroke there, millimetres, well within the half target length searched.
+                                     .number_of_relaxation_steps(0)
+                                     .do_project(false)
+                                     // Never called (do_project is off); without a functor
+                                     // CGAL builds an AABB tree of the mesh for nothing.
+                                     .projection_functor(stay));
         stroke_edges.assign(om.n_vertices(), 0);
         for (auto e : om.edges())
             if (om.property(constrained, e)) {
@@ -362,12 +544,22 @@ void remesh_relaxing_features(OMesh& om, const TriangleMesh& input, double targe
                 ++stroke_edges[static_cast<std::size_t>(om.from_vertex_handle(h).idx())];
                 ++stroke_edges[static_cast<std::size_t>(om.to_vertex_handle(h).idx())];
             }
+        relax_tangentially(om, constrained, stroke_edges, face_normal, moves);
         for (auto v : om.vertices()) {
-            if (stroke_edges[static_cast<std::size_t>(v.idx())] != 2) continue;
-            const glm::dvec3 q = strokes.nearest(FeatureSegments::to_glm(om.point(v)), 0.5 * target);
-            om.point(v) = OMesh::Point(q.x, q.y, q.z);
+            const int c = stroke_edges[static_cast<std::size_t>(v.idx())];
+            if (c == 0) {
+                // CGAL's projection step: free vertices onto the input surface.
+                om.point(v) = project(v);
+            } else if (c == 2) {
+                // A stroke vertex that the 1-D relaxation moved towards the midpoint of its
+                // stroke neighbours: off its stroke by the bend there, millimetres, well
+                // within the half target length searched.
+                const glm::dvec3 q = strokes.nearest(FeatureSegments::to_glm(om.point(v)), 0.5 * target);
+                om.point(v) = OMesh::Point(q.x, q.y, q.z);
+            }
         }
     }
+    om.remove_property(hint);
     if (iterations > 0) improve_small_angles(om, constrained, target);
 }
 
@@ -481,27 +673,31 @@ TriangleMesh remesh_isotropic(const TriangleMesh& mesh, const RemeshOptions& opt
                                  CGAL::parameters::number_of_iterations(options.iterations)
                                      .edge_is_constrained_map(ecm)
                                      .protect_constraints(!(options.relax_feature_edges && whole)));
-        om.garbage_collection();
     }
 
+    // The mesh still holds what remeshing deleted (a garbage collection would cost as much as
+    // a tenth of the remeshing): the vertices left are numbered afresh, in order.
     TriangleMesh out;
+    std::vector<int> index(om.n_vertices(), -1);
     out.positions.reserve(om.n_vertices());
     for (auto v : om.vertices()) {
         const OMesh::Point& p = om.point(v);
+        index[static_cast<std::size_t>(v.idx())] = static_cast<int>(out.positions.size());
         out.positions.emplace_back(static_cast<float>(p[0]), static_cast<float>(p[1]), static_cast<float>(p[2]));
     }
+    auto new_index = [&](OMesh::VertexHandle v) { return index[static_cast<std::size_t>(v.idx())]; };
     out.triangles.reserve(om.n_faces());
     for (auto f : om.faces()) {
         std::array<int, 3> t{};
         int k = 0;
-        for (OMesh::FaceVertexIter fv = om.fv_iter(f); fv.is_valid() && k < 3; ++fv) t[static_cast<std::size_t>(k++)] = fv->idx();
+        for (OMesh::FaceVertexIter fv = om.fv_iter(f); fv.is_valid() && k < 3; ++fv) t[static_cast<std::size_t>(k++)] = new_index(*fv);
         out.triangles.push_back(t);
     }
     if (options.protect_feature_edges)
         for (auto e : om.edges())
             if (om.property(constrained, e)) {
                 const OMesh::HalfedgeHandle h = om.halfedge_handle(e, 0);
-                out.feature_edges.push_back({om.from_vertex_handle(h).idx(), om.to_vertex_handle(h).idx()});
+                out.feature_edges.push_back({new_index(om.from_vertex_handle(h)), new_index(om.to_vertex_handle(h))});
             }
     return out;
 }

@@ -100,7 +100,9 @@ double segment_distance(const glm::dvec3& p, const glm::dvec3& a, const glm::dve
 
 /// Checks that the output's feature edges form closed chains whose vertices include every
 /// original polyline vertex and all lie on the original closed polyline.
-void expect_chain_on_polyline(const TriangleMesh& out, const std::vector<glm::dvec3>& polyline)
+/// `keeps_vertices`: every polyline vertex is still there (protected constraints); relaxed
+/// ones are split, collapsed and slid along the polyline, so only the chain is checked.
+void expect_chain_on_polyline(const TriangleMesh& out, const std::vector<glm::dvec3>& polyline, bool keeps_vertices = true)
 {
     ASSERT_FALSE(out.feature_edges.empty());
     std::map<int, int> degree;
@@ -133,6 +135,7 @@ void expect_chain_on_polyline(const TriangleMesh& out, const std::vector<glm::dv
         EXPECT_LT(best, 1e-5) << "feature vertex off the polyline";
     }
     // Every polyline vertex is still a chain vertex, at the same position.
+    if (!keeps_vertices) return;
     for (const glm::dvec3& q : polyline) {
         bool found = false;
         for (const auto& [v, d] : degree)
@@ -341,6 +344,33 @@ TEST(Remesh, ConstrainedGreatCircleSurvives)
             EXPECT_LE(glm::length(out.positions[static_cast<std::size_t>(e[0])] - out.positions[static_cast<std::size_t>(e[1])]),
                       0.03 * 1.25 + 1e-6);
     }
+}
+
+TEST(Remesh, RelaxedStrokeVerticesStayOnTheirStrokeAndEveryVertexLiesOnTheInputSurface)
+{
+    // The lobe path: strokes split and collapsed along themselves, their vertices slid along
+    // them, the other vertices relaxed and projected onto the input by walks over it.
+    std::vector<int> equator;
+    const TriangleMesh in = uv_sphere(24, 64, 0.2, equator);
+    std::vector<glm::dvec3> polyline;
+    for (int v : equator) polyline.emplace_back(in.positions[static_cast<std::size_t>(v)]);
+    RemeshOptions o;
+    o.relax_feature_edges = true;
+    o.iterations = 4;
+    const TriangleMesh out = remesh_isotropic(in, o);
+    const MeshQuality q = measure_quality(out);
+    EXPECT_TRUE(q.closed && q.manifold && q.outward);
+    EXPECT_EQ(q.components, 1u);
+    std::vector<char> used(out.positions.size(), 0);
+    for (const auto& t : out.triangles)
+        for (int v : t) used[static_cast<std::size_t>(v)] = 1;
+    EXPECT_EQ(std::count(used.begin(), used.end(), 0), 0) << "vertices that remeshing removed are not in the output";
+    expect_chain_on_polyline(out, polyline, false);
+    EXPECT_LT(max_vertex_distance(out, in), 1e-5) << "every vertex lies on the input surface";
+    EXPECT_LT(max_vertex_distance(in, out), 0.003);
+    EXPECT_NEAR(q.edge_mean_m, 0.03, 0.005);
+    EXPECT_GE(q.share_all_angles_ge_30, 0.95);
+    EXPECT_FALSE(self_intersects(out));
 }
 
 TEST(Remesh, FeatureEdgesCanBeIgnored)

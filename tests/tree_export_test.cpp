@@ -194,6 +194,7 @@ TEST_P(TreeInModel, ReferenceMeshGrowsOneConnectedTreeFillingIt)
     }
     EXPECT_NEAR(g.nodes[0].position.y, 0.0f, 1e-6f); // rooted at the ground below the model
     ASSERT_EQ(t.growth.lobes.size(), 1u);
+    RecordProperty("coverage", std::to_string(t.growth.lobes[0].coverage()));
     EXPECT_GE(t.growth.lobes[0].coverage(), 0.9) << t.growth.lobes[0].reached << " of " << t.growth.lobes[0].attractors;
     const MeshRaycaster ray(lobe.mesh);
     double out = 0.0, total = 0.0;
