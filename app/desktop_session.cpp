@@ -342,7 +342,24 @@ void DesktopSession::frame(double time, int width, int height)
     status_.edits = document().edits.size();
     status_.revision = revision_;
     last_hand_ = hand_frame.hand(Hand::Right);
+    update_live_pinch();
     add_dynamic_items();
+}
+
+void DesktopSession::update_live_pinch()
+{
+    const std::uint64_t have = built_ ? built_->generation : 0;
+    if (!live_pinch_.update(pipeline_, *builder_, built_ ? &built_->tree.lobes : nullptr, have, requested_generation_))
+        return;
+    // Only the lobe's item changes while it is dragged; when the deform ends, the lobes as built.
+    bool shown = false;
+    if (built_)
+        for (std::size_t i = 0; i < built_->tree.lobes.size(); ++i)
+            if (const TriangleMesh* m = live_pinch_.mesh_for(built_->tree.lobes[i].lobe_id, pipeline_, have, requested_generation_)) {
+                shown = replace_lobe_item(scene_, i, *m);
+                break;
+            }
+    if (!shown) rebuild_static_scene();
 }
 
 void DesktopSession::apply_actions()
@@ -418,7 +435,10 @@ void DesktopSession::rebuild_static_scene()
     const TreeGeometry empty;
     const TreeGeometry* geometry = &empty;
     if (built_) {
-        for (const BuiltLobe& l : built_->tree.lobes) lobes.push_back(l.mesh);
+        for (const BuiltLobe& l : built_->tree.lobes) {
+            const TriangleMesh* live = live_pinch_.mesh_for(l.lobe_id, pipeline_, built_->generation, requested_generation_);
+            lobes.push_back(live ? *live : l.mesh);
+        }
         if (built_->grown && grown_ && !built_->geometry.lods.empty()) geometry = &built_->geometry;
     }
     RenderContent content;

@@ -19,6 +19,7 @@
 #include <glm/vec3.hpp>
 
 #include "app/autosave.h"
+#include "app/live_pinch.h"
 #include "app/regrow_worker.h"
 #include "app/renderer.h"
 #include "core/document.h"
@@ -155,6 +156,7 @@ private:
     void request_regrowth();
     void take_regrowth(std::optional<RegrowResult> result);
     void rebuild_static_scene();
+    void update_live_pinch();
     void add_dynamic_items();
     void note(std::string line);
     void record(const InputEvent& e);
@@ -191,6 +193,7 @@ private:
     std::optional<RegrowResult> built_; ///< the newest regrowth result
     std::size_t builder_messages_seen_ = 0;
 
+    LivePinchView live_pinch_; ///< the lobe being deformed while the pinch is dragged
     HandState last_hand_; ///< the simulated hand of the last frame (drawn)
     RenderScene scene_;
     std::size_t static_items_ = 0;

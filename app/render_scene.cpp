@@ -144,6 +144,17 @@ SurfaceGeometry lobe_surface(const TriangleMesh& mesh)
     return g;
 }
 
+bool replace_lobe_item(RenderScene& scene, std::size_t index, const TriangleMesh& mesh)
+{
+    for (RenderItem& item : scene.items)
+        if (item.key == (kLobeKey | index)) {
+            item.geometry = lobe_surface(mesh);
+            item.version = content_hash(item.geometry) ^ (std::uint64_t(item.material) << 60);
+            return true;
+        }
+    return false;
+}
+
 RenderScene tree_render_scene(const TreeGeometry& geometry, const std::vector<TriangleMesh>& lobes,
                               const std::vector<Stroke>& strokes, float ground_y, const RenderContent& content)
 {

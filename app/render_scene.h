@@ -50,6 +50,10 @@ SurfaceGeometry lobe_surface(const TriangleMesh& mesh);
 RenderScene tree_render_scene(const TreeGeometry& geometry, const std::vector<TriangleMesh>& lobes,
                               const std::vector<Stroke>& strokes, float ground_y, const RenderContent& content);
 
+/// Replaces the mesh of the item tree_render_scene made for lobe `index` (a lobe being
+/// deformed live); false when `scene` has no such item.
+bool replace_lobe_item(RenderScene& scene, std::size_t index, const TriangleMesh& mesh);
+
 /// The scene of a .glb written by Lobesketch (nodes `tree_branches_LOD<k>`,
 /// `tree_leaves_LOD<k>`, `lobe_<i>`, `stroke_<id>`; docs/export.md): its origin is the trunk
 /// base, so the ground is at y = 0.

@@ -13,6 +13,7 @@
 #include "app/autosave.h"
 #include "app/edit_hooks.h"
 #include "app/export_scene.h"
+#include "app/live_pinch.h"
 #include "app/render_scene.h"
 #include "app/scene_parts.h"
 #include "app/tree_output.h"
@@ -220,6 +221,11 @@ struct VrSession::Impl {
     /// is made again only when its points changed.
     std::vector<StrokeTube> stroke_tubes;
     HandFrame last_frame;
+    // The lobe being deformed live (app/live_pinch.h): which grown item shows it, and the
+    // regrowth generation whose items those are.
+    LivePinchView live_pinch;
+    std::optional<std::size_t> live_shown;
+    std::uint64_t live_shown_generation = 0;
 
     Impl(VrSession& s, VrOptions o, const Document& doc) : self(s), options(std::move(o)), pipeline(doc.settings.input) {}
 
@@ -249,6 +255,7 @@ struct VrSession::Impl {
     void document_changed();
     void request_regrowth();
     void take_regrowth(std::optional<RegrowResult> result);
+    void update_live_pinch();
     void rebuild_stroke_items();
     void update_ground_area();
     void autosave();
@@ -294,6 +301,7 @@ void VrSession::Impl::frame(const HandFrame& input)
     grab_scene(f);
 
     if (options.background_regrowth) take_regrowth(worker->take());
+    update_live_pinch();
     report_autosave_failures();
     last_frame = f;
     update_status();
@@ -529,6 +537,27 @@ void VrSession::Impl::take_regrowth(std::optional<RegrowResult> result)
     grown_bounds = result->scene.ground_area;
     built = std::move(result);
     update_ground_area();
+}
+
+void VrSession::Impl::update_live_pinch()
+{
+    const std::uint64_t have = built ? built->generation : 0;
+    const bool changed =
+        live_pinch.update(pipeline, builder(), built ? &built->tree.lobes : nullptr, have, requested_generation);
+    // A new regrowth result brought its own lobe items: the deformed lobe goes into them again.
+    const bool fresh = have != live_shown_generation;
+    if (!changed && !fresh) return;
+    RenderScene& scene = self.scene_;
+    if (live_shown && !fresh && built && *live_shown < built->tree.lobes.size())
+        replace_lobe_item(scene, *live_shown, built->tree.lobes[*live_shown].mesh);
+    live_shown.reset();
+    live_shown_generation = have;
+    if (!built) return;
+    for (std::size_t i = 0; i < built->tree.lobes.size(); ++i)
+        if (const TriangleMesh* m = live_pinch.mesh_for(built->tree.lobes[i].lobe_id, pipeline, have, requested_generation)) {
+            if (replace_lobe_item(scene, i, *m)) live_shown = i;
+            break;
+        }
 }
 
 void VrSession::Impl::rebuild_stroke_items()

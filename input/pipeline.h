@@ -111,6 +111,13 @@ public:
     /// True while `hand` is drawing; `current_stroke` then holds the points so far.
     bool drawing(Hand hand) const { return pen_[static_cast<int>(hand)].down; }
     const Stroke& current_stroke(Hand hand) const { return pen_[static_cast<int>(hand)].stroke; }
+    /// The editing tool of the drag `hand` is making (its path so far in current_stroke);
+    /// nothing while it is not dragging.
+    std::optional<Tool> drag_tool(Hand hand) const
+    {
+        const Pen& pen = pen_[static_cast<int>(hand)];
+        return pen.down && pen.drag ? std::optional<Tool>(pen.tool) : std::nullopt;
+    }
 
 private:
     /// The right hand's filtered index tip if it is tracked, else the left hand's.

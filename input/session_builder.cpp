@@ -449,6 +449,12 @@ bool SessionBuilder::add_drag(const InputAction& a)
     return true;
 }
 
+std::int64_t SessionBuilder::lobe_at(const glm::dvec3& point) const
+{
+    const LobePick pick = pick_lobe(doc_, view(), point, pick_.lobe_pick_distance_m, hooks_);
+    return pick.lobe ? pick.lobe->id : 0;
+}
+
 bool SessionBuilder::apply(const InputAction& a)
 {
     if (a.type != InputAction::Type::SettingChanged) setting_run_.reset();

@@ -99,6 +99,10 @@ public:
 
     const Document& document() const { return doc_; }
     Document take_document() { return std::move(doc_); }
+    /// The lobe that a lobe-tool drag (deform, move, rotate, scale) starting at `point`
+    /// (document space) edits: the one whose strokes are nearest among those it is near or
+    /// inside, as a completed drag picks it. 0 when none.
+    std::int64_t lobe_at(const glm::dvec3& point) const;
     /// Warnings (one line each) about drags that edited nothing, in order.
     const std::vector<std::string>& messages() const { return messages_; }
 

@@ -8,6 +8,7 @@
 /// the document. See docs/lobes.md.
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,34 @@ LobeOptions lobe_options_from(const Settings& settings);
 /// stroke left out, an edit that picked nothing) are appended to `warnings` when given,
 /// one line each.
 std::vector<BuiltLobe> build_document_lobes(const Document& doc, std::vector<std::string>* warnings = nullptr);
+
+/// A pinch deform while it is being dragged (docs/editing.md): factored once when the pinch
+/// starts, solved for every new fingertip position (meshing/laplacian_edit.h), in the lobe's
+/// own frame as the lobe builder applies the finished edit. So the lobe follows the
+/// fingertip, and what the person sees at release is what the finished edit builds (the same
+/// mesh, up to the rounding of mapping it out of stage space and back when the lobe was
+/// moved, turned or scaled).
+class LivePinch {
+public:
+    /// Starts a pinch at `from` (stage space) on `lobe`, the lobe as last built for `doc`
+    /// (build_document_lobes: stage space, earlier pinch edits applied).
+    /// 	hrow InvalidInput when the pinch picks no vertex (farther than the pick distance) or
+    ///        the region cannot be edited (one line); SolverError for a singular system.
+    LivePinch(const Document& doc, const BuiltLobe& lobe, const glm::vec3& from);
+    ~LivePinch();
+    LivePinch(LivePinch&&) noexcept;
+    LivePinch& operator=(LivePinch&&) noexcept;
+
+    /// The lobe with the pinch dragged to `to` (stage space): lobe.mesh with the region moved.
+    /// 	hrow InvalidInput for a target that is not finite or farther than the editor allows.
+    const TriangleMesh& drag_to(const glm::vec3& to);
+    std::int64_t lobe_id() const;
+    const TriangleMesh& mesh() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
 
 /// Re-applies the pinch edits (edit operations of type "drag:deform-lobe") that target
 /// `lobe_id` (or, with target 0, start within the pick distance of `mesh`) to `mesh`, in

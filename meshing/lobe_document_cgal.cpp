@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
 #include <set>
 #include <utility>
 
@@ -57,6 +58,29 @@ double nearest_vertex_distance(const TriangleMesh& mesh, const glm::vec3& p)
     return best;
 }
 
+/// A pinch edit in the frame the mesh is in: `frame` maps that frame to stage space, where
+/// the pinch was recorded. Picks the handle nearest the pinch's start.
+/// \throw InvalidInput when no vertex is within the pick distance.
+struct FramedPinch {
+    glm::dmat4 back;          ///< stage space → the mesh's frame
+    glm::vec3 from;           ///< the pinch's start in the mesh's frame
+    int handle = -1;
+    PinchEditOptions options;
+
+    FramedPinch(const Document& doc, const TriangleMesh& mesh, const glm::vec3& stage_from, const glm::dmat4& frame)
+        : back(glm::inverse(frame)), from(to_frame(stage_from))
+    {
+        options.roi_radius_m = doc.settings.lobes.pinch_roi_radius_m;
+        handle = pick_handle(mesh, from, doc.settings.lobes.pinch_pick_distance_m);
+    }
+    glm::vec3 to_frame(const glm::vec3& p) const { return glm::vec3(back * glm::dvec4(glm::dvec3(p), 1.0)); }
+    /// Where the handle goes for the pinch at `stage_to`.
+    glm::vec3 target(const TriangleMesh& rest, const glm::vec3& stage_to) const
+    {
+        return rest.positions[static_cast<std::size_t>(handle)] + (to_frame(stage_to) - from);
+    }
+};
+
 /// Applies one pinch edit to `mesh`; false (and a warning) when it cannot be applied.
 /// `frame` maps the lobe's own frame to stage space at the time of the edit: the pinch,
 /// recorded in stage space, is mapped back into the frame the mesh is in.
@@ -69,15 +93,9 @@ bool apply_pinch(const Document& doc, const EditOperation& op, TriangleMesh& mes
         if (warnings) warnings->push_back(who + ": no fingertip path, skipped");
         return false;
     }
-    const glm::dmat4 back = glm::inverse(frame);
-    from = glm::vec3(back * glm::dvec4(glm::dvec3(from), 1.0));
-    to = glm::vec3(back * glm::dvec4(glm::dvec3(to), 1.0));
-    PinchEditOptions options;
-    options.roi_radius_m = doc.settings.lobes.pinch_roi_radius_m;
     try {
-        const int handle = pick_handle(mesh, from, doc.settings.lobes.pinch_pick_distance_m);
-        const glm::vec3 target = mesh.positions[static_cast<std::size_t>(handle)] + (to - from);
-        laplacian_deform(mesh, handle, target, options);
+        const FramedPinch pinch(doc, mesh, from, frame);
+        laplacian_deform(mesh, pinch.handle, pinch.target(mesh, to), pinch.options);
     } catch (const InvalidInput& e) {
         if (warnings) warnings->push_back(who + ": " + e.what());
         return false;
@@ -364,6 +382,53 @@ std::vector<BuiltLobe> build_document_lobes(const Document& doc, std::vector<std
     cache.counts_ = {};
     return finish_lobes(doc, build_lobes(doc, warnings, cache.impl_.get(), &cache.counts_), warnings);
 }
+
+struct LivePinch::Impl {
+    std::int64_t lobe_id = 0;
+    glm::dmat4 frame{1.0};       ///< the lobe's frame → stage space
+    TriangleMesh rest;           ///< the lobe in its own frame when the pinch started
+    TriangleMesh work;           ///< the same, deformed
+    TriangleMesh stage;          ///< work mapped to stage space
+    std::optional<FramedPinch> pinch;
+    std::optional<PinchEditor> editor;
+};
+
+LivePinch::LivePinch(const Document& doc, const BuiltLobe& lobe, const glm::vec3& from) : impl_(std::make_unique<Impl>())
+{
+    Impl& m = *impl_;
+    m.lobe_id = lobe.lobe_id;
+    // A new edit comes after every operation so far: the lobe's frame is its whole transform
+    // (finish_lobes' lobe_transform(doc, id, k) with k = the number of operations).
+    m.frame = lobe_transform(doc, lobe.lobe_id, doc.edits.size());
+    m.rest = lobe.mesh;
+    if (m.frame != glm::dmat4(1.0)) transform_mesh(m.rest, glm::inverse(m.frame));
+    m.pinch.emplace(doc, m.rest, from, m.frame);
+    m.editor.emplace(m.rest, m.pinch->handle, m.pinch->options);
+    m.work = m.rest;
+    m.stage = lobe.mesh;
+}
+
+LivePinch::~LivePinch() = default;
+LivePinch::LivePinch(LivePinch&&) noexcept = default;
+LivePinch& LivePinch::operator=(LivePinch&&) noexcept = default;
+
+const TriangleMesh& LivePinch::drag_to(const glm::vec3& to)
+{
+    Impl& m = *impl_;
+    m.editor->drag_to(m.pinch->target(m.rest, to), m.work);
+    // Only the region moves: map its vertices out to stage space (all of them, untransformed).
+    if (m.frame == glm::dmat4(1.0)) {
+        for (int v : m.editor->roi()) m.stage.positions[static_cast<std::size_t>(v)] = m.work.positions[static_cast<std::size_t>(v)];
+    } else {
+        for (int v : m.editor->roi())
+            m.stage.positions[static_cast<std::size_t>(v)] =
+                glm::vec3(m.frame * glm::dvec4(glm::dvec3(m.work.positions[static_cast<std::size_t>(v)]), 1.0));
+    }
+    return m.stage;
+}
+
+std::int64_t LivePinch::lobe_id() const { return impl_->lobe_id; }
+const TriangleMesh& LivePinch::mesh() const { return impl_->stage; }
 
 std::size_t apply_pinch_edits(const Document& doc, std::int64_t lobe_id, TriangleMesh& mesh,
                               std::vector<std::string>* warnings)

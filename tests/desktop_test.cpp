@@ -245,6 +245,74 @@ TEST(DesktopSession, SketchBuildsLobeAndTreeAndEveryChangeIsAutosaved)
     EXPECT_GT(fs::file_size(dir + "/session.glb"), 10000u);
 }
 
+/// The lobe item of a desktop scene (one lobe).
+const RenderItem* lobe_item(const DesktopSession& s)
+{
+    for (const RenderItem& item : s.scene().items)
+        if (item.material == RenderMaterial::Lobe) return &item;
+    return nullptr;
+}
+
+double largest_move(const SurfaceGeometry& a, const SurfaceGeometry& b)
+{
+    double most = 0.0;
+    for (std::size_t v = 0; v < std::min(a.positions.size(), b.positions.size()); ++v)
+        most = std::max(most, double(glm::distance(a.positions[v], b.positions[v])));
+    return most;
+}
+
+TEST(DesktopSession, PinchDeformedLobeFollowsTheFingertipFrameByFrameAndKeepsItsShapeAtRelease)
+{
+    DesktopSession s(Document{}, quiet_options());
+    Driver d{s};
+    d.move(320, 180);
+    d.circle(320, 180, 60);
+    d.drag(480, 300, 680, 300, 8, desktop_keys::kMouseRight);
+    d.circle(320, 180, 60);
+    s.wait_for_regrowth();
+    d.step();
+    ASSERT_EQ(s.document().lobes.size(), 1u);
+    ASSERT_NE(lobe_item(s), nullptr);
+    const SurfaceGeometry before = lobe_item(s)->geometry;
+
+    d.press(keys::kDeformLobe);
+    // Pinch on the second ring's rim (on the lobe) and pull outwards, frame by frame.
+    d.move(380, 180);
+    s.mouse_button(desktop_keys::kMouseLeft, true);
+    d.step(6); // the pinch is recognised a few frames after the button goes down
+    ASSERT_TRUE(s.status().drawing);
+    const glm::vec3 start = s.status().tip;
+    double last = 0.0;
+    for (int i = 1; i <= 12; ++i) {
+        d.move(380.0f + float(i), 180.0f);
+        const RenderItem* item = lobe_item(s);
+        ASSERT_NE(item, nullptr);
+        ASSERT_EQ(item->geometry.positions.size(), before.positions.size());
+        // The handle follows the fingertip (the pipeline's filtered tip lags the cursor a
+        // little): what moved most moved about as far as the fingertip, and further each frame.
+        const double moved = largest_move(item->geometry, before);
+        const double pulled = glm::distance(s.status().tip, start);
+        EXPECT_GT(moved, last) << "frame " << i;
+        EXPECT_LT(moved, pulled + 0.002) << "frame " << i;
+        EXPECT_GT(moved, pulled - 0.01) << "frame " << i;
+        last = moved;
+    }
+    EXPECT_GT(last, 0.01);
+    EXPECT_TRUE(s.document().edits.empty()) << "the edit is made at release";
+    d.step(6); // held still: the fingertip filter catches up with the cursor
+    const SurfaceGeometry dragged = lobe_item(s)->geometry;
+    s.mouse_button(desktop_keys::kMouseLeft, false);
+    d.step(6);
+    ASSERT_EQ(s.document().edits.size(), 1u) << s.status().last_message;
+    EXPECT_EQ(s.document().edits[0].type, "drag:deform-lobe");
+    // After the release the lobe is the one built with the finished edit: where the drag left it.
+    const RenderItem* after = lobe_item(s);
+    ASSERT_NE(after, nullptr);
+    ASSERT_EQ(after->geometry.positions.size(), dragged.positions.size());
+    EXPECT_LT(largest_move(after->geometry, dragged), 0.001);
+    EXPECT_GT(largest_move(after->geometry, before), 0.01);
+}
+
 TEST(DesktopSession, RecordingReplaysToTheSameDocument)
 {
     const std::string dir = temp_dir("desktop_replay");

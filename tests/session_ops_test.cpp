@@ -798,3 +798,89 @@ TEST(SessionReplay, KeysAndSettingsInARecordingReplayToTheSameDocumentFromBothFo
         EXPECT_EQ(text(replay(back)), want) << (binary ? "binary" : "text");
     }
 }
+
+namespace {
+
+/// A deform dragged live (LivePinch) on the lobes as built before it, through every point of
+/// the drag's path, against the lobes built after the finished drag.
+void expect_live_pinch_ends_as_built(const SessionBuilder& before_drag, const InputAction& drag, double tolerance)
+{
+    const Document before = before_drag.document();
+    const std::vector<BuiltLobe> lobes = build_document_lobes(before);
+    const glm::dvec3 from(drag.drag.path.front().position);
+    const std::int64_t id = before_drag.lobe_at(from);
+    ASSERT_GT(id, 0);
+    const BuiltLobe* lobe = nullptr;
+    for (const BuiltLobe& l : lobes)
+        if (l.lobe_id == id) lobe = &l;
+    ASSERT_NE(lobe, nullptr);
+    LivePinch live(before, *lobe, glm::vec3(from));
+    EXPECT_EQ(live.lobe_id(), id);
+    double moved_most = 0.0;
+    for (const StrokePoint& p : drag.drag.path) {
+        const TriangleMesh& m = live.drag_to(p.position);
+        ASSERT_EQ(m.positions.size(), lobe->mesh.positions.size());
+        moved_most = 0.0;
+        for (std::size_t v = 0; v < m.positions.size(); ++v)
+            moved_most = std::max(moved_most, glm::distance(glm::dvec3(m.positions[v]), glm::dvec3(lobe->mesh.positions[v])));
+        // The surface follows the fingertip: the handle moves with it, nothing moves more.
+        const double pulled = glm::distance(glm::dvec3(p.position), from);
+        EXPECT_NEAR(moved_most, pulled, 1e-4) << "at " << p.time;
+    }
+    ASSERT_GT(moved_most, 0.03);
+
+    SessionBuilder after_drag = before_drag;
+    ASSERT_TRUE(after_drag.apply(drag));
+    const std::vector<BuiltLobe> after = build_document_lobes(after_drag.document());
+    const BuiltLobe* done = nullptr;
+    for (const BuiltLobe& l : after)
+        if (l.lobe_id == id) done = &l;
+    ASSERT_NE(done, nullptr);
+    EXPECT_EQ(done->edits_applied, lobe->edits_applied + 1);
+    ASSERT_EQ(done->mesh.triangles, live.mesh().triangles);
+    ASSERT_EQ(done->mesh.positions.size(), live.mesh().positions.size());
+    double worst = 0.0;
+    for (std::size_t v = 0; v < done->mesh.positions.size(); ++v)
+        worst = std::max(worst, double(glm::distance(done->mesh.positions[v], live.mesh().positions[v])));
+    EXPECT_LE(worst, tolerance);
+}
+
+} // namespace
+
+TEST(LivePinch, OnAnUnmovedLobeEndsExactlyAsTheFinishedDeformBuilds)
+{
+    const SessionBuilder b = scene();
+    const glm::dvec3 top = kCentre + glm::dvec3(0, 0.15, 0);
+    expect_live_pinch_ends_as_built(b, drag_action(Tool::DeformLobe, top, top + glm::dvec3(0.02, 0.04, 0), 110.0), 0.0);
+}
+
+TEST(LivePinch, OnAMovedTurnedAndScaledLobeEndsAsTheFinishedDeformBuildsWithinAMicrometre)
+{
+    SessionBuilder b = scene();
+    const glm::dvec3 move(0.0, 0.04, 0.0), c = kCentre + move;
+    ASSERT_TRUE(b.apply(drag_action(Tool::MoveLobe, kCentre, c)));
+    const glm::dvec3 lever(0.15, 0, 0), turned(0.15 * std::cos(0.35), 0, 0.15 * std::sin(0.35));
+    ASSERT_TRUE(b.apply(drag_action(Tool::RotateLobe, c + lever, c + turned, 105.0)));
+    ASSERT_TRUE(b.apply(drag_action(Tool::ScaleLobe, c + turned, c + 1.2 * turned, 107.0)));
+    ASSERT_TRUE(b.messages().empty()) << b.messages().front();
+    // The top of the moved, turned and scaled lobe (1.2 × 15 cm above its centre).
+    const glm::dvec3 top = c + glm::dvec3(0, 0.18, 0);
+    expect_live_pinch_ends_as_built(b, drag_action(Tool::DeformLobe, top, top + glm::dvec3(-0.03, 0.03, 0.01), 110.0),
+                                    1e-6);
+}
+
+TEST(LivePinch, APinchFarFromTheLobeSaysSoInOneLine)
+{
+    const SessionBuilder b = scene();
+    const Document& d = b.document();
+    const std::vector<BuiltLobe> lobes = build_document_lobes(d);
+    ASSERT_FALSE(lobes.empty());
+    try {
+        LivePinch live(d, lobes.front(), glm::vec3(kCentre + glm::dvec3(0, 0.6, 0)));
+        FAIL() << "a pinch 45 cm off the lobe picked a vertex";
+    } catch (const InvalidInput& e) {
+        const std::string m = e.what();
+        EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+        EXPECT_NE(m.find("cm from the nearest vertex"), std::string::npos) << m;
+    }
+}

@@ -213,6 +213,53 @@ TEST(VrSession, ScriptedSessionExercisesEveryInteractionAndItsRecordingReplaysTo
 // arrived is what a scene built in one go from the same document draws (the tree's items are
 // made on the worker, each stroke's tube only when the stroke changed), and the autosave on
 // disk when the session ends is its last document.
+/// The highest point of the scene's lobe item (one lobe).
+float lobe_top(const VrSession& s)
+{
+    float top = -1e9f;
+    for (const RenderItem& item : s.scene().items)
+        if (item.material == RenderMaterial::Lobe)
+            for (const glm::vec3& p : item.geometry.positions) top = std::max(top, p.y);
+    return top;
+}
+
+TEST(VrSession, PinchDeformedLobeRisesWithTheFingertipWhileDraggedAndStaysWhereReleased)
+{
+    VrOptions o;
+    o.background_regrowth = false;
+    VrSession s(Document{}, o);
+    VrScript script([&](const HandFrame& f) { s.frame(f); });
+    script.hand(Hand::Right) = {true, HandPose::Open, {0.25f, 1.3f, -0.3f}, 0.05f};
+    script.wait(0.3);
+    const glm::vec3 c(0.15f, 1.45f, -0.45f);
+    const glm::vec3 X(1, 0, 0), Y(0, 1, 0), Z(0, 0, 1);
+    script.pinch_along(Hand::Right, circle(c, X, Z, 0.12f));
+    script.pinch_along(Hand::Right, circle(c, X, Y, 0.12f));
+    script.pinch_along(Hand::Right, circle(c, Z, Y, 0.12f));
+    ASSERT_EQ(s.document().lobes.size(), 1u);
+    const float top0 = lobe_top(s);
+    EXPECT_NEAR(top0, c.y + 0.12f, 0.01f);
+
+    poke(script, s, "PINCH");
+    ASSERT_EQ(s.status().tool, Tool::DeformLobe);
+    script.hand(Hand::Right).pose = HandPose::Open;
+    script.move(Hand::Right, c + glm::vec3(0, 0.12f, 0), 0.5);
+    script.pinch(Hand::Right, true);
+    // Up 5 cm in five steps: after each the lobe's top is where the fingertip is.
+    for (int k = 1; k <= 5; ++k) {
+        script.move(Hand::Right, c + glm::vec3(0, 0.12f + 0.01f * float(k), 0), 0.1);
+        script.wait(0.1);
+        EXPECT_NEAR(lobe_top(s), top0 + 0.01f * float(k), 0.004f) << "step " << k;
+    }
+    EXPECT_EQ(s.document().edits.size(), 0u) << "the edit is made at release";
+    const float dragged = lobe_top(s);
+    script.pinch(Hand::Right, false);
+    script.wait(0.2);
+    ASSERT_EQ(s.document().edits.size(), 1u);
+    EXPECT_EQ(s.document().edits.back().type, "drag:deform-lobe");
+    EXPECT_NEAR(lobe_top(s), dragged, 0.002f) << "the lobe built with the finished edit is where the drag left it";
+}
+
 TEST(VrSession, OffTheFrameThreadTheSceneIsTheOneBuiltInOneGoAndTheAutosaveIsTheLastDocument)
 {
     const fs::path dir = scratch("background");
