@@ -213,6 +213,20 @@ TEST(VrSession, ScriptedSessionExercisesEveryInteractionAndItsRecordingReplaysTo
 // arrived is what a scene built in one go from the same document draws (the tree's items are
 // made on the worker, each stroke's tube only when the stroke changed), and the autosave on
 // disk when the session ends is its last document.
+/// The right hand raised, then three 12 cm loops drawn around one lobe (in three planes);
+/// returns the lobe's centre.
+glm::vec3 draw_three_loops(VrScript& script)
+{
+    script.hand(Hand::Right) = {true, HandPose::Open, {0.25f, 1.3f, -0.3f}, 0.05f};
+    script.wait(0.3);
+    const glm::vec3 c(0.15f, 1.45f, -0.45f);
+    const glm::vec3 X(1, 0, 0), Y(0, 1, 0), Z(0, 0, 1);
+    script.pinch_along(Hand::Right, circle(c, X, Z, 0.12f));
+    script.pinch_along(Hand::Right, circle(c, X, Y, 0.12f));
+    script.pinch_along(Hand::Right, circle(c, Z, Y, 0.12f));
+    return c;
+}
+
 /// The highest point of the scene's lobe item (one lobe).
 float lobe_top(const VrSession& s)
 {
@@ -229,13 +243,7 @@ TEST(VrSession, PinchDeformedLobeRisesWithTheFingertipWhileDraggedAndStaysWhereR
     o.background_regrowth = false;
     VrSession s(Document{}, o);
     VrScript script([&](const HandFrame& f) { s.frame(f); });
-    script.hand(Hand::Right) = {true, HandPose::Open, {0.25f, 1.3f, -0.3f}, 0.05f};
-    script.wait(0.3);
-    const glm::vec3 c(0.15f, 1.45f, -0.45f);
-    const glm::vec3 X(1, 0, 0), Y(0, 1, 0), Z(0, 0, 1);
-    script.pinch_along(Hand::Right, circle(c, X, Z, 0.12f));
-    script.pinch_along(Hand::Right, circle(c, X, Y, 0.12f));
-    script.pinch_along(Hand::Right, circle(c, Z, Y, 0.12f));
+    const glm::vec3 c = draw_three_loops(script);
     ASSERT_EQ(s.document().lobes.size(), 1u);
     const float top0 = lobe_top(s);
     EXPECT_NEAR(top0, c.y + 0.12f, 0.01f);
@@ -269,13 +277,7 @@ TEST(VrSession, OffTheFrameThreadTheSceneIsTheOneBuiltInOneGoAndTheAutosaveIsThe
     o.background_regrowth = true;
     VrSession s(Document{}, o);
     VrScript script([&](const HandFrame& f) { s.frame(f); });
-    script.hand(Hand::Right) = {true, HandPose::Open, {0.25f, 1.3f, -0.3f}, 0.05f};
-    script.wait(0.3);
-    const glm::vec3 c(0.15f, 1.45f, -0.45f);
-    const glm::vec3 X(1, 0, 0), Y(0, 1, 0), Z(0, 0, 1);
-    script.pinch_along(Hand::Right, circle(c, X, Z, 0.12f));
-    script.pinch_along(Hand::Right, circle(c, X, Y, 0.12f));
-    script.pinch_along(Hand::Right, circle(c, Z, Y, 0.12f));
+    const glm::vec3 c = draw_three_loops(script);
     poke(script, s, "TRUNK");
     script.pinch_along(Hand::Right, {c + glm::vec3(0, -0.45f, 0), c + glm::vec3(0.005f, -0.30f, 0), c + glm::vec3(0, -0.12f, 0)});
     poke(script, s, "GROW");
