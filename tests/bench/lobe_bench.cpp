@@ -167,4 +167,42 @@ void BM_CgalDefaultRemeshTenStrokeLobe10Iterations(benchmark::State& state)
 }
 BENCHMARK(BM_CgalDefaultRemeshTenStrokeLobe10Iterations)->Unit(benchmark::kMillisecond);
 
+/// A pinch deform dragged live (LivePinch, as the desktop and VR sessions run it every frame
+/// while the pinch is held): one solve and the region mapped out to stage space, on lobe 1 of
+/// the pinch-edit recording as built before its first deform, from that deform's start along
+/// its path and back. Arg: the region radius in centimetres (8 = the default).
+void BM_LivePinchFrame(benchmark::State& state)
+{
+    Document doc = test::replay_document("pinch-edit");
+    std::vector<glm::vec3> path;
+    std::size_t first = doc.edits.size();
+    for (std::size_t k = 0; k < doc.edits.size() && first == doc.edits.size(); ++k)
+        if (doc.edits[k].type == "drag:deform-lobe") first = k;
+    if (first == doc.edits.size()) {
+        state.SkipWithError("the recording has no pinch deform");
+        return;
+    }
+    const EditOperation op = doc.edits[first];
+    for (const auto& p : op.params["path"]) path.emplace_back(p[0].get<float>(), p[1].get<float>(), p[2].get<float>());
+    doc.edits.resize(first);
+    doc.settings.lobes.pinch_roi_radius_m = static_cast<double>(state.range(0)) / 100.0;
+    const std::vector<BuiltLobe> lobes = build_document_lobes(doc);
+    const BuiltLobe* lobe = nullptr;
+    for (const BuiltLobe& l : lobes)
+        if (l.lobe_id == op.target) lobe = &l;
+    if (!lobe || path.size() < 2) {
+        state.SkipWithError("no lobe for the deform");
+        return;
+    }
+    LivePinch live(doc, *lobe, path.front());
+    std::size_t frame = 0;
+    for (auto _ : state) {
+        // Along the path and back, one point per frame.
+        const std::size_t n = path.size(), k = frame++ % (2 * n - 2);
+        benchmark::DoNotOptimize(live.drag_to(path[k < n ? k : 2 * n - 2 - k]).positions.data());
+    }
+    state.counters["lobe_vertices"] = static_cast<double>(lobe->mesh.positions.size());
+}
+BENCHMARK(BM_LivePinchFrame)->Arg(8)->Arg(30)->Unit(benchmark::kMillisecond);
+
 } // namespace
