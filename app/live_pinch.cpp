@@ -46,6 +46,7 @@ bool LivePinchView::update(const InputPipeline& pipeline, const SessionBuilder& 
                     } catch (const Error&) {
                         // Picks nothing or cannot be solved: the finished drag says why.
                     }
+                    break;
                 }
         }
     }

@@ -50,7 +50,7 @@ class LivePinch {
 public:
     /// Starts a pinch at `from` (stage space) on `lobe`, the lobe as last built for `doc`
     /// (build_document_lobes: stage space, earlier pinch edits applied).
-    /// 	hrow InvalidInput when the pinch picks no vertex (farther than the pick distance) or
+    /// \throw InvalidInput when the pinch picks no vertex (farther than the pick distance) or
     ///        the region cannot be edited (one line); SolverError for a singular system.
     LivePinch(const Document& doc, const BuiltLobe& lobe, const glm::vec3& from);
     ~LivePinch();
@@ -58,7 +58,7 @@ public:
     LivePinch& operator=(LivePinch&&) noexcept;
 
     /// The lobe with the pinch dragged to `to` (stage space): lobe.mesh with the region moved.
-    /// 	hrow InvalidInput for a target that is not finite or farther than the editor allows.
+    /// \throw InvalidInput for a target that is not finite or farther than the editor allows.
     const TriangleMesh& drag_to(const glm::vec3& to);
     std::int64_t lobe_id() const;
     const TriangleMesh& mesh() const;

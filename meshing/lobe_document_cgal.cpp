@@ -416,14 +416,10 @@ const TriangleMesh& LivePinch::drag_to(const glm::vec3& to)
 {
     Impl& m = *impl_;
     m.editor->drag_to(m.pinch->target(m.rest, to), m.work);
-    // Only the region moves: map its vertices out to stage space (all of them, untransformed).
-    if (m.frame == glm::dmat4(1.0)) {
-        for (int v : m.editor->roi()) m.stage.positions[static_cast<std::size_t>(v)] = m.work.positions[static_cast<std::size_t>(v)];
-    } else {
-        for (int v : m.editor->roi())
-            m.stage.positions[static_cast<std::size_t>(v)] =
-                glm::vec3(m.frame * glm::dvec4(glm::dvec3(m.work.positions[static_cast<std::size_t>(v)]), 1.0));
-    }
+    // Only the region moves: map its vertices out to stage space (exactly, for the identity).
+    for (int v : m.editor->roi())
+        m.stage.positions[static_cast<std::size_t>(v)] =
+            glm::vec3(m.frame * glm::dvec4(glm::dvec3(m.work.positions[static_cast<std::size_t>(v)]), 1.0));
     return m.stage;
 }
 
