@@ -342,24 +342,38 @@ void DesktopSession::frame(double time, int width, int height)
     status_.edits = document().edits.size();
     status_.revision = revision_;
     last_hand_ = hand_frame.hand(Hand::Right);
-    update_live_pinch();
+    update_live_edits();
     add_dynamic_items();
 }
 
-void DesktopSession::update_live_pinch()
+void DesktopSession::update_live_edits()
 {
     const std::uint64_t have = built_ ? built_->generation : 0;
-    if (!live_pinch_.update(pipeline_, *builder_, built_ ? &built_->tree.lobes : nullptr, have, requested_generation_))
-        return;
-    // Only the lobe's item changes while it is dragged; when the deform ends, the lobes as built.
+    const std::vector<BuiltLobe>* lobes = built_ ? &built_->tree.lobes : nullptr;
+    const bool pinch = live_pinch_.update(pipeline_, *builder_, lobes, have, requested_generation_);
+    const bool moved = live_transform_.update(pipeline_, *builder_, lobes, have, requested_generation_);
+    if (!pinch && !moved) return;
+    // Only the lobe's item (and a moved lobe's strokes) change while it is dragged; when the
+    // edit ends, the lobes and strokes as built.
     bool shown = false;
     if (built_)
         for (std::size_t i = 0; i < built_->tree.lobes.size(); ++i)
-            if (const TriangleMesh* m = live_pinch_.mesh_for(built_->tree.lobes[i].lobe_id, pipeline_, have, requested_generation_)) {
+            if (const TriangleMesh* m = live_lobe(built_->tree.lobes[i].lobe_id)) {
                 shown = replace_lobe_item(scene_, i, *m);
                 break;
             }
+    if (shown && moved) {
+        if (live_transform_.strokes().empty()) shown = false; // released: the document's strokes again
+        for (const Stroke& st : live_transform_.strokes()) shown = replace_stroke_item(scene_, st) && shown;
+    }
     if (!shown) rebuild_static_scene();
+}
+
+const TriangleMesh* DesktopSession::live_lobe(std::int64_t lobe_id) const
+{
+    const std::uint64_t have = built_ ? built_->generation : 0;
+    if (const TriangleMesh* m = live_pinch_.mesh_for(lobe_id, pipeline_, have, requested_generation_)) return m;
+    return live_transform_.mesh_for(lobe_id, have, requested_generation_);
 }
 
 void DesktopSession::apply_actions()
@@ -436,7 +450,7 @@ void DesktopSession::rebuild_static_scene()
     const TreeGeometry* geometry = &empty;
     if (built_) {
         for (const BuiltLobe& l : built_->tree.lobes) {
-            const TriangleMesh* live = live_pinch_.mesh_for(l.lobe_id, pipeline_, built_->generation, requested_generation_);
+            const TriangleMesh* live = live_lobe(l.lobe_id);
             lobes.push_back(live ? *live : l.mesh);
         }
         if (built_->grown && grown_ && !built_->geometry.lods.empty()) geometry = &built_->geometry;
@@ -447,7 +461,9 @@ void DesktopSession::rebuild_static_scene()
     content.lod = content.tree ? std::min(lod_, int(geometry->lods.size()) - 1) : 0;
     status_.lod = content.lod;
     status_.tree_triangles = content.tree ? lod_triangles(geometry->lods[std::size_t(content.lod)]) : 0;
-    scene_ = tree_render_scene(*geometry, lobes, effective_strokes(document()), 0.0f, content);
+    std::vector<Stroke> strokes = effective_strokes(document());
+    live_transform_.apply_to(strokes);
+    scene_ = tree_render_scene(*geometry, lobes, strokes, 0.0f, content);
     Bounds area = scene_bounds(scene_);
     if (area.empty()) {
         area.add(orbit_.target - glm::vec3(0.5f));

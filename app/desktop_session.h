@@ -20,6 +20,7 @@
 
 #include "app/autosave.h"
 #include "app/live_pinch.h"
+#include "app/live_transform.h"
 #include "app/regrow_worker.h"
 #include "app/renderer.h"
 #include "core/document.h"
@@ -156,7 +157,9 @@ private:
     void request_regrowth();
     void take_regrowth(std::optional<RegrowResult> result);
     void rebuild_static_scene();
-    void update_live_pinch();
+    void update_live_edits();
+    /// The lobe shown in place of lobe `lobe_id` while it is edited live (pinched, moved); null: the built one.
+    const TriangleMesh* live_lobe(std::int64_t lobe_id) const;
     void add_dynamic_items();
     void note(std::string line);
     void record(const InputEvent& e);
@@ -194,6 +197,7 @@ private:
     std::size_t builder_messages_seen_ = 0;
 
     LivePinchView live_pinch_; ///< the lobe being deformed while the pinch is dragged
+    LiveTransformView live_transform_; ///< the lobe being moved, turned or scaled while dragged
     HandState last_hand_; ///< the simulated hand of the last frame (drawn)
     RenderScene scene_;
     std::size_t static_items_ = 0;

@@ -155,6 +155,33 @@ bool replace_lobe_item(RenderScene& scene, std::size_t index, const TriangleMesh
     return false;
 }
 
+namespace {
+
+std::uint64_t stroke_key(const Stroke& s) { return kStrokeKey | (static_cast<std::uint64_t>(s.id) & 0x00FFFFFFFFFFFFFFull); }
+
+/// The tube a stroke is drawn as: through its points, round again when it is closed.
+SurfaceGeometry stroke_tube(const Stroke& s)
+{
+    std::vector<glm::vec3> pts;
+    pts.reserve(s.points.size() + 1);
+    for (const StrokePoint& p : s.points) pts.push_back(p.position);
+    if (s.closed && pts.size() > 2) pts.push_back(pts.front());
+    return polyline_tube(pts);
+}
+
+} // namespace
+
+bool replace_stroke_item(RenderScene& scene, const Stroke& stroke)
+{
+    for (RenderItem& item : scene.items)
+        if (item.key == stroke_key(stroke)) {
+            item.geometry = stroke_tube(stroke);
+            item.version = content_hash(item.geometry) ^ (std::uint64_t(item.material) << 60);
+            return true;
+        }
+    return false;
+}
+
 RenderScene tree_render_scene(const TreeGeometry& geometry, const std::vector<TriangleMesh>& lobes,
                               const std::vector<Stroke>& strokes, float ground_y, const RenderContent& content)
 {
@@ -181,13 +208,7 @@ RenderScene tree_render_scene(const TreeGeometry& geometry, const std::vector<Tr
         for (std::size_t i = 0; i < lobes.size(); ++i)
             add_item(scene, kLobeKey | i, RenderMaterial::Lobe, kLobeColor, lobe_surface(lobes[i]));
     if (content.strokes)
-        for (const Stroke& s : strokes) {
-            std::vector<glm::vec3> pts;
-            for (const StrokePoint& p : s.points) pts.push_back(p.position);
-            if (s.closed && pts.size() > 2) pts.push_back(pts.front());
-            add_item(scene, kStrokeKey | (static_cast<std::uint64_t>(s.id) & 0x00FFFFFFFFFFFFFFull), RenderMaterial::Stroke,
-                     kStrokeColor, polyline_tube(pts));
-        }
+        for (const Stroke& s : strokes) add_item(scene, stroke_key(s), RenderMaterial::Stroke, kStrokeColor, stroke_tube(s));
     return scene;
 }
 

@@ -54,6 +54,11 @@ RenderScene tree_render_scene(const TreeGeometry& geometry, const std::vector<Tr
 /// deformed live); false when `scene` has no such item.
 bool replace_lobe_item(RenderScene& scene, std::size_t index, const TriangleMesh& mesh);
 
+/// Replaces the tube of the item tree_render_scene made for `stroke` (found by its id) with
+/// one through the stroke's points as given (a lobe's stroke while the lobe is moved, turned
+/// or scaled live); false when `scene` has no such item.
+bool replace_stroke_item(RenderScene& scene, const Stroke& stroke);
+
 /// The scene of a .glb written by Lobesketch (nodes `tree_branches_LOD<k>`,
 /// `tree_leaves_LOD<k>`, `lobe_<i>`, `stroke_<id>`; docs/export.md): its origin is the trunk
 /// base, so the ground is at y = 0.

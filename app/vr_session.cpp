@@ -14,6 +14,7 @@
 #include "app/edit_hooks.h"
 #include "app/export_scene.h"
 #include "app/live_pinch.h"
+#include "app/live_transform.h"
 #include "app/render_scene.h"
 #include "app/scene_parts.h"
 #include "app/tree_output.h"
@@ -27,6 +28,16 @@ constexpr std::size_t kMaxMessages = 200;
 constexpr std::uint64_t kDynamicKey = 10ull << 56;
 constexpr std::uint64_t kPanelKey = kDynamicKey | (1ull << 40);
 constexpr std::uint64_t kPhotoKey = kDynamicKey | (2ull << 40);
+
+/// What a stroke's tube is made from (its points, round again when closed), hashed.
+std::uint64_t stroke_fingerprint(const Stroke& st)
+{
+    std::vector<glm::vec3> pts;
+    pts.reserve(st.points.size() + 1);
+    for (const StrokePoint& p : st.points) pts.push_back(p.position);
+    if (st.closed && pts.size() > 2) pts.push_back(pts.front());
+    return bytes_hash(pts.data(), pts.size() * sizeof(glm::vec3));
+}
 
 // Panel geometry (metres) and poke thresholds. A fingertip presses a button when it reaches
 // kPressDepth in front of the board (or goes through it) inside the button, having come from
@@ -224,6 +235,7 @@ struct VrSession::Impl {
     // The lobe being deformed live (app/live_pinch.h): which grown item shows it, and the
     // regrowth generation whose items those are.
     LivePinchView live_pinch;
+    LiveTransformView live_transform; ///< the lobe being moved, turned or scaled live, with its strokes
     std::optional<std::size_t> live_shown;
     std::uint64_t live_shown_generation = 0;
 
@@ -255,7 +267,8 @@ struct VrSession::Impl {
     void document_changed();
     void request_regrowth();
     void take_regrowth(std::optional<RegrowResult> result);
-    void update_live_pinch();
+    void update_live_edits();
+    void refresh_stroke_item(const Stroke& stroke);
     void rebuild_stroke_items();
     void update_ground_area();
     void autosave();
@@ -301,7 +314,7 @@ void VrSession::Impl::frame(const HandFrame& input)
     grab_scene(f);
 
     if (options.background_regrowth) take_regrowth(worker->take());
-    update_live_pinch();
+    update_live_edits();
     report_autosave_failures();
     last_frame = f;
     update_status();
@@ -539,24 +552,51 @@ void VrSession::Impl::take_regrowth(std::optional<RegrowResult> result)
     update_ground_area();
 }
 
-void VrSession::Impl::update_live_pinch()
+void VrSession::Impl::update_live_edits()
 {
     const std::uint64_t have = built ? built->generation : 0;
-    const bool changed =
-        live_pinch.update(pipeline, builder(), built ? &built->tree.lobes : nullptr, have, requested_generation);
-    // A new regrowth result brought its own lobe items: the deformed lobe goes into them again.
+    const std::vector<BuiltLobe>* lobes = built ? &built->tree.lobes : nullptr;
+    const bool pinched = live_pinch.update(pipeline, builder(), lobes, have, requested_generation);
+    const bool moved = live_transform.update(pipeline, builder(), lobes, have, requested_generation);
+    // A new regrowth result brought its own lobe items: the edited lobe goes into them again.
     const bool fresh = have != live_shown_generation;
-    if (!changed && !fresh) return;
+    if (moved) {
+        // A moved lobe's strokes: as dragged, or the document's again once the drag is over.
+        if (!live_transform.strokes().empty()) {
+            for (const Stroke& st : live_transform.strokes()) refresh_stroke_item(st);
+        } else {
+            const std::vector<std::int64_t>& ids = live_transform.moved_stroke_ids();
+            for (const Stroke& st : effective_strokes(document()))
+                if (std::find(ids.begin(), ids.end(), st.id) != ids.end()) refresh_stroke_item(st);
+        }
+    }
+    if (!pinched && !moved && !fresh) return;
     RenderScene& scene = self.scene_;
     if (live_shown && !fresh && built && *live_shown < built->tree.lobes.size())
         replace_lobe_item(scene, *live_shown, built->tree.lobes[*live_shown].mesh);
     live_shown.reset();
     live_shown_generation = have;
     if (!built) return;
-    for (std::size_t i = 0; i < built->tree.lobes.size(); ++i)
-        if (const TriangleMesh* m = live_pinch.mesh_for(built->tree.lobes[i].lobe_id, pipeline, have, requested_generation)) {
+    for (std::size_t i = 0; i < built->tree.lobes.size(); ++i) {
+        const std::int64_t id = built->tree.lobes[i].lobe_id;
+        const TriangleMesh* m = live_pinch.mesh_for(id, pipeline, have, requested_generation);
+        if (!m) m = live_transform.mesh_for(id, have, requested_generation);
+        if (m) {
             if (replace_lobe_item(scene, i, *m)) live_shown = i;
             break;
+        }
+    }
+}
+
+void VrSession::Impl::refresh_stroke_item(const Stroke& stroke)
+{
+    // The tube and the fingerprint rebuild_stroke_items keeps for it, so that the next
+    // rebuild makes the tube again exactly when the document's points differ from these.
+    for (std::size_t i = 0; i < stroke_tubes.size(); ++i)
+        if (stroke_tubes[i].id == stroke.id && grown_items + i < self.scene_.items.size()) {
+            if (!replace_stroke_item(self.scene_, stroke)) return;
+            stroke_tubes[i].fingerprint = stroke_fingerprint(stroke);
+            return;
         }
 }
 
@@ -572,12 +612,10 @@ void VrSession::Impl::rebuild_stroke_items()
     scene.items.resize(grown_items);
     stroke_tubes.clear();
     stroke_bounds = Bounds{};
-    for (const Stroke& st : effective_strokes(document())) {
-        std::vector<glm::vec3> pts;
-        pts.reserve(st.points.size() + 1);
-        for (const StrokePoint& p : st.points) pts.push_back(p.position);
-        if (st.closed && pts.size() > 2) pts.push_back(pts.front());
-        const std::uint64_t fingerprint = bytes_hash(pts.data(), pts.size() * sizeof(glm::vec3));
+    std::vector<Stroke> strokes = effective_strokes(document());
+    live_transform.apply_to(strokes); // a lobe being moved shows its strokes where it is dragged
+    for (const Stroke& st : strokes) {
+        const std::uint64_t fingerprint = stroke_fingerprint(st);
         const auto it = old.find(st.id);
         RenderItem item;
         if (it != old.end() && it->second.first == fingerprint) item = std::move(it->second.second);

@@ -449,10 +449,13 @@ bool SessionBuilder::add_drag(const InputAction& a)
     return true;
 }
 
-std::int64_t SessionBuilder::lobe_at(const glm::dvec3& point) const
+std::int64_t SessionBuilder::lobe_at(const glm::dvec3& point) const { return lobe_drag_target(point).lobe; }
+
+SessionBuilder::LobeDragTarget SessionBuilder::lobe_drag_target(const glm::dvec3& point) const
 {
     const LobePick pick = pick_lobe(doc_, view(), point, pick_.lobe_pick_distance_m, hooks_);
-    return pick.lobe ? pick.lobe->id : 0;
+    if (!pick.lobe) return {};
+    return {pick.lobe->id, pick.centre};
 }
 
 bool SessionBuilder::apply(const InputAction& a)

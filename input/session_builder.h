@@ -103,6 +103,13 @@ public:
     /// (document space) edits: the one whose strokes are nearest among those it is near or
     /// inside, as a completed drag picks it. 0 when none.
     std::int64_t lobe_at(const glm::dvec3& point) const;
+    /// What a lobe-tool drag starting at `point` picks: the lobe (lobe_at; 0 when none) and
+    /// the centre a move, rotate or scale drag records, about which it turns and scales it.
+    struct LobeDragTarget {
+        std::int64_t lobe = 0;
+        glm::dvec3 centre{0.0};
+    };
+    LobeDragTarget lobe_drag_target(const glm::dvec3& point) const;
     /// Warnings (one line each) about drags that edited nothing, in order.
     const std::vector<std::string>& messages() const { return messages_; }
 

@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <thread>
 
@@ -311,6 +312,120 @@ TEST(DesktopSession, PinchDeformedLobeFollowsTheFingertipFrameByFrameAndKeepsIts
     ASSERT_EQ(after->geometry.positions.size(), dragged.positions.size());
     EXPECT_LT(largest_move(after->geometry, dragged), 0.001);
     EXPECT_GT(largest_move(after->geometry, before), 0.01);
+}
+
+/// The scene's tubes of the document's strokes, by item key.
+std::map<std::uint64_t, SurfaceGeometry> stroke_items(const DesktopSession& s)
+{
+    std::map<std::uint64_t, SurfaceGeometry> out;
+    for (const RenderItem& item : s.scene().items)
+        if (item.material == RenderMaterial::Stroke && (item.key >> 56) == 4) // 4: tree_render_scene's stroke items
+            out.emplace(item.key, item.geometry);
+    return out;
+}
+
+/// The largest distance of a vertex of `b` from where `a`'s moved by `t` (same vertex count).
+double largest_miss(const SurfaceGeometry& a, const SurfaceGeometry& b, const glm::vec3& t)
+{
+    EXPECT_EQ(a.positions.size(), b.positions.size());
+    double most = 0.0;
+    for (std::size_t v = 0; v < std::min(a.positions.size(), b.positions.size()); ++v)
+        most = std::max(most, double(glm::distance(a.positions[v] + t, b.positions[v])));
+    return most;
+}
+
+TEST(DesktopSession, MovedLobeAndItsStrokesFollowTheFingertipFrameByFrameAndStayWhereReleased)
+{
+    DesktopSession s(Document{}, quiet_options());
+    Driver d{s};
+    d.move(320, 180);
+    d.circle(320, 180, 60);
+    d.drag(480, 300, 680, 300, 8, desktop_keys::kMouseRight);
+    d.circle(320, 180, 60);
+    d.drag(480, 300, 680, 300, 8, desktop_keys::kMouseRight);
+    d.circle(320, 180, 60);
+    s.wait_for_regrowth();
+    d.step();
+    ASSERT_EQ(s.document().lobes.size(), 1u);
+    ASSERT_NE(lobe_item(s), nullptr);
+    const SurfaceGeometry before = lobe_item(s)->geometry;
+    const auto strokes_before = stroke_items(s);
+    ASSERT_EQ(strokes_before.size(), 3u);
+
+    d.press(keys::kMoveLobe);
+    d.move(320, 180);
+    s.mouse_button(desktop_keys::kMouseLeft, true);
+    d.step(6);
+    ASSERT_TRUE(s.status().drawing);
+    double last = 0.0;
+    for (int i = 1; i <= 12; ++i) {
+        d.move(320.0f + 2.0f * float(i), 180.0f);
+        const RenderItem* item = lobe_item(s);
+        ASSERT_NE(item, nullptr);
+        // Every vertex of the lobe and of its strokes moved by one vector, further each frame.
+        const glm::vec3 t = item->geometry.positions[0] - before.positions[0];
+        EXPECT_LT(largest_miss(before, item->geometry, t), 1e-4) << "frame " << i;
+        for (const auto& [key, tube] : stroke_items(s)) {
+            ASSERT_TRUE(strokes_before.count(key));
+            EXPECT_LT(largest_miss(strokes_before.at(key), tube, t), 1e-4) << "frame " << i;
+        }
+        EXPECT_GE(double(glm::length(t)), last) << "frame " << i;
+        last = double(glm::length(t));
+    }
+    EXPECT_GT(last, 0.01);
+    EXPECT_TRUE(s.document().edits.empty()) << "the edit is made at release";
+    d.step(6); // held still: the fingertip filter catches up with the cursor
+    const SurfaceGeometry dragged = lobe_item(s)->geometry;
+    const auto strokes_dragged = stroke_items(s);
+    s.mouse_button(desktop_keys::kMouseLeft, false);
+    d.step(6);
+    ASSERT_EQ(s.document().edits.size(), 1u) << s.status().last_message;
+    EXPECT_EQ(s.document().edits[0].type, "drag:move-lobe");
+    // After the release the lobe and strokes are the ones built with the finished edit:
+    // where the drag left them.
+    const RenderItem* after = lobe_item(s);
+    ASSERT_NE(after, nullptr);
+    EXPECT_LT(largest_miss(dragged, after->geometry, glm::vec3(0.0f)), 0.001);
+    for (const auto& [key, tube] : stroke_items(s)) EXPECT_LT(largest_miss(strokes_dragged.at(key), tube, glm::vec3(0.0f)), 0.001);
+    EXPECT_GT(largest_move(after->geometry, before), 0.01);
+}
+
+TEST(DesktopSession, TurnedAndScaledLobesShowLiveWhatTheFinishedEditBuilds)
+{
+    for (const int tool : {keys::kRotateLobe, keys::kScaleLobe}) {
+        SCOPED_TRACE(tool == keys::kRotateLobe ? "rotate" : "scale");
+        DesktopSession s(Document{}, quiet_options());
+        Driver d{s};
+        d.move(320, 180);
+        d.circle(320, 180, 60);
+        d.drag(480, 300, 680, 300, 8, desktop_keys::kMouseRight);
+        d.circle(320, 180, 60);
+        s.wait_for_regrowth();
+        d.step();
+        ASSERT_NE(lobe_item(s), nullptr);
+        const SurfaceGeometry before = lobe_item(s)->geometry;
+        const auto strokes_before = stroke_items(s);
+
+        d.press(tool);
+        d.move(380, 180); // on the rim: a lever arm of about the lobe's radius
+        s.mouse_button(desktop_keys::kMouseLeft, true);
+        d.step(6);
+        for (int i = 1; i <= 10; ++i) d.move(380.0f + 2.0f * float(i), 180.0f - 3.0f * float(i));
+        d.step(30); // held still: the fingertip filter catches up with the cursor
+        EXPECT_TRUE(s.document().edits.empty()) << "the edit is made at release";
+        const SurfaceGeometry dragged = lobe_item(s)->geometry;
+        const auto strokes_dragged = stroke_items(s);
+        EXPECT_GT(largest_move(dragged, before), 0.01) << "the lobe is shown turned or scaled while dragged";
+        for (const auto& [key, tube] : strokes_dragged) EXPECT_GT(largest_move(tube, strokes_before.at(key)), 0.005);
+        s.mouse_button(desktop_keys::kMouseLeft, false);
+        d.step(6);
+        ASSERT_EQ(s.document().edits.size(), 1u) << s.status().last_message;
+        EXPECT_EQ(s.document().edits[0].type, tool == keys::kRotateLobe ? "drag:rotate-lobe" : "drag:scale-lobe");
+        // As shown at the last frame of the drag, up to the few tenths of a millimetre the
+        // fingertip moves while the pinch opens (a scale's lever arm multiplies them).
+        EXPECT_LT(largest_miss(dragged, lobe_item(s)->geometry, glm::vec3(0.0f)), 0.002);
+        for (const auto& [key, tube] : stroke_items(s)) EXPECT_LT(largest_miss(strokes_dragged.at(key), tube, glm::vec3(0.0f)), 0.002);
+    }
 }
 
 TEST(DesktopSession, RecordingReplaysToTheSameDocument)

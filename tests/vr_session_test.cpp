@@ -268,6 +268,73 @@ TEST(VrSession, PinchDeformedLobeRisesWithTheFingertipWhileDraggedAndStaysWhereR
     EXPECT_NEAR(lobe_top(s), dragged, 0.002f) << "the lobe built with the finished edit is where the drag left it";
 }
 
+/// The mean of the vertices of the scene's lobe items or of its tubes of the document's
+/// strokes (not the hands' or the panel's items).
+glm::vec3 items_mean(const VrSession& s, RenderMaterial material)
+{
+    glm::dvec3 sum(0.0);
+    std::size_t n = 0;
+    for (const RenderItem& item : s.scene().items)
+        if (item.material == material && (material != RenderMaterial::Stroke || (item.key >> 56) == 4))
+            for (const glm::vec3& p : item.geometry.positions) {
+                sum += glm::dvec3(p);
+                ++n;
+            }
+    return n ? glm::vec3(sum / double(n)) : glm::vec3(0.0f);
+}
+
+TEST(VrSession, MovedLobeAndItsStrokesGoWithTheFingertipWhileDraggedAndStayWhereReleased)
+{
+    VrOptions o;
+    o.background_regrowth = false;
+    VrSession s(Document{}, o);
+    VrScript script([&](const HandFrame& f) { s.frame(f); });
+    const glm::vec3 c = draw_three_loops(script);
+    ASSERT_EQ(s.document().lobes.size(), 1u);
+    const glm::vec3 lobe0 = items_mean(s, RenderMaterial::Lobe);
+    const glm::vec3 strokes0 = items_mean(s, RenderMaterial::Stroke);
+
+    poke(script, s, "MOVE");
+    ASSERT_EQ(s.status().tool, Tool::MoveLobe);
+    script.hand(Hand::Right).pose = HandPose::Open;
+    script.move(Hand::Right, c, 0.5);
+    script.pinch(Hand::Right, true);
+    // 5 cm to the side in five steps: after each the lobe and its strokes have gone as far
+    // again as the fingertip (the drag starts once the pinch is recognised, a little into the
+    // first step), and nothing else moved. Exactly as far as the drag went is checked at the
+    // release, against the path the edit recorded.
+    glm::vec3 first(0.0f);
+    for (int k = 1; k <= 5; ++k) {
+        script.move(Hand::Right, c + glm::vec3(0.01f * float(k), 0, 0), 0.1);
+        script.wait(0.1);
+        const glm::vec3 lobe = items_mean(s, RenderMaterial::Lobe) - lobe0;
+        const glm::vec3 strokes = items_mean(s, RenderMaterial::Stroke) - strokes0;
+        if (k == 1) first = lobe;
+        EXPECT_NEAR(lobe.x - first.x, 0.01f * float(k - 1), 0.005f) << "step " << k; // the tip filter lags a little
+        EXPECT_NEAR(glm::length(lobe - strokes), 0.0f, 1e-4f) << "step " << k << ": the strokes go with the lobe";
+        EXPECT_NEAR(lobe.y, 0.0f, 0.002f);
+        EXPECT_NEAR(lobe.z, 0.0f, 0.002f);
+    }
+    EXPECT_GT(first.x, 0.0f);
+    EXPECT_LE(first.x, 0.012f);
+    EXPECT_EQ(s.document().edits.size(), 0u) << "the edit is made at release";
+    const glm::vec3 lobe_dragged = items_mean(s, RenderMaterial::Lobe);
+    const glm::vec3 strokes_dragged = items_mean(s, RenderMaterial::Stroke);
+    script.pinch(Hand::Right, false);
+    script.wait(0.2);
+    ASSERT_EQ(s.document().edits.size(), 1u);
+    EXPECT_EQ(s.document().edits.back().type, "drag:move-lobe");
+    // The lobe and strokes built with the finished edit are where the drag left them.
+    EXPECT_LT(glm::distance(items_mean(s, RenderMaterial::Lobe), lobe_dragged), 0.002f);
+    EXPECT_LT(glm::distance(items_mean(s, RenderMaterial::Stroke), strokes_dragged), 0.002f);
+    // The edit is the drag as shown: from where the pinch began to where it was released.
+    const nlohmann::json& path = s.document().edits.back().params.at("path");
+    const glm::vec3 from(path.front()[0].get<float>(), path.front()[1].get<float>(), path.front()[2].get<float>());
+    const glm::vec3 to(path.back()[0].get<float>(), path.back()[1].get<float>(), path.back()[2].get<float>());
+    EXPECT_LT(glm::distance(lobe_dragged - lobe0, to - from), 0.001f);
+    EXPECT_GT(glm::distance(items_mean(s, RenderMaterial::Lobe), lobe0), 0.04f);
+}
+
 TEST(VrSession, OffTheFrameThreadTheSceneIsTheOneBuiltInOneGoAndTheAutosaveIsTheLastDocument)
 {
     const fs::path dir = scratch("background");
