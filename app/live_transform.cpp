@@ -94,8 +94,13 @@ bool LiveTransformView::update(const InputPipeline& pipeline, const SessionBuild
         }
     }
     if (live_ && hand_ == *hand) {
+        // The fingertip now: what the release would add as the path's last point (the path
+        // itself keeps a point only every few millimetres).
+        const HandGesture& g = pipeline.gestures().hand(hand_);
         const Stroke& path = pipeline.current_stroke(hand_);
-        const glm::vec3 end = path.points.empty() ? live_->start : path.points.back().position;
+        const glm::vec3 end = g.tracked ? pipeline.scene_transform().to_document(g.index_tip)
+                              : path.points.empty() ? live_->start
+                                                    : path.points.back().position;
         if (end != last_end_) {
             last_end_ = end;
             try {

@@ -3,8 +3,8 @@
 /// The live side of moving, turning and scaling a lobe (docs/editing.md), for the desktop
 /// and VR sessions: while a hand drags under the move, rotate or scale tool, the lobe the
 /// drag started on and its strokes are shown moved by the transform the drag would make if
-/// it were released now (meshing/lobe_transform.h: drag_transform of the path's first and
-/// last points about the centre the drag records). After the release the moved lobe stays on
+/// it were released now (meshing/lobe_transform.h: drag_transform of the path's first point
+/// and the fingertip, which the release adds as its last, about the centre the drag records). After the release the moved lobe stays on
 /// screen until the regrowth that holds the finished edit arrives, so it never jumps back in
 /// between; a drag that edited nothing puts it back at once.
 
