@@ -352,6 +352,14 @@ void DesktopSession::update_live_edits()
     const std::vector<BuiltLobe>* lobes = built_ ? &built_->tree.lobes : nullptr;
     const bool pinch = live_pinch_.update(pipeline_, *builder_, lobes, have, requested_generation_);
     const bool moved = live_transform_.update(pipeline_, *builder_, lobes, have, requested_generation_);
+    if (live_stroke_edit_.update(pipeline_, *builder_)) {
+        // A bent stroke's tube alone; the document's strokes again when the drag is over.
+        const Stroke* bent = live_stroke_edit_.stroke();
+        if (!bent || !replace_stroke_item(scene_, *bent)) {
+            rebuild_static_scene();
+            return;
+        }
+    }
     if (!pinch && !moved) return;
     // Only the lobe's item (and a moved lobe's strokes) change while it is dragged; when the
     // edit ends, the lobes and strokes as built.
@@ -463,6 +471,7 @@ void DesktopSession::rebuild_static_scene()
     status_.tree_triangles = content.tree ? lod_triangles(geometry->lods[std::size_t(content.lod)]) : 0;
     std::vector<Stroke> strokes = effective_strokes(document());
     live_transform_.apply_to(strokes);
+    live_stroke_edit_.apply_to(strokes);
     scene_ = tree_render_scene(*geometry, lobes, strokes, 0.0f, content);
     Bounds area = scene_bounds(scene_);
     if (area.empty()) {

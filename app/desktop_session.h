@@ -20,6 +20,7 @@
 
 #include "app/autosave.h"
 #include "app/live_pinch.h"
+#include "app/live_stroke_edit.h"
 #include "app/live_transform.h"
 #include "app/regrow_worker.h"
 #include "app/renderer.h"
@@ -198,6 +199,7 @@ private:
 
     LivePinchView live_pinch_; ///< the lobe being deformed while the pinch is dragged
     LiveTransformView live_transform_; ///< the lobe being moved, turned or scaled while dragged
+    LiveStrokeEditView live_stroke_edit_; ///< the stroke being bent while dragged
     HandState last_hand_; ///< the simulated hand of the last frame (drawn)
     RenderScene scene_;
     std::size_t static_items_ = 0;

@@ -14,6 +14,7 @@
 #include "app/edit_hooks.h"
 #include "app/export_scene.h"
 #include "app/live_pinch.h"
+#include "app/live_stroke_edit.h"
 #include "app/live_transform.h"
 #include "app/render_scene.h"
 #include "app/scene_parts.h"
@@ -236,6 +237,7 @@ struct VrSession::Impl {
     // regrowth generation whose items those are.
     LivePinchView live_pinch;
     LiveTransformView live_transform; ///< the lobe being moved, turned or scaled live, with its strokes
+    LiveStrokeEditView live_stroke_edit; ///< the stroke being bent live
     std::optional<std::size_t> live_shown;
     std::uint64_t live_shown_generation = 0;
 
@@ -558,6 +560,15 @@ void VrSession::Impl::update_live_edits()
     const std::vector<BuiltLobe>* lobes = built ? &built->tree.lobes : nullptr;
     const bool pinched = live_pinch.update(pipeline, builder(), lobes, have, requested_generation);
     const bool moved = live_transform.update(pipeline, builder(), lobes, have, requested_generation);
+    if (live_stroke_edit.update(pipeline, builder())) {
+        // A bent stroke's tube: as dragged, or the document's again once the drag is over.
+        if (const Stroke* bent = live_stroke_edit.stroke()) {
+            refresh_stroke_item(*bent);
+        } else {
+            for (const Stroke& st : effective_strokes(document()))
+                if (st.id == live_stroke_edit.bent_stroke_id()) refresh_stroke_item(st);
+        }
+    }
     // A new regrowth result brought its own lobe items: the edited lobe goes into them again.
     const bool fresh = have != live_shown_generation;
     if (moved) {
@@ -614,6 +625,7 @@ void VrSession::Impl::rebuild_stroke_items()
     stroke_bounds = Bounds{};
     std::vector<Stroke> strokes = effective_strokes(document());
     live_transform.apply_to(strokes); // a lobe being moved shows its strokes where it is dragged
+    live_stroke_edit.apply_to(strokes);
     for (const Stroke& st : strokes) {
         const std::uint64_t fingerprint = stroke_fingerprint(st);
         const auto it = old.find(st.id);

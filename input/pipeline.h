@@ -118,6 +118,9 @@ public:
         const Pen& pen = pen_[static_cast<int>(hand)];
         return pen.down && pen.drag ? std::optional<Tool>(pen.tool) : std::nullopt;
     }
+    /// While `hand` makes an edit-stroke drag: the other hand's pointing fingertip when it
+    /// started (Drag::other_tip of the drag its release will complete).
+    std::optional<glm::vec3> drag_other_tip(Hand hand) const { return pen_[static_cast<int>(hand)].other_tip; }
 
 private:
     /// The right hand's filtered index tip if it is tracked, else the left hand's.

@@ -374,14 +374,27 @@ void SessionBuilder::snapshot()
 
 bool SessionBuilder::add_drag(const InputAction& a)
 {
-    const Drag& drag = a.drag;
-    const std::string tool = tool_name(drag.tool);
-    auto nothing = [&](const std::string& why) {
+    std::string why;
+    std::optional<EditOperation> op = drag_operation(a.drag, &why);
+    if (!op) {
         char when[96];
-        std::snprintf(when, sizeof when, "%s drag at t=%.2fs edits nothing: ", tool.c_str(),
-                      drag.path.empty() ? a.time : drag.path.front().time);
+        std::snprintf(when, sizeof when, "%s drag at t=%.2fs edits nothing: ", tool_name(a.drag.tool),
+                      a.drag.path.empty() ? a.time : a.drag.path.front().time);
         messages_.push_back(when + why);
         return false;
+    }
+    snapshot();
+    ++next_edit_id_;
+    doc_.edits.push_back(std::move(*op));
+    return true;
+}
+
+std::optional<EditOperation> SessionBuilder::drag_operation(const Drag& drag, std::string* reason) const
+{
+    const std::string tool = tool_name(drag.tool);
+    auto nothing = [&](const std::string& why) -> std::optional<EditOperation> {
+        if (reason) *reason = why;
+        return std::nullopt;
     };
     if (drag.path.empty()) return nothing("it has no points");
     if (drag.tool == Tool::DrawLobe || drag.tool == Tool::DrawTrunk) return nothing("not an editing tool");
@@ -443,10 +456,7 @@ bool SessionBuilder::add_drag(const InputAction& a)
         const std::string why = hooks_.check(doc_, op);
         if (!why.empty()) return nothing(why);
     }
-    snapshot();
-    ++next_edit_id_;
-    doc_.edits.push_back(std::move(op));
-    return true;
+    return op;
 }
 
 std::int64_t SessionBuilder::lobe_at(const glm::dvec3& point) const { return lobe_drag_target(point).lobe; }

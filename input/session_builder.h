@@ -110,6 +110,11 @@ public:
         glm::dvec3 centre{0.0};
     };
     LobeDragTarget lobe_drag_target(const glm::dvec3& point) const;
+    /// The edit operation a completed `drag` would append (what it picks, its parameters, the
+    /// edit hooks' check), without appending it: what the live views show while a drag goes
+    /// on. Nothing, with the one-line reason in `why` when given, where the drag would edit
+    /// nothing.
+    std::optional<EditOperation> drag_operation(const Drag& drag, std::string* why = nullptr) const;
     /// Warnings (one line each) about drags that edited nothing, in order.
     const std::vector<std::string>& messages() const { return messages_; }
 

@@ -1,5 +1,6 @@
 // The desktop app: the simulated hand, the session logic without a window, and the real
 // window under Xvfb driven by a scripted mouse session (docs/desktop.md).
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -425,6 +426,48 @@ TEST(DesktopSession, TurnedAndScaledLobesShowLiveWhatTheFinishedEditBuilds)
         EXPECT_LT(largest_miss(dragged, lobe_item(s)->geometry, glm::vec3(0.0f)), 0.001);
         for (const auto& [key, tube] : stroke_items(s)) EXPECT_LT(largest_miss(strokes_dragged.at(key), tube, glm::vec3(0.0f)), 0.001);
     }
+}
+
+TEST(DesktopSession, BentStrokeFollowsTheFingertipFrameByFrameAndStaysWhereReleased)
+{
+    DesktopSession s(Document{}, quiet_options());
+    Driver d{s};
+    d.move(320, 180);
+    d.circle(320, 180, 60);
+    d.drag(480, 300, 680, 300, 8, desktop_keys::kMouseRight);
+    d.circle(320, 180, 60);
+    s.wait_for_regrowth();
+    d.step();
+    const auto before = stroke_items(s);
+    ASSERT_EQ(before.size(), 2u);
+
+    d.press(keys::kEditStroke);
+    d.move(380, 180); // on a ring: the drag picks it
+    s.mouse_button(desktop_keys::kMouseLeft, true);
+    d.step(6);
+    ASSERT_TRUE(s.status().drawing);
+    double last = 0.0;
+    for (int i = 1; i <= 12; ++i) {
+        d.move(380.0f + 2.0f * float(i), 180.0f);
+        // One stroke bends further each frame; the other stays where it was.
+        std::vector<double> moved;
+        for (const auto& [key, tube] : stroke_items(s)) moved.push_back(largest_move(tube, before.at(key)));
+        ASSERT_EQ(moved.size(), 2u);
+        std::sort(moved.begin(), moved.end());
+        EXPECT_EQ(moved[0], 0.0) << "frame " << i;
+        EXPECT_GE(moved[1], last) << "frame " << i;
+        last = moved[1];
+    }
+    EXPECT_GT(last, 0.01);
+    EXPECT_TRUE(s.document().edits.empty()) << "the edit is made at release";
+    d.step(6);
+    const auto dragged = stroke_items(s);
+    s.mouse_button(desktop_keys::kMouseLeft, false);
+    d.step(6);
+    ASSERT_EQ(s.document().edits.size(), 1u) << s.status().last_message;
+    EXPECT_EQ(s.document().edits[0].type, "drag:edit-stroke");
+    // The document's stroke, bent by the finished edit, is where the drag left it.
+    for (const auto& [key, tube] : stroke_items(s)) EXPECT_LT(largest_miss(dragged.at(key), tube, glm::vec3(0.0f)), 0.001);
 }
 
 TEST(DesktopSession, RecordingReplaysToTheSameDocument)
