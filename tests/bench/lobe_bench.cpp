@@ -9,6 +9,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "meshing/edit_ops.h"
 #include "meshing/lobe.h"
 #include "meshing/lobe_cache.h"
 #include "meshing/lobe_document.h"
@@ -204,5 +205,43 @@ void BM_LivePinchFrame(benchmark::State& state)
     state.counters["lobe_vertices"] = static_cast<double>(lobe->mesh.positions.size());
 }
 BENCHMARK(BM_LivePinchFrame)->Arg(8)->Arg(30)->Unit(benchmark::kMillisecond);
+
+} // namespace
+
+namespace {
+
+/// A stroke bend shown live (app/live_stroke_edit.h, as the desktop and VR sessions run it
+/// every frame while the fingertip moves): the document's effective strokes with the drag's
+/// operation appended, on table1-4lobes-22strokes (22 strokes, 4 lobes); the bend picks a
+/// point of its first stroke and pulls it up to 4 cm out and back.
+void BM_LiveStrokeEditFrame(benchmark::State& state)
+{
+    const Document doc = test::replay_document("table1-4lobes-22strokes");
+    if (doc.strokes.empty() || doc.strokes.front().points.size() < 20) {
+        state.SkipWithError("the recording has no usable stroke");
+        return;
+    }
+    const Stroke& target = doc.strokes.front();
+    const glm::vec3 from = target.points[10].position;
+    Document with = doc;
+    EditOperation op;
+    op.id = 1000000;
+    op.type = edit_type::kEditStroke;
+    op.target = target.id;
+    op.params = {{"hand", "right"}, {"pick_distance_m", 0.03}, {"half_length_m", 0.08}};
+    with.edits.push_back(op);
+    std::size_t frame = 0;
+    std::size_t points = 0;
+    for (const Stroke& s : doc.strokes) points += s.points.size();
+    for (auto _ : state) {
+        const float t = 0.04f * static_cast<float>(std::sin(static_cast<double>(frame++ % 180) * 3.14159265358979 / 180.0));
+        const glm::vec3 to = from + glm::vec3(0.0f, t, 0.0f);
+        with.edits.back().params["path"] = nlohmann::json::array({{from.x, from.y, from.z, 0.0}, {to.x, to.y, to.z, 1.0}});
+        benchmark::DoNotOptimize(effective_strokes(with).data());
+    }
+    state.counters["strokes"] = static_cast<double>(doc.strokes.size());
+    state.counters["points"] = static_cast<double>(points);
+}
+BENCHMARK(BM_LiveStrokeEditFrame)->Unit(benchmark::kMillisecond);
 
 } // namespace
