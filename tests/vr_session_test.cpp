@@ -335,6 +335,49 @@ TEST(VrSession, MovedLobeAndItsStrokesGoWithTheFingertipWhileDraggedAndStayWhere
     EXPECT_GT(glm::distance(items_mean(s, RenderMaterial::Lobe), lobe0), 0.04f);
 }
 
+/// The farthest reach along +z of the scene's tubes of the document's strokes.
+float strokes_front(const VrSession& s)
+{
+    float front = -1e9f;
+    for (const RenderItem& item : s.scene().items)
+        if (item.material == RenderMaterial::Stroke && (item.key >> 56) == 4)
+            for (const glm::vec3& p : item.geometry.positions) front = std::max(front, p.z);
+    return front;
+}
+
+TEST(VrSession, BentStrokeGoesWithTheFingertipWhileDraggedAndStaysWhereReleased)
+{
+    VrOptions o;
+    o.background_regrowth = false;
+    VrSession s(Document{}, o);
+    VrScript script([&](const HandFrame& f) { s.frame(f); });
+    const glm::vec3 c = draw_three_loops(script);
+    const float front0 = strokes_front(s);
+    EXPECT_NEAR(front0, c.z + 0.12f, 0.01f);
+
+    poke(script, s, "BEND");
+    ASSERT_EQ(s.status().tool, Tool::EditStroke);
+    script.hand(Hand::Right).pose = HandPose::Open;
+    script.move(Hand::Right, c + glm::vec3(0, 0, 0.12f), 0.5);
+    script.pinch(Hand::Right, true);
+    // Out 4 cm in four steps: after each the bent loop reaches about as far as the fingertip.
+    float last = front0;
+    for (int k = 1; k <= 4; ++k) {
+        script.move(Hand::Right, c + glm::vec3(0, 0, 0.12f + 0.01f * float(k)), 0.1);
+        script.wait(0.1);
+        const float front = strokes_front(s);
+        EXPECT_GT(front, last) << "step " << k;
+        EXPECT_NEAR(front, front0 + 0.01f * float(k), 0.006f) << "step " << k; // the tip filter lags a little
+        last = front;
+    }
+    EXPECT_EQ(s.document().edits.size(), 0u) << "the edit is made at release";
+    script.pinch(Hand::Right, false);
+    script.wait(0.2);
+    ASSERT_EQ(s.document().edits.size(), 1u);
+    EXPECT_EQ(s.document().edits.back().type, "drag:edit-stroke");
+    EXPECT_NEAR(strokes_front(s), last, 0.002f) << "the stroke bent by the finished edit is where the drag left it";
+}
+
 TEST(VrSession, OffTheFrameThreadTheSceneIsTheOneBuiltInOneGoAndTheAutosaveIsTheLastDocument)
 {
     const fs::path dir = scratch("background");
