@@ -348,6 +348,12 @@ void DesktopSession::frame(double time, int width, int height)
 
 void DesktopSession::update_live_edits()
 {
+    // The lobes and the tree follow an editing drag at the regrowth's pace; when it ends
+    // without an edit, the document's own are grown again.
+    DragPreview::Step preview = drag_preview_.update(pipeline_, *builder_, !worker_->has_waiting());
+    if (preview.preview) submit_preview(std::move(*preview.preview));
+    else if (preview.ended && preview_generation_ > requested_generation_) request_regrowth();
+
     const std::uint64_t have = built_ ? built_->generation : 0;
     const std::vector<BuiltLobe>* lobes = built_ ? &built_->tree.lobes : nullptr;
     const bool pinch = live_pinch_.update(pipeline_, *builder_, lobes, have, requested_generation_);
@@ -440,13 +446,23 @@ void DesktopSession::wait_for_regrowth()
     take_regrowth(worker_->wait_for(requested_generation_));
 }
 
+void DesktopSession::submit_preview(Document doc)
+{
+    preview_generation_ = worker_->submit(std::move(doc), grown_);
+    if (!options_.background_regrowth) take_regrowth(worker_->wait_for(preview_generation_));
+}
+
 void DesktopSession::take_regrowth(std::optional<RegrowResult> result)
 {
     if (!result) return;
     if (built_ && result->generation < built_->generation) return;
-    status_.tree_error = result->error;
-    if (!result->error.empty()) note("tree: " + result->error);
-    for (const std::string& w : result->tree.warnings) note(w);
+    // A drag preview's (asked for after the last change of the document) is shown, but what
+    // it reports is the document's only once the drag made its edit.
+    if (result->generation <= requested_generation_) {
+        status_.tree_error = result->error;
+        if (!result->error.empty()) note("tree: " + result->error);
+        for (const std::string& w : result->tree.warnings) note(w);
+    }
     built_ = std::move(result);
     rebuild_static_scene();
 }

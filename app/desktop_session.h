@@ -19,6 +19,7 @@
 #include <glm/vec3.hpp>
 
 #include "app/autosave.h"
+#include "app/drag_preview.h"
 #include "app/live_pinch.h"
 #include "app/live_stroke_edit.h"
 #include "app/live_transform.h"
@@ -159,6 +160,7 @@ private:
     void take_regrowth(std::optional<RegrowResult> result);
     void rebuild_static_scene();
     void update_live_edits();
+    void submit_preview(Document doc);
     /// The lobe shown in place of lobe `lobe_id` while it is edited live (pinched, moved); null: the built one.
     const TriangleMesh* live_lobe(std::int64_t lobe_id) const;
     void add_dynamic_items();
@@ -200,6 +202,8 @@ private:
     LivePinchView live_pinch_; ///< the lobe being deformed while the pinch is dragged
     LiveTransformView live_transform_; ///< the lobe being moved, turned or scaled while dragged
     LiveStrokeEditView live_stroke_edit_; ///< the stroke being bent while dragged
+    DragPreview drag_preview_; ///< the document as an editing drag would leave it, regrown while it goes on
+    std::uint64_t preview_generation_ = 0; ///< the regrowth last asked for a drag preview
     HandState last_hand_; ///< the simulated hand of the last frame (drawn)
     RenderScene scene_;
     std::size_t static_items_ = 0;

@@ -39,6 +39,12 @@ std::uint64_t RegrowWorker::submit(Document doc, bool grow_tree)
     return generation;
 }
 
+bool RegrowWorker::has_waiting()
+{
+    std::lock_guard<std::mutex> lock(mutex_);
+    return pending_.has_value();
+}
+
 std::optional<RegrowResult> RegrowWorker::take()
 {
     std::lock_guard<std::mutex> lock(mutex_);

@@ -44,6 +44,9 @@ public:
     /// growth. With `grow_tree` false only the lobes are built (the result's tree has lobes,
     /// no growth, and its geometry no LOD): the sketching stages before the tree is grown.
     std::uint64_t submit(Document doc, bool grow_tree = true);
+    /// True while a submission waits for the worker to start on it (a newer one would replace
+    /// it): the interactive apps' drag previews are not made then.
+    bool has_waiting();
     /// The newest finished result newer than the last one taken, if any. Never blocks on growth.
     std::optional<RegrowResult> take();
     /// Waits until the result of `generation` (or a newer one) is ready; for tests and batch use.

@@ -13,6 +13,7 @@
 #include "app/autosave.h"
 #include "app/edit_hooks.h"
 #include "app/export_scene.h"
+#include "app/drag_preview.h"
 #include "app/live_pinch.h"
 #include "app/live_stroke_edit.h"
 #include "app/live_transform.h"
@@ -238,6 +239,8 @@ struct VrSession::Impl {
     LivePinchView live_pinch;
     LiveTransformView live_transform; ///< the lobe being moved, turned or scaled live, with its strokes
     LiveStrokeEditView live_stroke_edit; ///< the stroke being bent live
+    DragPreview drag_preview; ///< the document as an editing drag would leave it, regrown while it goes on
+    std::uint64_t preview_generation = 0; ///< the regrowth last asked for a drag preview
     std::optional<std::size_t> live_shown;
     std::uint64_t live_shown_generation = 0;
 
@@ -268,6 +271,7 @@ struct VrSession::Impl {
     void grab_scene(const HandFrame& f);
     void document_changed();
     void request_regrowth();
+    void submit_preview(Document doc);
     void take_regrowth(std::optional<RegrowResult> result);
     void update_live_edits();
     void refresh_stroke_item(const Stroke& stroke);
@@ -529,13 +533,23 @@ void VrSession::Impl::request_regrowth()
     if (!options.background_regrowth) take_regrowth(worker->wait_for(requested_generation));
 }
 
+void VrSession::Impl::submit_preview(Document doc)
+{
+    preview_generation = worker->submit(std::move(doc), grown);
+    if (!options.background_regrowth) take_regrowth(worker->wait_for(preview_generation));
+}
+
 void VrSession::Impl::take_regrowth(std::optional<RegrowResult> result)
 {
     if (!result) return;
     if (built && result->generation < built->generation) return;
-    self.status_.tree_error = result->error;
-    if (!result->error.empty()) note("tree: " + result->error);
-    for (const std::string& w : result->tree.warnings) note(w);
+    // A drag preview's (asked for after the last change of the document) is shown, but what
+    // it reports is the document's only once the drag made its edit.
+    if (result->generation <= requested_generation) {
+        self.status_.tree_error = result->error;
+        if (!result->error.empty()) note("tree: " + result->error);
+        for (const std::string& w : result->tree.warnings) note(w);
+    }
     RenderScene& scene = self.scene_;
     // The regrowth's items, made on the worker (prepare_grown_scene), replace the old ones;
     // the strokes' items stay as they are.
@@ -556,6 +570,12 @@ void VrSession::Impl::take_regrowth(std::optional<RegrowResult> result)
 
 void VrSession::Impl::update_live_edits()
 {
+    // The lobes and the tree follow an editing drag at the regrowth's pace; when it ends
+    // without an edit, the document's own are grown again.
+    DragPreview::Step preview = drag_preview.update(pipeline, builder(), !worker->has_waiting());
+    if (preview.preview) submit_preview(std::move(*preview.preview));
+    else if (preview.ended && preview_generation > requested_generation) request_regrowth();
+
     const std::uint64_t have = built ? built->generation : 0;
     const std::vector<BuiltLobe>* lobes = built ? &built->tree.lobes : nullptr;
     const bool pinched = live_pinch.update(pipeline, builder(), lobes, have, requested_generation);

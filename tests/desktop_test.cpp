@@ -470,6 +470,67 @@ TEST(DesktopSession, BentStrokeFollowsTheFingertipFrameByFrameAndStaysWhereRelea
     for (const auto& [key, tube] : stroke_items(s)) EXPECT_LT(largest_miss(dragged.at(key), tube, glm::vec3(0.0f)), 0.001);
 }
 
+/// The mean of the vertices of the scene's items of `material`.
+glm::dvec3 items_mean(const DesktopSession& s, RenderMaterial material)
+{
+    glm::dvec3 sum(0.0);
+    std::size_t n = 0;
+    for (const RenderItem& item : s.scene().items)
+        if (item.material == material)
+            for (const glm::vec3& p : item.geometry.positions) {
+                sum += glm::dvec3(p);
+                ++n;
+            }
+    return n ? sum / double(n) : glm::dvec3(0.0);
+}
+
+TEST(DesktopSession, TheTreeRegrowsIntoALobeWhileItIsDraggedAndTheDocumentGetsOnlyTheFinishedEdit)
+{
+    DesktopSession s(Document{}, quiet_options());
+    Driver d{s};
+    d.move(320, 180);
+    d.circle(320, 180, 60);
+    d.drag(480, 300, 680, 300, 8, desktop_keys::kMouseRight);
+    d.circle(320, 180, 60);
+    d.press(keys::kDrawTrunk);
+    d.drag(320, 335, 320, 244, 30);
+    d.press(keys::kGrow);
+    s.wait_for_regrowth();
+    d.step();
+    ASSERT_TRUE(s.status().grown);
+    const std::size_t edits = s.document().edits.size();
+    const std::string doc_before = document_to_json(s.document()).dump();
+    const glm::dvec3 lobe0 = items_mean(s, RenderMaterial::Lobe), leaves0 = items_mean(s, RenderMaterial::Leaf);
+    ASSERT_NE(leaves0, glm::dvec3(0.0));
+
+    d.press(keys::kMoveLobe);
+    d.move(320, 180);
+    s.mouse_button(desktop_keys::kMouseLeft, true);
+    d.step(6);
+    for (int i = 1; i <= 12; ++i) d.move(320.0f + 3.0f * float(i), 180.0f);
+    d.step(6);
+    // Before the release: the leaves grew again in the moved lobe, about as far over as it
+    // went, and the document has no new edit yet.
+    const glm::dvec3 moved = items_mean(s, RenderMaterial::Lobe) - lobe0;
+    const glm::dvec3 leaves = items_mean(s, RenderMaterial::Leaf) - leaves0;
+    EXPECT_GT(glm::length(moved), 0.02);
+    EXPECT_GT(glm::dot(leaves, moved), 0.5 * glm::dot(moved, moved)) << "the crown follows the lobe while it is dragged";
+    EXPECT_EQ(document_to_json(s.document()).dump(), doc_before);
+    EXPECT_EQ(s.status().last_message.find("tree:"), std::string::npos);
+    const glm::dvec3 leaves_dragged = items_mean(s, RenderMaterial::Leaf);
+    s.mouse_button(desktop_keys::kMouseLeft, false);
+    d.step(6);
+    ASSERT_EQ(s.document().edits.size(), edits + 1);
+    EXPECT_EQ(s.document().edits.back().type, "drag:move-lobe");
+    EXPECT_LT(glm::length(items_mean(s, RenderMaterial::Leaf) - leaves_dragged), 0.01);
+
+    // A drag that edits nothing (it starts far from every lobe) leaves the tree as it was.
+    const glm::dvec3 leaves_kept = items_mean(s, RenderMaterial::Leaf);
+    d.drag(40, 40, 60, 60, 10);
+    EXPECT_EQ(s.document().edits.size(), edits + 1);
+    EXPECT_LT(glm::length(items_mean(s, RenderMaterial::Leaf) - leaves_kept), 1e-6);
+}
+
 TEST(DesktopSession, RecordingReplaysToTheSameDocument)
 {
     const std::string dir = temp_dir("desktop_replay");

@@ -1,0 +1,44 @@
+#include "app/drag_preview.h"
+
+#include <glm/geometric.hpp>
+
+namespace lobe {
+
+DragPreview::Step DragPreview::update(const InputPipeline& pipeline, const SessionBuilder& builder, bool may_preview)
+{
+    Step step;
+    std::optional<Hand> hand;
+    for (Hand h : {Hand::Right, Hand::Left})
+        if (pipeline.drag_tool(h)) hand = h;
+    if (!hand || (active_ && *hand != hand_)) {
+        // Released (or the other hand took over): the session regrows its own document.
+        step.ended = active_ && previewed_;
+        active_ = previewed_ = false;
+        last_tip_.reset();
+        if (!hand) return step;
+    }
+    if (!active_) {
+        active_ = true;
+        hand_ = *hand;
+    }
+    const Stroke& path = pipeline.current_stroke(hand_);
+    if (!may_preview || path.points.empty()) return step;
+    // The fingertip now: what the release adds as the path's last point.
+    const HandGesture& g = pipeline.gestures().hand(hand_);
+    const glm::vec3 tip = g.tracked ? pipeline.scene_transform().to_document(g.index_tip) : path.points.back().position;
+    if (glm::distance(last_tip_.value_or(path.points.front().position), tip) < kMinMoveM) return step;
+    Drag drag;
+    drag.tool = *pipeline.drag_tool(hand_);
+    drag.hand = hand_;
+    drag.path = {path.points.front(), StrokePoint{tip, path.points.back().time}};
+    drag.other_tip = pipeline.drag_other_tip(hand_);
+    std::optional<EditOperation> op = builder.drag_operation(drag);
+    if (!op) return step;
+    last_tip_ = tip;
+    previewed_ = true;
+    step.preview = builder.document();
+    step.preview->edits.push_back(std::move(*op));
+    return step;
+}
+
+} // namespace lobe
