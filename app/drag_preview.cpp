@@ -2,14 +2,15 @@
 
 #include <glm/geometric.hpp>
 
+#include "app/drag_hand.h"
+
 namespace lobe {
 
 DragPreview::Step DragPreview::update(const InputPipeline& pipeline, const SessionBuilder& builder, bool may_preview)
 {
     Step step;
-    std::optional<Hand> hand;
-    for (Hand h : {Hand::Right, Hand::Left})
-        if (pipeline.drag_tool(h)) hand = h;
+    const std::optional<Hand> hand = dragging_hand(pipeline, active_ ? std::optional<Hand>(hand_) : std::nullopt,
+                                                   [](std::optional<Tool> t) { return t.has_value(); });
     if (!hand || (active_ && *hand != hand_)) {
         // Released (or the other hand took over): the session regrows its own document.
         step.ended = active_ && previewed_;

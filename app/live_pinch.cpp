@@ -1,5 +1,6 @@
 #include "app/live_pinch.h"
 
+#include "app/drag_hand.h"
 #include "core/errors.h"
 
 namespace lobe {
@@ -13,9 +14,8 @@ bool LivePinchView::update(const InputPipeline& pipeline, const SessionBuilder& 
                            const std::vector<BuiltLobe>* lobes, std::uint64_t built_generation,
                            std::uint64_t requested_generation)
 {
-    std::optional<Hand> hand;
-    for (Hand h : {Hand::Right, Hand::Left})
-        if (pipeline.drag_tool(h) == Tool::DeformLobe) hand = h;
+    const std::optional<Hand> hand = dragging_hand(pipeline, in_drag_ ? std::optional<Hand>(hand_) : std::nullopt,
+                                                   [](std::optional<Tool> t) { return t == Tool::DeformLobe; });
     if (!hand) {
         in_drag_ = false;
         // Released: the deformed lobe stays until a regrowth with the finished edit is in

@@ -2,6 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/drag_hand.h"
 #include "meshing/edit_ops.h"
 
 namespace lobe {
@@ -14,9 +15,8 @@ nlohmann::json path_point(const glm::vec3& p, double t) { return nlohmann::json:
 
 bool LiveStrokeEditView::update(const InputPipeline& pipeline, const SessionBuilder& builder)
 {
-    std::optional<Hand> hand;
-    for (Hand h : {Hand::Right, Hand::Left})
-        if (pipeline.drag_tool(h) == Tool::EditStroke) hand = h;
+    const std::optional<Hand> hand = dragging_hand(pipeline, in_drag_ ? std::optional<Hand>(hand_) : std::nullopt,
+                                                   [](std::optional<Tool> t) { return t == Tool::EditStroke; });
     if (!hand) {
         if (!in_drag_) return false;
         // Released: the document's stroke again (bent when the edit was made).

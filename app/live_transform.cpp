@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "app/drag_hand.h"
 #include "core/errors.h"
 #include "meshing/edit_ops.h"
 
@@ -36,9 +37,8 @@ bool LiveTransformView::update(const InputPipeline& pipeline, const SessionBuild
                                const std::vector<BuiltLobe>* lobes, std::uint64_t built_generation,
                                std::uint64_t requested_generation)
 {
-    std::optional<Hand> hand;
-    for (Hand h : {Hand::Right, Hand::Left})
-        if (kind_of(pipeline.drag_tool(h))) hand = h;
+    const std::optional<Hand> hand = dragging_hand(pipeline, in_drag_ ? std::optional<Hand>(hand_) : std::nullopt,
+                                                   [](std::optional<Tool> t) { return kind_of(t).has_value(); });
     if (!hand) {
         bool changed = false;
         if (in_drag_) {
