@@ -457,11 +457,14 @@ void DesktopSession::take_regrowth(std::optional<RegrowResult> result)
     if (!result) return;
     if (built_ && result->generation < built_->generation) return;
     // A drag preview's (asked for after the last change of the document) is shown, but what
-    // it reports is the document's only once the drag made its edit.
+    // it reports is the document's only once the drag made its edit: until then the status
+    // line alone says it, the message list keeps nothing of it.
     if (result->generation <= requested_generation_) {
         status_.tree_error = result->error;
         if (!result->error.empty()) note("tree: " + result->error);
         for (const std::string& w : result->tree.warnings) note(w);
+    } else if (!result->error.empty() || !result->tree.warnings.empty()) {
+        status_.last_message = "if released here: " + (result->error.empty() ? result->tree.warnings.front() : "tree: " + result->error);
     }
     built_ = std::move(result);
     rebuild_static_scene();

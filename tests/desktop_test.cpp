@@ -531,6 +531,30 @@ TEST(DesktopSession, TheTreeRegrowsIntoALobeWhileItIsDraggedAndTheDocumentGetsOn
     EXPECT_LT(glm::length(items_mean(s, RenderMaterial::Leaf) - leaves_kept), 1e-6);
 }
 
+TEST(DesktopSession, ADragThatWouldBreakALobeSaysSoWhileItGoesOnAndLeavesTheMessagesToTheDocument)
+{
+    DesktopSession s(Document{}, quiet_options());
+    Driver d{s};
+    d.move(320, 180);
+    d.circle(320, 180, 60);
+    d.drag(480, 300, 680, 300, 8, desktop_keys::kMouseRight);
+    d.circle(320, 180, 60);
+    s.wait_for_regrowth();
+    d.step();
+    const std::size_t messages = s.messages().size();
+
+    // Bend a point of a ring into the lobe's centre: a stroke through the centre cannot join.
+    d.press(keys::kEditStroke);
+    d.move(380, 180);
+    s.mouse_button(desktop_keys::kMouseLeft, true);
+    d.step(6);
+    for (int i = 1; i <= 15; ++i) d.move(380.0f - 4.0f * float(i), 180.0f);
+    d.step(6);
+    EXPECT_EQ(s.status().last_message.rfind("if released here: ", 0), 0u) << s.status().last_message;
+    EXPECT_EQ(s.messages().size(), messages) << "nothing of a preview goes to the message list";
+    EXPECT_TRUE(s.document().edits.empty());
+}
+
 TEST(DesktopSession, RecordingReplaysToTheSameDocument)
 {
     const std::string dir = temp_dir("desktop_replay");
