@@ -263,26 +263,40 @@ double largest_move(const SurfaceGeometry& a, const SurfaceGeometry& b)
     return most;
 }
 
+/// `rings` loops drawn around one lobe, the view turned between them, and its lobe built.
+void draw_rings(Driver& d, int rings)
+{
+    d.move(320, 180);
+    for (int k = 0; k < rings; ++k) {
+        if (k > 0) d.drag(480, 300, 680, 300, 8, desktop_keys::kMouseRight);
+        d.circle(320, 180, 60);
+    }
+    d.s.wait_for_regrowth();
+    d.step();
+}
+
+/// Picks `tool` and pinches at (x, y), until the pinch is recognised (a few frames after the
+/// button goes down).
+void start_drag(Driver& d, int tool, float x, float y)
+{
+    d.press(tool);
+    d.move(x, y);
+    d.s.mouse_button(desktop_keys::kMouseLeft, true);
+    d.step(6);
+    ASSERT_TRUE(d.s.status().drawing);
+}
+
 TEST(DesktopSession, PinchDeformedLobeFollowsTheFingertipFrameByFrameAndKeepsItsShapeAtRelease)
 {
     DesktopSession s(Document{}, quiet_options());
     Driver d{s};
-    d.move(320, 180);
-    d.circle(320, 180, 60);
-    d.drag(480, 300, 680, 300, 8, desktop_keys::kMouseRight);
-    d.circle(320, 180, 60);
-    s.wait_for_regrowth();
-    d.step();
+    draw_rings(d, 2);
     ASSERT_EQ(s.document().lobes.size(), 1u);
     ASSERT_NE(lobe_item(s), nullptr);
     const SurfaceGeometry before = lobe_item(s)->geometry;
 
-    d.press(keys::kDeformLobe);
     // Pinch on the second ring's rim (on the lobe) and pull outwards, frame by frame.
-    d.move(380, 180);
-    s.mouse_button(desktop_keys::kMouseLeft, true);
-    d.step(6); // the pinch is recognised a few frames after the button goes down
-    ASSERT_TRUE(s.status().drawing);
+    start_drag(d, keys::kDeformLobe, 380, 180);
     const glm::vec3 start = s.status().tip;
     double last = 0.0;
     for (int i = 1; i <= 12; ++i) {
@@ -339,25 +353,14 @@ TEST(DesktopSession, MovedLobeAndItsStrokesFollowTheFingertipFrameByFrameAndStay
 {
     DesktopSession s(Document{}, quiet_options());
     Driver d{s};
-    d.move(320, 180);
-    d.circle(320, 180, 60);
-    d.drag(480, 300, 680, 300, 8, desktop_keys::kMouseRight);
-    d.circle(320, 180, 60);
-    d.drag(480, 300, 680, 300, 8, desktop_keys::kMouseRight);
-    d.circle(320, 180, 60);
-    s.wait_for_regrowth();
-    d.step();
+    draw_rings(d, 3);
     ASSERT_EQ(s.document().lobes.size(), 1u);
     ASSERT_NE(lobe_item(s), nullptr);
     const SurfaceGeometry before = lobe_item(s)->geometry;
     const auto strokes_before = stroke_items(s);
     ASSERT_EQ(strokes_before.size(), 3u);
 
-    d.press(keys::kMoveLobe);
-    d.move(320, 180);
-    s.mouse_button(desktop_keys::kMouseLeft, true);
-    d.step(6);
-    ASSERT_TRUE(s.status().drawing);
+    start_drag(d, keys::kMoveLobe, 320, 180);
     double last = 0.0;
     for (int i = 1; i <= 12; ++i) {
         d.move(320.0f + 2.0f * float(i), 180.0f);
@@ -397,20 +400,12 @@ TEST(DesktopSession, TurnedAndScaledLobesShowLiveWhatTheFinishedEditBuilds)
         SCOPED_TRACE(tool == keys::kRotateLobe ? "rotate" : "scale");
         DesktopSession s(Document{}, quiet_options());
         Driver d{s};
-        d.move(320, 180);
-        d.circle(320, 180, 60);
-        d.drag(480, 300, 680, 300, 8, desktop_keys::kMouseRight);
-        d.circle(320, 180, 60);
-        s.wait_for_regrowth();
-        d.step();
+        draw_rings(d, 2);
         ASSERT_NE(lobe_item(s), nullptr);
         const SurfaceGeometry before = lobe_item(s)->geometry;
         const auto strokes_before = stroke_items(s);
 
-        d.press(tool);
-        d.move(380, 180); // on the rim: a lever arm of about the lobe's radius
-        s.mouse_button(desktop_keys::kMouseLeft, true);
-        d.step(6);
+        start_drag(d, tool, 380, 180); // on the rim: a lever arm of about the lobe's radius
         for (int i = 1; i <= 10; ++i) d.move(380.0f + 2.0f * float(i), 180.0f - 3.0f * float(i));
         d.step(30); // held still: the fingertip filter catches up with the cursor
         EXPECT_TRUE(s.document().edits.empty()) << "the edit is made at release";
@@ -432,20 +427,11 @@ TEST(DesktopSession, BentStrokeFollowsTheFingertipFrameByFrameAndStaysWhereRelea
 {
     DesktopSession s(Document{}, quiet_options());
     Driver d{s};
-    d.move(320, 180);
-    d.circle(320, 180, 60);
-    d.drag(480, 300, 680, 300, 8, desktop_keys::kMouseRight);
-    d.circle(320, 180, 60);
-    s.wait_for_regrowth();
-    d.step();
+    draw_rings(d, 2);
     const auto before = stroke_items(s);
     ASSERT_EQ(before.size(), 2u);
 
-    d.press(keys::kEditStroke);
-    d.move(380, 180); // on a ring: the drag picks it
-    s.mouse_button(desktop_keys::kMouseLeft, true);
-    d.step(6);
-    ASSERT_TRUE(s.status().drawing);
+    start_drag(d, keys::kEditStroke, 380, 180); // on a ring: the drag picks it
     double last = 0.0;
     for (int i = 1; i <= 12; ++i) {
         d.move(380.0f + 2.0f * float(i), 180.0f);
@@ -503,10 +489,7 @@ TEST(DesktopSession, TheTreeRegrowsIntoALobeWhileItIsDraggedAndTheDocumentGetsOn
     const glm::dvec3 lobe0 = items_mean(s, RenderMaterial::Lobe), leaves0 = items_mean(s, RenderMaterial::Leaf);
     ASSERT_NE(leaves0, glm::dvec3(0.0));
 
-    d.press(keys::kMoveLobe);
-    d.move(320, 180);
-    s.mouse_button(desktop_keys::kMouseLeft, true);
-    d.step(6);
+    start_drag(d, keys::kMoveLobe, 320, 180);
     for (int i = 1; i <= 12; ++i) d.move(320.0f + 3.0f * float(i), 180.0f);
     d.step(6);
     // Before the release: the leaves grew again in the moved lobe, about as far over as it
@@ -535,19 +518,11 @@ TEST(DesktopSession, ADragThatWouldBreakALobeSaysSoWhileItGoesOnAndLeavesTheMess
 {
     DesktopSession s(Document{}, quiet_options());
     Driver d{s};
-    d.move(320, 180);
-    d.circle(320, 180, 60);
-    d.drag(480, 300, 680, 300, 8, desktop_keys::kMouseRight);
-    d.circle(320, 180, 60);
-    s.wait_for_regrowth();
-    d.step();
+    draw_rings(d, 2);
     const std::size_t messages = s.messages().size();
 
     // Bend a point of a ring into the lobe's centre: a stroke through the centre cannot join.
-    d.press(keys::kEditStroke);
-    d.move(380, 180);
-    s.mouse_button(desktop_keys::kMouseLeft, true);
-    d.step(6);
+    start_drag(d, keys::kEditStroke, 380, 180);
     for (int i = 1; i <= 15; ++i) d.move(380.0f - 4.0f * float(i), 180.0f);
     d.step(6);
     EXPECT_EQ(s.status().last_message.rfind("if released here: ", 0), 0u) << s.status().last_message;

@@ -227,22 +227,52 @@ glm::vec3 draw_three_loops(VrScript& script)
     return c;
 }
 
-/// The highest point of the scene's lobe item (one lobe).
-float lobe_top(const VrSession& s)
+/// The vertices of the scene's items of `material` that show the document: its lobes or its
+/// strokes' tubes (not the hands, the panel or its labels, whose keys start with 10).
+std::vector<glm::vec3> scene_points(const VrSession& s, RenderMaterial material)
 {
-    float top = -1e9f;
+    std::vector<glm::vec3> out;
     for (const RenderItem& item : s.scene().items)
-        if (item.material == RenderMaterial::Lobe)
-            for (const glm::vec3& p : item.geometry.positions) top = std::max(top, p.y);
-    return top;
+        if (item.material == material && (item.key >> 56) != 10)
+            out.insert(out.end(), item.geometry.positions.begin(), item.geometry.positions.end());
+    return out;
 }
+
+/// The farthest reach of those vertices along `axis` (0: x, 1: y, 2: z).
+float farthest(const VrSession& s, RenderMaterial material, int axis)
+{
+    float most = -1e9f;
+    for (const glm::vec3& p : scene_points(s, material)) most = std::max(most, p[axis]);
+    return most;
+}
+
+/// Their mean.
+glm::vec3 items_mean(const VrSession& s, RenderMaterial material)
+{
+    glm::dvec3 sum(0.0);
+    const std::vector<glm::vec3> points = scene_points(s, material);
+    for (const glm::vec3& p : points) sum += glm::dvec3(p);
+    return points.empty() ? glm::vec3(0.0f) : glm::vec3(sum / double(points.size()));
+}
+
+/// A VR session that regrows on the frame thread, and the script that drives it.
+struct ScriptedVr {
+    VrSession s{Document{}, [] {
+                    VrOptions o;
+                    o.background_regrowth = false;
+                    return o;
+                }()};
+    VrScript script{[this](const HandFrame& f) { s.frame(f); }};
+};
+
+/// The highest point of the scene's lobe (one lobe).
+float lobe_top(const VrSession& s) { return farthest(s, RenderMaterial::Lobe, 1); }
 
 TEST(VrSession, PinchDeformedLobeRisesWithTheFingertipWhileDraggedAndStaysWhereReleased)
 {
-    VrOptions o;
-    o.background_regrowth = false;
-    VrSession s(Document{}, o);
-    VrScript script([&](const HandFrame& f) { s.frame(f); });
+    ScriptedVr vr;
+    VrSession& s = vr.s;
+    VrScript& script = vr.script;
     const glm::vec3 c = draw_three_loops(script);
     ASSERT_EQ(s.document().lobes.size(), 1u);
     const float top0 = lobe_top(s);
@@ -268,27 +298,11 @@ TEST(VrSession, PinchDeformedLobeRisesWithTheFingertipWhileDraggedAndStaysWhereR
     EXPECT_NEAR(lobe_top(s), dragged, 0.002f) << "the lobe built with the finished edit is where the drag left it";
 }
 
-/// The mean of the vertices of the scene's lobe items or of its tubes of the document's
-/// strokes (not the hands' or the panel's items).
-glm::vec3 items_mean(const VrSession& s, RenderMaterial material)
-{
-    glm::dvec3 sum(0.0);
-    std::size_t n = 0;
-    for (const RenderItem& item : s.scene().items)
-        if (item.material == material && (material != RenderMaterial::Stroke || (item.key >> 56) == 4))
-            for (const glm::vec3& p : item.geometry.positions) {
-                sum += glm::dvec3(p);
-                ++n;
-            }
-    return n ? glm::vec3(sum / double(n)) : glm::vec3(0.0f);
-}
-
 TEST(VrSession, MovedLobeAndItsStrokesGoWithTheFingertipWhileDraggedAndStayWhereReleased)
 {
-    VrOptions o;
-    o.background_regrowth = false;
-    VrSession s(Document{}, o);
-    VrScript script([&](const HandFrame& f) { s.frame(f); });
+    ScriptedVr vr;
+    VrSession& s = vr.s;
+    VrScript& script = vr.script;
     const glm::vec3 c = draw_three_loops(script);
     ASSERT_EQ(s.document().lobes.size(), 1u);
     const glm::vec3 lobe0 = items_mean(s, RenderMaterial::Lobe);
@@ -335,24 +349,13 @@ TEST(VrSession, MovedLobeAndItsStrokesGoWithTheFingertipWhileDraggedAndStayWhere
     EXPECT_GT(glm::distance(items_mean(s, RenderMaterial::Lobe), lobe0), 0.04f);
 }
 
-/// The farthest reach along +z of the scene's tubes of the document's strokes.
-float strokes_front(const VrSession& s)
-{
-    float front = -1e9f;
-    for (const RenderItem& item : s.scene().items)
-        if (item.material == RenderMaterial::Stroke && (item.key >> 56) == 4)
-            for (const glm::vec3& p : item.geometry.positions) front = std::max(front, p.z);
-    return front;
-}
-
 TEST(VrSession, BentStrokeGoesWithTheFingertipWhileDraggedAndStaysWhereReleased)
 {
-    VrOptions o;
-    o.background_regrowth = false;
-    VrSession s(Document{}, o);
-    VrScript script([&](const HandFrame& f) { s.frame(f); });
+    ScriptedVr vr;
+    VrSession& s = vr.s;
+    VrScript& script = vr.script;
     const glm::vec3 c = draw_three_loops(script);
-    const float front0 = strokes_front(s);
+    const float front0 = farthest(s, RenderMaterial::Stroke, 2);
     EXPECT_NEAR(front0, c.z + 0.12f, 0.01f);
 
     poke(script, s, "BEND");
@@ -365,7 +368,7 @@ TEST(VrSession, BentStrokeGoesWithTheFingertipWhileDraggedAndStaysWhereReleased)
     for (int k = 1; k <= 4; ++k) {
         script.move(Hand::Right, c + glm::vec3(0, 0, 0.12f + 0.01f * float(k)), 0.1);
         script.wait(0.1);
-        const float front = strokes_front(s);
+        const float front = farthest(s, RenderMaterial::Stroke, 2);
         EXPECT_GT(front, last) << "step " << k;
         EXPECT_NEAR(front, front0 + 0.01f * float(k), 0.006f) << "step " << k; // the tip filter lags a little
         last = front;
@@ -375,7 +378,7 @@ TEST(VrSession, BentStrokeGoesWithTheFingertipWhileDraggedAndStaysWhereReleased)
     script.wait(0.2);
     ASSERT_EQ(s.document().edits.size(), 1u);
     EXPECT_EQ(s.document().edits.back().type, "drag:edit-stroke");
-    EXPECT_NEAR(strokes_front(s), last, 0.002f) << "the stroke bent by the finished edit is where the drag left it";
+    EXPECT_NEAR(farthest(s, RenderMaterial::Stroke, 2), last, 0.002f) << "the stroke bent by the finished edit is where the drag left it";
 }
 
 TEST(VrSession, OffTheFrameThreadTheSceneIsTheOneBuiltInOneGoAndTheAutosaveIsTheLastDocument)
