@@ -5,7 +5,7 @@
 /// is shown bent as the drag would bend it if it were released now: the operation the
 /// session builder would append (SessionBuilder::drag_operation, from the path's first point
 /// to the fingertip), applied to the document as every edit is (meshing/edit_ops.h). The
-/// lobe through the stroke follows with the regrowth after the release.
+/// lobe through the stroke follows at the regrowth thread's pace (drag_preview.h).
 
 #include <cstdint>
 #include <optional>
