@@ -212,6 +212,19 @@ BENCHMARK(BM_LivePinchFrame)->Arg(8)->Arg(30)->Unit(benchmark::kMillisecond);
 
 namespace {
 
+/// A stroke-edit operation on `stroke` that picks its 11th point and lifts it by `lift` metres.
+EditOperation bend_operation(const Stroke& stroke, float lift)
+{
+    const glm::vec3 from = stroke.points[10].position, to = from + glm::vec3(0.0f, lift, 0.0f);
+    EditOperation op;
+    op.id = 1000000;
+    op.type = edit_type::kEditStroke;
+    op.target = stroke.id;
+    op.params = {{"hand", "right"}, {"pick_distance_m", 0.03}, {"half_length_m", 0.08}};
+    op.params["path"] = nlohmann::json::array({{from.x, from.y, from.z, 0.0}, {to.x, to.y, to.z, 1.0}});
+    return op;
+}
+
 /// A stroke bend shown live (app/live_stroke_edit.h, as the desktop and VR sessions run it
 /// every frame while the fingertip moves): the document's effective strokes with the drag's
 /// operation appended, on table1-4lobes-22strokes (22 strokes, 4 lobes); the bend picks a
@@ -223,27 +236,52 @@ void BM_LiveStrokeEditFrame(benchmark::State& state)
         state.SkipWithError("the recording has no usable stroke");
         return;
     }
-    const Stroke& target = doc.strokes.front();
-    const glm::vec3 from = target.points[10].position;
     Document with = doc;
-    EditOperation op;
-    op.id = 1000000;
-    op.type = edit_type::kEditStroke;
-    op.target = target.id;
-    op.params = {{"hand", "right"}, {"pick_distance_m", 0.03}, {"half_length_m", 0.08}};
-    with.edits.push_back(op);
+    with.edits.push_back(bend_operation(doc.strokes.front(), 0.0f));
     std::size_t frame = 0;
     std::size_t points = 0;
     for (const Stroke& s : doc.strokes) points += s.points.size();
     for (auto _ : state) {
         const float t = 0.04f * static_cast<float>(std::sin(static_cast<double>(frame++ % 180) * 3.14159265358979 / 180.0));
-        const glm::vec3 to = from + glm::vec3(0.0f, t, 0.0f);
-        with.edits.back().params["path"] = nlohmann::json::array({{from.x, from.y, from.z, 0.0}, {to.x, to.y, to.z, 1.0}});
+        with.edits.back() = bend_operation(doc.strokes.front(), t);
         benchmark::DoNotOptimize(effective_strokes(with).data());
     }
     state.counters["strokes"] = static_cast<double>(doc.strokes.size());
     state.counters["points"] = static_cast<double>(points);
 }
 BENCHMARK(BM_LiveStrokeEditFrame)->Unit(benchmark::kMillisecond);
+
+/// What the regrowth thread does with the lobes for each preview of a stroke bend
+/// (app/drag_preview.h): table1-4lobes-22strokes with a bend of one lobe stroke that changes
+/// from one preview to the next, built with the kept build of the previews before it. Arg 0:
+/// the first stroke of its lobe (the lobe joined again from its first stroke); arg 1: the
+/// last (only that stroke joined again).
+void BM_LobesWhileBendingAStroke(benchmark::State& state)
+{
+    const Document doc = test::replay_document("table1-4lobes-22strokes");
+    const LobeRecord* lobe = nullptr;
+    for (const LobeRecord& l : doc.lobes)
+        if (!lobe && l.stroke_ids.size() >= 2) lobe = &l;
+    const Stroke* target = nullptr;
+    const std::int64_t id = lobe ? (state.range(0) ? lobe->stroke_ids.back() : lobe->stroke_ids.front()) : 0;
+    for (const Stroke& s : doc.strokes)
+        if (s.id == id) target = &s;
+    if (!target || target->points.size() < 20) {
+        state.SkipWithError("the recording has no usable lobe stroke");
+        return;
+    }
+    LobeBuildCache cache;
+    Document with = doc;
+    with.edits.push_back(bend_operation(*target, 0.0f));
+    build_document_lobes(with, nullptr, cache);
+    std::size_t frame = 0;
+    for (auto _ : state) {
+        with.edits.back() = bend_operation(*target, 0.002f * static_cast<float>(1 + frame++ % 20));
+        benchmark::DoNotOptimize(build_document_lobes(with, nullptr, cache).size());
+    }
+    state.counters["lobe_strokes"] = static_cast<double>(lobe->stroke_ids.size());
+    state.counters["lobes_built"] = static_cast<double>(cache.last_build().built + cache.last_build().continued);
+}
+BENCHMARK(BM_LobesWhileBendingAStroke)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 } // namespace
