@@ -456,15 +456,14 @@ void DesktopSession::take_regrowth(std::optional<RegrowResult> result)
 {
     if (!result) return;
     if (built_ && result->generation < built_->generation) return;
-    // A drag preview's (asked for after the last change of the document) is shown, but what
-    // it reports is the document's only once the drag made its edit: until then the status
-    // line alone says it, the message list keeps nothing of it.
+    // A drag preview's result (asked for after the last change of the document) is shown; what
+    // it reports goes to the status line alone (preview_report).
     if (result->generation <= requested_generation_) {
         status_.tree_error = result->error;
         if (!result->error.empty()) note("tree: " + result->error);
         for (const std::string& w : result->tree.warnings) note(w);
-    } else if (!result->error.empty() || !result->tree.warnings.empty()) {
-        status_.last_message = "if released here: " + (result->error.empty() ? result->tree.warnings.front() : "tree: " + result->error);
+    } else if (std::string report = preview_report(*result); !report.empty()) {
+        status_.last_message = std::move(report);
     }
     built_ = std::move(result);
     rebuild_static_scene();

@@ -3,6 +3,7 @@
 #include <glm/geometric.hpp>
 
 #include "app/drag_hand.h"
+#include "app/regrow_worker.h"
 
 namespace lobe {
 
@@ -24,9 +25,7 @@ DragPreview::Step DragPreview::update(const InputPipeline& pipeline, const Sessi
     }
     const Stroke& path = pipeline.current_stroke(hand_);
     if (!may_preview || path.points.empty()) return step;
-    // The fingertip now: what the release adds as the path's last point.
-    const HandGesture& g = pipeline.gestures().hand(hand_);
-    const glm::vec3 tip = g.tracked ? pipeline.scene_transform().to_document(g.index_tip) : path.points.back().position;
+    const glm::vec3 tip = *drag_end(pipeline, hand_);
     if (glm::distance(last_tip_.value_or(path.points.front().position), tip) < kMinMoveM) return step;
     Drag drag;
     drag.tool = *pipeline.drag_tool(hand_);
@@ -40,6 +39,13 @@ DragPreview::Step DragPreview::update(const InputPipeline& pipeline, const Sessi
     step.preview = builder.document();
     step.preview->edits.push_back(std::move(*op));
     return step;
+}
+
+std::string preview_report(const RegrowResult& result)
+{
+    if (!result.error.empty()) return "if released here: tree: " + result.error;
+    if (!result.tree.warnings.empty()) return "if released here: " + result.tree.warnings.front();
+    return {};
 }
 
 } // namespace lobe

@@ -9,6 +9,7 @@
 /// Nothing of it enters the document, the recording or the autosave.
 
 #include <optional>
+#include <string>
 
 #include <glm/vec3.hpp>
 
@@ -17,6 +18,8 @@
 #include "input/session_builder.h"
 
 namespace lobe {
+
+struct RegrowResult; // app/regrow_worker.h
 
 class DragPreview {
 public:
@@ -38,5 +41,10 @@ private:
     Hand hand_ = Hand::Right;
     std::optional<glm::vec3> last_tip_;
 };
+
+/// What the sessions' status line says of a preview's regrowth: "if released here: " and its
+/// error or first warning; empty when it has neither. The message list keeps nothing of a
+/// preview: what it reports is the document's only once the drag made its edit.
+std::string preview_report(const RegrowResult& result);
 
 } // namespace lobe

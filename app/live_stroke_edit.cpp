@@ -50,10 +50,8 @@ bool LiveStrokeEditView::update(const InputPipeline& pipeline, const SessionBuil
         }
     }
     if (with_ && hand_ == *hand) {
-        // The fingertip now: what the release adds as the path's last point.
-        const HandGesture& g = pipeline.gestures().hand(hand_);
         const Stroke& path = pipeline.current_stroke(hand_);
-        const glm::vec3 end = g.tracked ? pipeline.scene_transform().to_document(g.index_tip) : path.points.back().position;
+        const glm::vec3 end = drag_end(pipeline, hand_).value_or(path.points.front().position);
         if (end != last_end_ || !shown_) {
             last_end_ = end;
             // Only the path's first and last points decide a stroke edit.

@@ -53,7 +53,6 @@ bool LiveTransformView::update(const InputPipeline& pipeline, const SessionBuild
             live_.reset();
             changed = true;
         }
-        if (!live_) transform_ = glm::dmat4(1.0);
         return changed;
     }
     bool changed = false;
@@ -65,7 +64,6 @@ bool LiveTransformView::update(const InputPipeline& pipeline, const SessionBuild
         live_.reset();
         shown_strokes_.clear();
         moved_ids_.clear();
-        transform_ = glm::dmat4(1.0);
         const Stroke& path = pipeline.current_stroke(hand_);
         if (lobes && !path.points.empty()) {
             const glm::vec3 from = path.points.front().position;
@@ -94,13 +92,8 @@ bool LiveTransformView::update(const InputPipeline& pipeline, const SessionBuild
         }
     }
     if (live_ && hand_ == *hand) {
-        // The fingertip now: what the release would add as the path's last point (the path
-        // itself keeps a point only every few millimetres).
-        const HandGesture& g = pipeline.gestures().hand(hand_);
-        const Stroke& path = pipeline.current_stroke(hand_);
-        const glm::vec3 end = g.tracked ? pipeline.scene_transform().to_document(g.index_tip)
-                              : path.points.empty() ? live_->start
-                                                    : path.points.back().position;
+        // Not the path's last point: the path keeps one only every few millimetres.
+        const glm::vec3 end = drag_end(pipeline, hand_).value_or(live_->start);
         if (end != last_end_) {
             last_end_ = end;
             try {
@@ -112,7 +105,6 @@ bool LiveTransformView::update(const InputPipeline& pipeline, const SessionBuild
                 for (Stroke& s : strokes) transform_stroke(s, m);
                 live_->shown = std::move(shown);
                 shown_strokes_ = std::move(strokes);
-                transform_ = m;
                 changed = true;
             } catch (const InvalidInput&) {
                 // A fingertip the transform cannot use: the lobe stays as last shown.

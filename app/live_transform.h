@@ -12,8 +12,6 @@
 #include <optional>
 #include <vector>
 
-#include <glm/mat4x4.hpp>
-
 #include "core/mesh.h"
 #include "input/pipeline.h"
 #include "input/session_builder.h"
@@ -46,8 +44,6 @@ public:
     void apply_to(std::vector<Stroke>& strokes) const;
     /// The ids of the strokes the last drag moved (to put back when it ends).
     const std::vector<std::int64_t>& moved_stroke_ids() const { return moved_ids_; }
-    /// The transform shown now (the identity when none).
-    const glm::dmat4& transform() const { return transform_; }
 
 private:
     struct Live {
@@ -63,7 +59,6 @@ private:
     std::optional<Live> live_;
     std::vector<Stroke> shown_strokes_;
     std::vector<std::int64_t> moved_ids_;
-    glm::dmat4 transform_{1.0};
     Hand hand_ = Hand::Right;
     bool in_drag_ = false;
     glm::vec3 last_end_{0.0f};

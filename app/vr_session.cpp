@@ -543,15 +543,14 @@ void VrSession::Impl::take_regrowth(std::optional<RegrowResult> result)
 {
     if (!result) return;
     if (built && result->generation < built->generation) return;
-    // A drag preview's (asked for after the last change of the document) is shown, but what
-    // it reports is the document's only once the drag made its edit: until then the status
-    // line alone says it, the message list keeps nothing of it.
+    // A drag preview's result (asked for after the last change of the document) is shown; what
+    // it reports goes to the status line alone (preview_report).
     if (result->generation <= requested_generation) {
         self.status_.tree_error = result->error;
         if (!result->error.empty()) note("tree: " + result->error);
         for (const std::string& w : result->tree.warnings) note(w);
-    } else if (!result->error.empty() || !result->tree.warnings.empty()) {
-        self.status_.last_message = "if released here: " + (result->error.empty() ? result->tree.warnings.front() : "tree: " + result->error);
+    } else if (std::string report = preview_report(*result); !report.empty()) {
+        self.status_.last_message = std::move(report);
     }
     RenderScene& scene = self.scene_;
     // The regrowth's items, made on the worker (prepare_grown_scene), replace the old ones;
@@ -583,27 +582,23 @@ void VrSession::Impl::update_live_edits()
     const std::vector<BuiltLobe>* lobes = built ? &built->tree.lobes : nullptr;
     const bool pinched = live_pinch.update(pipeline, builder(), lobes, have, requested_generation);
     const bool moved = live_transform.update(pipeline, builder(), lobes, have, requested_generation);
+    // A bent stroke's tube and a moved lobe's strokes: as dragged, or the document's again
+    // once the drag is over.
+    std::vector<std::int64_t> put_back;
     if (live_stroke_edit.update(pipeline, builder())) {
-        // A bent stroke's tube: as dragged, or the document's again once the drag is over.
-        if (const Stroke* bent = live_stroke_edit.stroke()) {
-            refresh_stroke_item(*bent);
-        } else {
-            for (const Stroke& st : effective_strokes(document()))
-                if (st.id == live_stroke_edit.bent_stroke_id()) refresh_stroke_item(st);
-        }
+        if (const Stroke* bent = live_stroke_edit.stroke()) refresh_stroke_item(*bent);
+        else put_back.push_back(live_stroke_edit.bent_stroke_id());
     }
+    if (moved) {
+        for (const Stroke& st : live_transform.strokes()) refresh_stroke_item(st);
+        if (live_transform.strokes().empty())
+            put_back.insert(put_back.end(), live_transform.moved_stroke_ids().begin(), live_transform.moved_stroke_ids().end());
+    }
+    if (!put_back.empty())
+        for (const Stroke& st : effective_strokes(document()))
+            if (std::find(put_back.begin(), put_back.end(), st.id) != put_back.end()) refresh_stroke_item(st);
     // A new regrowth result brought its own lobe items: the edited lobe goes into them again.
     const bool fresh = have != live_shown_generation;
-    if (moved) {
-        // A moved lobe's strokes: as dragged, or the document's again once the drag is over.
-        if (!live_transform.strokes().empty()) {
-            for (const Stroke& st : live_transform.strokes()) refresh_stroke_item(st);
-        } else {
-            const std::vector<std::int64_t>& ids = live_transform.moved_stroke_ids();
-            for (const Stroke& st : effective_strokes(document()))
-                if (std::find(ids.begin(), ids.end(), st.id) != ids.end()) refresh_stroke_item(st);
-        }
-    }
     if (!pinched && !moved && !fresh) return;
     RenderScene& scene = self.scene_;
     if (live_shown && !fresh && built && *live_shown < built->tree.lobes.size())
