@@ -9,6 +9,7 @@
 
 #include <glm/vec3.hpp>
 
+#include "meshing/lobe_regions.h"
 #include "meshing/lobe_surface.h"
 #include "meshing/sampling.h"
 
@@ -46,6 +47,10 @@ public:
     explicit Lobe(LobeOptions options = {});
 
     /// Adds a raw stroke: sampled, closed when its ends meet, then joined to the surface.
+    /// While the centre stays, every region of the surface that the stroke leaves as it was
+    /// keeps its triangles and vertices bit for bit (keep_unchanged_regions): the surface
+    /// after a stroke depends on the surface before it, so a lobe is the strokes added in
+    /// their order (as LobeBuildCache and a replay both add them).
     void add_stroke(std::int64_t id, const std::vector<glm::vec3>& raw);
     /// Adds an already prepared stroke.
     void add_prepared(LobeStrokeSamples stroke);
@@ -54,6 +59,8 @@ public:
     bool remove_stroke(std::int64_t id);
 
     bool empty() const { return strokes_.empty(); }
+    /// What the last add_stroke / add_prepared kept of the surface before it.
+    const KeptRegions& last_kept() const { return last_kept_; }
     const std::vector<LobeStrokeSamples>& strokes() const { return strokes_; }
     /// The closed surface through every stroke, before remeshing.
     /// \pre !empty()
@@ -66,11 +73,12 @@ public:
     double distance_to(const std::vector<glm::vec3>& points) const;
 
 private:
-    void rebuild(std::vector<LobeStrokeSamples> strokes);
+    void rebuild(std::vector<LobeStrokeSamples> strokes, bool keep_regions);
     LobeOptions options_;
     std::vector<LobeStrokeSamples> strokes_;
     std::optional<LobeSurface> surface_;
     glm::dvec3 centre_{0.0};
+    KeptRegions last_kept_;
 };
 
 } // namespace lobe

@@ -170,7 +170,7 @@ void Lobe::add_prepared(LobeStrokeSamples stroke)
     }
     std::vector<LobeStrokeSamples> next = strokes_;
     next.push_back(std::move(stroke));
-    rebuild(std::move(next));
+    rebuild(std::move(next), true);
 }
 
 bool Lobe::remove_stroke(std::int64_t id)
@@ -184,13 +184,14 @@ bool Lobe::remove_stroke(std::int64_t id)
         strokes_.clear();
         surface_.reset();
         centre_ = glm::dvec3(0.0);
+        last_kept_ = {};
         return true;
     }
-    rebuild(std::move(next));
+    rebuild(std::move(next), false);
     return true;
 }
 
-void Lobe::rebuild(std::vector<LobeStrokeSamples> strokes)
+void Lobe::rebuild(std::vector<LobeStrokeSamples> strokes, bool keep_regions)
 {
     // The centre moves only when the strokes' centroid has drifted away from it: then
     // adding a stroke re-lays only the region around it. When the kept centre cannot see
@@ -219,9 +220,17 @@ void Lobe::rebuild(std::vector<LobeStrokeSamples> strokes)
         centre = centroid;
         surface = build_lobe_surface(strokes, centre, options_.surface);
     }
+    // Regions the stroke did not reach stay as they were (with the centre and the fill
+    // density they were made with): the fill of those regions would otherwise follow the
+    // radius model, which every stroke refits, by up to millimetres, and nothing of the
+    // lobe's remeshing could be kept.
+    KeptRegions kept_regions;
+    if (keep_regions && surface_ && centre == centre_) kept_regions = keep_unchanged_regions(*surface_, surface);
+    else kept_regions.regions = mesh_regions(surface.mesh).count;
     strokes_ = std::move(strokes);
     surface_ = std::move(surface);
     centre_ = centre;
+    last_kept_ = kept_regions;
 }
 
 } // namespace lobe

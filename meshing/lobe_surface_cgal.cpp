@@ -526,12 +526,35 @@ void Builder::build_chains()
             const glm::dvec3 p1(pts[(static_cast<Index>(seg) + 1) % pts.size()]);
             return p0 + t * (p1 - p0);
         };
-        const glm::dvec2 x = plane_[a][static_cast<Index>(c.seg)] +
-                             c.s * (plane_[a][(static_cast<Index>(c.seg) + 1) % plane_[a].size()] -
-                                    plane_[a][static_cast<Index>(c.seg)]);
+        // Where the two segments cross seen from the centre: the direction common to the
+        // planes through the centre and each segment, and on each segment the point in that
+        // direction. Found in 3D rather than in the projection, so that it does not depend on
+        // the pole: a stroke that moves the pole leaves the crossings of other strokes (and
+        // with them the regions they bound) where they were.
+        const glm::dvec3 a0 = lerp3(a, c.seg, 0.0) - centre_, a1 = lerp3(a, c.seg, 1.0) - centre_;
+        const glm::dvec3 b0 = lerp3(b, c.other_seg, 0.0) - centre_, b1 = lerp3(b, c.other_seg, 1.0) - centre_;
+        glm::dvec3 d = glm::cross(glm::cross(a0, a1), glm::cross(b0, b1));
+        auto along = [](const glm::dvec3& p0, const glm::dvec3& p1, const glm::dvec3& dir, double fallback) {
+            // p0 + s (p1 − p0) parallel to dir: cross(p0, dir) + s cross(p1 − p0, dir) = 0.
+            const glm::dvec3 u = glm::cross(p0, dir), w = glm::cross(p1 - p0, dir);
+            const double ww = glm::dot(w, w);
+            const double s = ww > 0.0 ? -glm::dot(u, w) / ww : fallback;
+            return std::isfinite(s) ? std::clamp(s, 0.0, 1.0) : fallback;
+        };
+        double sa = c.s, sb = c.t;
+        const double dl = glm::length(d);
+        if (dl > 1e-12 * glm::length(a1 - a0) * glm::length(b1 - b0) * (glm::length(a0) + glm::length(b0))) {
+            d /= dl;
+            if (glm::dot(d, a0 + a1 + b0 + b1) < 0.0) d = -d;
+            sa = along(a0, a1, d, c.s);
+            sb = along(b0, b1, d, c.t);
+        }
+        c.s = sa; // the chains order crossings along each segment by these
+        c.t = sb;
+        const glm::dvec3 pa = lerp3(a, c.seg, sa), pb = lerp3(b, c.other_seg, sb);
+        const glm::dvec3 mid = 0.5 * (pa + pb);
         Node n;
-        n.dir = glm::normalize(stereo_.to_sphere(x));
-        const glm::dvec3 mid = 0.5 * (lerp3(a, c.seg, c.s) + lerp3(b, c.other_seg, c.t));
+        n.dir = glm::normalize(mid - centre_);
         n.radius = glm::length(mid - centre_);
         n.origin = {LobeVertexKind::Crossing, c.a, -1, c.b};
         c.node = add_node(n);

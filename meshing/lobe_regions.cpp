@@ -1,0 +1,229 @@
+#include "meshing/lobe_regions.h"
+
+#include <algorithm>
+#include <array>
+#include <map>
+#include <numeric>
+#include <tuple>
+
+#include <glm/geometric.hpp>
+
+namespace lobe {
+
+namespace {
+
+using Index = std::size_t;
+using Key3 = std::array<float, 3>;
+using DirectedEdge = RegionStrokeEdge;
+
+Key3 key_of(const glm::vec3& p) { return {p.x, p.y, p.z}; }
+
+/// Whether each vertex lies on a feature edge, and the feature edges as sorted (lower, higher).
+struct Features {
+    std::vector<std::array<int, 2>> edges;
+    std::vector<char> on_vertex;
+
+    explicit Features(const TriangleMesh& mesh) : on_vertex(mesh.positions.size(), 0)
+    {
+        edges.reserve(mesh.feature_edges.size());
+        for (const auto& e : mesh.feature_edges) {
+            edges.push_back({std::min(e[0], e[1]), std::max(e[0], e[1])});
+            on_vertex[static_cast<Index>(e[0])] = on_vertex[static_cast<Index>(e[1])] = 1;
+        }
+        std::sort(edges.begin(), edges.end());
+    }
+    bool has(int a, int b) const
+    {
+        return std::binary_search(edges.begin(), edges.end(), std::array<int, 2>{std::min(a, b), std::max(a, b)});
+    }
+};
+
+MeshRegions regions_of(const TriangleMesh& mesh, const Features& features)
+{
+    const Index nf = mesh.triangles.size();
+    // Every edge with the face it belongs to; the two faces of an edge end up side by side.
+    std::vector<std::array<int, 3>> edges; // (lower, higher, face)
+    edges.reserve(3 * nf);
+    for (Index f = 0; f < nf; ++f) {
+        const auto& t = mesh.triangles[f];
+        for (int k = 0; k < 3; ++k) {
+            const int a = t[static_cast<Index>(k)], b = t[static_cast<Index>((k + 1) % 3)];
+            edges.push_back({std::min(a, b), std::max(a, b), static_cast<int>(f)});
+        }
+    }
+    std::sort(edges.begin(), edges.end());
+    std::vector<int> parent(nf);
+    std::iota(parent.begin(), parent.end(), 0);
+    auto find = [&](int x) {
+        while (parent[static_cast<Index>(x)] != x)
+            x = parent[static_cast<Index>(x)] = parent[static_cast<Index>(parent[static_cast<Index>(x)])];
+        return x;
+    };
+    for (Index i = 0; i + 1 < edges.size(); ++i) {
+        const auto& e = edges[i];
+        const auto& g = edges[i + 1];
+        if (e[0] != g[0] || e[1] != g[1] || features.has(e[0], e[1])) continue;
+        const int a = find(e[2]), b = find(g[2]);
+        if (a != b) parent[static_cast<Index>(std::max(a, b))] = std::min(a, b);
+    }
+    MeshRegions out;
+    out.face_region.assign(nf, -1);
+    std::vector<int> region_of_root(nf, -1);
+    for (Index f = 0; f < nf; ++f) {
+        int& r = region_of_root[static_cast<Index>(find(static_cast<int>(f)))];
+        if (r < 0) r = out.count++;
+        out.face_region[f] = r;
+    }
+    return out;
+}
+
+/// Each region's stroke edges, directed as its triangles run round them, sorted.
+std::vector<std::vector<DirectedEdge>> region_keys(const TriangleMesh& mesh, const Features& features,
+                                                   const MeshRegions& regions)
+{
+    std::vector<std::vector<DirectedEdge>> keys(static_cast<Index>(regions.count));
+    for (Index f = 0; f < mesh.triangles.size(); ++f) {
+        const auto& t = mesh.triangles[f];
+        for (int k = 0; k < 3; ++k) {
+            const int a = t[static_cast<Index>(k)], b = t[static_cast<Index>((k + 1) % 3)];
+            if (!features.has(a, b)) continue;
+            const glm::vec3& p = mesh.positions[static_cast<Index>(a)];
+            const glm::vec3& q = mesh.positions[static_cast<Index>(b)];
+            keys[static_cast<Index>(regions.face_region[f])].push_back({p.x, p.y, p.z, q.x, q.y, q.z});
+        }
+    }
+    for (auto& k : keys) std::sort(k.begin(), k.end());
+    return keys;
+}
+
+} // namespace
+
+MeshRegions mesh_regions(const TriangleMesh& mesh) { return regions_of(mesh, Features(mesh)); }
+
+std::vector<std::vector<RegionStrokeEdge>> region_stroke_edges(const TriangleMesh& mesh, const MeshRegions& regions)
+{
+    return region_keys(mesh, Features(mesh), regions);
+}
+
+KeptRegions keep_unchanged_regions(const LobeSurface& previous, LobeSurface& next)
+{
+    KeptRegions result;
+    const Features next_features(next.mesh);
+    const MeshRegions next_regions = regions_of(next.mesh, next_features);
+    result.regions = next_regions.count;
+    if (previous.centre != next.centre || previous.reference_radius != next.reference_radius ||
+        previous.mesh.triangles.empty())
+        return result;
+    const Features prev_features(previous.mesh);
+    const MeshRegions prev_regions = regions_of(previous.mesh, prev_features);
+    const auto prev_keys = region_keys(previous.mesh, prev_features, prev_regions);
+    const auto next_keys = region_keys(next.mesh, next_features, next_regions);
+    std::map<std::vector<DirectedEdge>, int> prev_by_key;
+    for (Index r = 0; r < prev_keys.size(); ++r)
+        if (!prev_keys[r].empty()) prev_by_key.emplace(prev_keys[r], static_cast<int>(r));
+    std::vector<int> source(static_cast<Index>(next_regions.count), -1); // region of `previous` kept
+    for (Index r = 0; r < next_keys.size(); ++r) {
+        const auto it = next_keys[r].empty() ? prev_by_key.end() : prev_by_key.find(next_keys[r]);
+        if (it == prev_by_key.end()) continue;
+        source[r] = it->second;
+        ++result.kept;
+    }
+    if (result.kept == 0) return result;
+
+    // Vertices on strokes are shared by position: every stroke edge of a kept region is one
+    // of `next` (the keys matched), so its ends are vertices of `next` at the same place.
+    std::vector<std::pair<Key3, int>> on_stroke;
+    for (Index v = 0; v < next.mesh.positions.size(); ++v)
+        if (next_features.on_vertex[v]) on_stroke.emplace_back(key_of(next.mesh.positions[v]), static_cast<int>(v));
+    std::sort(on_stroke.begin(), on_stroke.end());
+
+    // All vertices of both surfaces that the result may use: `next`'s, then `previous`'s
+    // inner vertices of kept regions.
+    struct Vertex {
+        glm::vec3 position;
+        LobeVertexOrigin origin;
+    };
+    std::vector<Vertex> all;
+    all.reserve(next.mesh.positions.size());
+    for (Index v = 0; v < next.mesh.positions.size(); ++v) all.push_back({next.mesh.positions[v], next.origins[v]});
+    std::vector<int> from_previous(previous.mesh.positions.size(), -1);
+    std::vector<std::array<int, 3>> tris;
+    tris.reserve(next.mesh.triangles.size());
+    for (Index f = 0; f < next.mesh.triangles.size(); ++f)
+        if (source[static_cast<Index>(next_regions.face_region[f])] < 0) tris.push_back(next.mesh.triangles[f]);
+    std::vector<char> kept_region(static_cast<Index>(prev_regions.count), 0);
+    for (int r : source)
+        if (r >= 0) kept_region[static_cast<Index>(r)] = 1;
+    for (Index f = 0; f < previous.mesh.triangles.size(); ++f) {
+        if (!kept_region[static_cast<Index>(prev_regions.face_region[f])]) continue;
+        std::array<int, 3> t{};
+        for (int k = 0; k < 3; ++k) {
+            const int v = previous.mesh.triangles[f][static_cast<Index>(k)];
+            int& mapped = from_previous[static_cast<Index>(v)];
+            if (mapped < 0) {
+                const glm::vec3& p = previous.mesh.positions[static_cast<Index>(v)];
+                if (prev_features.on_vertex[static_cast<Index>(v)]) {
+                    const auto it = std::lower_bound(on_stroke.begin(), on_stroke.end(), std::make_pair(key_of(p), -1));
+                    if (it == on_stroke.end() || it->first != key_of(p)) return KeptRegions{next_regions.count, 0, 0};
+                    mapped = it->second;
+                } else {
+                    mapped = static_cast<int>(all.size());
+                    all.push_back({p, previous.origins[static_cast<Index>(v)]});
+                }
+            }
+            t[static_cast<Index>(k)] = mapped;
+        }
+        tris.push_back(t);
+        ++result.kept_triangles;
+    }
+
+    // Canonical order, as build_lobe_surface emits it: stroke vertices in their order, then
+    // interpolated vertices by direction from the centre; only vertices some triangle uses.
+    std::vector<char> used(all.size(), 0);
+    for (const auto& t : tris)
+        for (int v : t) used[static_cast<Index>(v)] = 1;
+    std::vector<int> order;
+    std::vector<std::tuple<double, double, double, float, float, float, int>> fill;
+    for (Index v = 0; v < all.size(); ++v) {
+        if (!used[v]) continue;
+        if (all[v].origin.kind != LobeVertexKind::Fill) {
+            order.push_back(static_cast<int>(v));
+            continue;
+        }
+        const glm::vec3& p = all[v].position;
+        const glm::dvec3 d = glm::normalize(glm::dvec3(p) - next.centre);
+        fill.emplace_back(d.x, d.y, d.z, p.x, p.y, p.z, static_cast<int>(v));
+    }
+    std::sort(fill.begin(), fill.end());
+    for (const auto& f : fill) order.push_back(std::get<6>(f));
+    std::vector<int> new_index(all.size(), -1);
+    LobeSurface out;
+    out.centre = next.centre;
+    out.reference_radius = next.reference_radius;
+    out.paper_strip_triangles = next.paper_strip_triangles;
+    out.crossings = next.crossings;
+    out.mesh.positions.reserve(order.size());
+    out.origins.reserve(order.size());
+    for (int v : order) {
+        new_index[static_cast<Index>(v)] = static_cast<int>(out.mesh.positions.size());
+        out.mesh.positions.push_back(all[static_cast<Index>(v)].position);
+        out.origins.push_back(all[static_cast<Index>(v)].origin);
+    }
+    out.mesh.triangles.reserve(tris.size());
+    for (const auto& t : tris) {
+        const std::array<int, 3> o{new_index[static_cast<Index>(t[0])], new_index[static_cast<Index>(t[1])],
+                                   new_index[static_cast<Index>(t[2])]};
+        const Index first = static_cast<Index>(std::min_element(o.begin(), o.end()) - o.begin());
+        out.mesh.triangles.push_back({o[first], o[(first + 1) % 3], o[(first + 2) % 3]});
+    }
+    std::sort(out.mesh.triangles.begin(), out.mesh.triangles.end());
+    for (const auto& e : next_features.edges) {
+        const int a = new_index[static_cast<Index>(e[0])], b = new_index[static_cast<Index>(e[1])];
+        if (a >= 0 && b >= 0) out.mesh.feature_edges.push_back({std::min(a, b), std::max(a, b)});
+    }
+    std::sort(out.mesh.feature_edges.begin(), out.mesh.feature_edges.end());
+    next = std::move(out);
+    return result;
+}
+
+} // namespace lobe
