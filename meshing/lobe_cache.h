@@ -30,6 +30,9 @@ public:
     /// at the end), and lobes it built from scratch.
     struct Counts {
         std::size_t kept = 0, continued = 0, built = 0;
+        /// Regions of the lobes remeshed by the last build, and regions it took as remeshed
+        /// before (lobe_remesh.h): a stroke added remeshes only the regions it changed.
+        std::size_t regions_remeshed = 0, regions_reused = 0;
     };
     const Counts& last_build() const { return counts_; }
 

@@ -16,6 +16,7 @@
 #include "meshing/edit_ops.h"
 #include "meshing/laplacian_edit.h"
 #include "meshing/lobe_cache.h"
+#include "meshing/lobe_remesh.h"
 #include "meshing/lobe_transform.h"
 #include "meshing/mesh_quality.h"
 #include "meshing/remesh.h"
@@ -179,6 +180,7 @@ struct LobeBuildCache::Impl {
         bool remeshed = false;             ///< mesh / remesh_error are those of `steps`
         TriangleMesh mesh;
         std::string remesh_error;
+        LobeRemeshCache regions;           ///< the regions `mesh` was remeshed from
     };
     std::map<std::int64_t, Entry> lobes;
 };
@@ -239,7 +241,7 @@ std::vector<BuiltLobe> build_lobes(const Document& doc, std::vector<std::string>
         }
         // The kept state of this lobe when its steps begin this lobe's steps (taken out of the
         // cache while it is worked on: an exception leaves no half-made entry behind).
-        Entry work{key, {}, Lobe(options), {}, {}, false, {}, {}};
+        Entry work{key, {}, Lobe(options), {}, {}, false, {}, {}, {}};
         if (cache) {
             const auto it = cache->lobes.find(rec.id);
             if (it != cache->lobes.end() && it->second.key == key && it->second.steps.size() <= steps.size() &&
@@ -287,8 +289,13 @@ std::vector<BuiltLobe> build_lobes(const Document& doc, std::vector<std::string>
         if (remesh.iterations > 0) {
             if (!work.remeshed) {
                 try {
-                    work.mesh = remesh_isotropic(built.surface.mesh, remesh);
+                    LobeRemeshStats stats;
+                    work.mesh = remesh_lobe_surface(built.surface, remesh, cache ? &work.regions : nullptr, &stats);
                     work.remesh_error.clear();
+                    if (counts) {
+                        counts->regions_remeshed += static_cast<std::size_t>(stats.whole ? stats.regions : stats.remeshed);
+                        counts->regions_reused += static_cast<std::size_t>(stats.reused);
+                    }
                 } catch (const InvalidInput& e) {
                     // Too large for the spacing (kMaxRemeshTriangles), or a surface remeshing refuses.
                     work.mesh = TriangleMesh{};

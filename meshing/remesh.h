@@ -29,6 +29,10 @@ struct RemeshOptions {
     /// edges are never flipped, and their vertices end on the input polylines. Whole-mesh
     /// remeshing only (`faces` empty).
     bool relax_feature_edges = false;
+    /// After the rounds, the local repairs of angles under 30° that remeshing with relaxed
+    /// feature edges always makes (free vertices collapsed, free edges flipped; feature edges
+    /// and border edges stay). Whole-mesh remeshing with relax_feature_edges makes them anyway.
+    bool repair_small_angles = false;
     /// Triangle indices to remesh (incremental remeshing of a changed region); empty: all.
     /// The region's border edges are constrained too (split first when longer than the
     /// target), so every vertex outside the region keeps its position.

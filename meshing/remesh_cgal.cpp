@@ -675,6 +675,7 @@ TriangleMesh remesh_isotropic(const TriangleMesh& mesh, const RemeshOptions& opt
                                  CGAL::parameters::number_of_iterations(options.iterations)
                                      .edge_is_constrained_map(ecm)
                                      .protect_constraints(!(options.relax_feature_edges && whole)));
+        if (options.repair_small_angles && options.iterations > 0) improve_small_angles(om, constrained, target);
     }
 
     // The mesh still holds what remeshing deleted (a garbage collection would cost as much as

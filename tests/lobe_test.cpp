@@ -25,6 +25,7 @@
 #include "meshing/edit_ops.h"
 #include "meshing/lobe.h"
 #include "meshing/lobe_document.h"
+#include "meshing/lobe_remesh.h"
 #include "meshing/mesh_quality.h"
 #include "meshing/repair.h"
 #include "meshing/stitch.h"
@@ -190,6 +191,19 @@ TEST(Lobes, EveryShippedRecordingGivesClosedManifoldOutwardLobesThroughEveryStro
             const std::string what = std::string(name) + " lobe " + std::to_string(b.lobe_id);
             expect_valid_lobe(b.surface.mesh, what + " (before remeshing)");
             expect_valid_lobe(b.mesh, what);
+            {
+                // Remeshed region by region (lobe_remesh.h), not as a whole.
+                RemeshOptions o;
+                o.target_edge_length_m = doc.settings.lobes.edge_length_m;
+                o.iterations = static_cast<unsigned>(doc.settings.lobes.remesh_iterations);
+                LobeRemeshStats stats;
+                const TriangleMesh again = remesh_lobe_surface(b.surface, o, nullptr, &stats);
+                EXPECT_FALSE(stats.whole) << what;
+                EXPECT_EQ(stats.remeshed, stats.regions) << what;
+                if (b.edits_applied == 0) {
+                    EXPECT_TRUE(again.positions == b.mesh.positions) << what;
+                }
+            }
             const MeshQuality q = measure_quality(b.mesh);
             // Issue goal: ≥ 95 % of triangles with every angle ≥ 30°, in every lobe. The worst
             // is the kidney lobe, whose stacked loops run 3 cm apart (one target edge) and are

@@ -13,6 +13,7 @@
 #include "meshing/lobe.h"
 #include "meshing/lobe_cache.h"
 #include "meshing/lobe_document.h"
+#include "meshing/lobe_remesh.h"
 #include "meshing/mesh_quality.h"
 #include "meshing/remesh.h"
 #include "tests/bench/cgal_surface_mesh.h"
@@ -125,8 +126,10 @@ void BM_PrepareStroke(benchmark::State& state)
 }
 BENCHMARK(BM_PrepareStroke)->Unit(benchmark::kMillisecond);
 
-/// Remeshing the ten-stroke lobe to 3 cm with the strokes as constraints, as lobes are
-/// remeshed (the default rounds, feature edges split and collapsed along their stroke).
+/// Remeshing the ten-stroke lobe to 3 cm with the strokes as constraints. Arg 0: as lobes
+/// are remeshed, region by region (lobe_remesh.h), every region from scratch; arg 1: the whole
+/// lobe as one mesh with its stroke vertices relaxed along the strokes (remesh_isotropic, what
+/// lobes used before, and what a lobe a region of which cannot be charted still gets).
 void BM_RemeshTenStrokeLobe(benchmark::State& state)
 {
     Lobe lobe;
@@ -136,8 +139,10 @@ void BM_RemeshTenStrokeLobe(benchmark::State& state)
     options.relax_feature_edges = true;
     options.iterations = static_cast<unsigned>(LobeSettings{}.remesh_iterations);
     TriangleMesh out;
+    LobeRemeshStats stats;
     for (auto _ : state) {
-        out = remesh_isotropic(lobe.surface().mesh, options);
+        out = state.range(0) ? remesh_isotropic(lobe.surface().mesh, options)
+                             : remesh_lobe_surface(lobe.surface(), options, nullptr, &stats);
         benchmark::DoNotOptimize(out.positions.data());
     }
     const MeshQuality q = measure_quality(out);
@@ -145,8 +150,38 @@ void BM_RemeshTenStrokeLobe(benchmark::State& state)
     state.counters["out_vertices"] = static_cast<double>(q.vertices);
     state.counters["share_angles_ge_30"] = q.share_all_angles_ge_30;
     state.counters["min_angle_deg"] = q.min_angle_deg;
+    if (!state.range(0)) state.counters["regions"] = static_cast<double>(stats.regions);
 }
-BENCHMARK(BM_RemeshTenStrokeLobe)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_RemeshTenStrokeLobe)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+/// Remeshing the ten-stroke lobe after an eleventh stroke, with the regions remeshed after
+/// the tenth kept (LobeRemeshCache, as the regrowth worker keeps them): only the regions the
+/// stroke changed are remeshed. Arg 0: a ring round the equator, between the two middle rings
+/// (it changes the strip between them); arg 1: the loop tilted by 45° of
+/// BM_AddStrokeToTenStrokeLobe, which crosses every stroke.
+void BM_RemeshAfterEleventhStroke(benchmark::State& state)
+{
+    Lobe lobe;
+    const auto strokes = ten_strokes();
+    for (std::size_t i = 0; i < strokes.size(); ++i) lobe.add_stroke(static_cast<std::int64_t>(i + 1), strokes[i]);
+    RemeshOptions options;
+    options.iterations = static_cast<unsigned>(LobeSettings{}.remesh_iterations);
+    LobeRemeshCache before;
+    remesh_lobe_surface(lobe.surface(), options, &before);
+    lobe.add_stroke(11, state.range(0) ? raw_loop(kCentre, glm::normalize(glm::dvec3(1, 1, 0)), {0, 0, 1}, kRadius, 11)
+                                       : raw_loop(kCentre, {1, 0, 0}, {0, 0, 1}, kRadius, 5));
+    LobeRemeshStats stats;
+    for (auto _ : state) {
+        state.PauseTiming();
+        LobeRemeshCache cache = before;
+        state.ResumeTiming();
+        benchmark::DoNotOptimize(remesh_lobe_surface(lobe.surface(), options, &cache, &stats).positions.data());
+    }
+    state.counters["regions"] = static_cast<double>(stats.regions);
+    state.counters["remeshed"] = static_cast<double>(stats.remeshed);
+    state.counters["kept_by_surface"] = static_cast<double>(lobe.last_kept().kept);
+}
+BENCHMARK(BM_RemeshAfterEleventhStroke)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 /// The same lobe through a plain default CGAL::Polygon_mesh_processing::isotropic_remeshing
 /// call (10 iterations, same target, no constraints) on a CGAL::Surface_mesh, for the
