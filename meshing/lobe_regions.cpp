@@ -18,40 +18,54 @@ using DirectedEdge = RegionStrokeEdge;
 
 Key3 key_of(const glm::vec3& p) { return {p.x, p.y, p.z}; }
 
-/// Whether each vertex lies on a feature edge, and the feature edges as sorted (lower, higher).
-struct Features {
-    std::vector<std::array<int, 2>> edges;
-    std::vector<char> on_vertex;
+/// Edges bucketed by their lower vertex (a counting sort: a vertex has a handful), so that
+/// finding an edge is a scan of a few entries instead of a search in all of them. This runs
+/// twice for every stroke added to a lobe; sorted arrays made the region bookkeeping a third
+/// of the time of adding a stroke.
+struct EdgeBuckets {
+    std::vector<int> start;                   ///< #V + 1
+    std::vector<std::array<int, 2>> entries;  ///< (higher vertex, payload)
 
-    explicit Features(const TriangleMesh& mesh) : on_vertex(mesh.positions.size(), 0)
+    template <class ForEach>
+    EdgeBuckets(Index vertices, Index count, ForEach&& for_each) : start(vertices + 1, 0), entries(count)
     {
-        edges.reserve(mesh.feature_edges.size());
-        for (const auto& e : mesh.feature_edges) {
-            edges.push_back({std::min(e[0], e[1]), std::max(e[0], e[1])});
-            on_vertex[static_cast<Index>(e[0])] = on_vertex[static_cast<Index>(e[1])] = 1;
-        }
-        std::sort(edges.begin(), edges.end());
+        for_each([&](int a, int b, int) { ++start[static_cast<Index>(std::min(a, b)) + 1]; });
+        for (Index i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+        std::vector<int> next(start.begin(), start.end() - 1);
+        for_each([&](int a, int b, int payload) {
+            entries[static_cast<Index>(next[static_cast<Index>(std::min(a, b))]++)] = {std::max(a, b), payload};
+        });
     }
-    bool has(int a, int b) const
+    /// The payload of edge (a, b), or −1.
+    int find(int a, int b) const
     {
-        return std::binary_search(edges.begin(), edges.end(), std::array<int, 2>{std::min(a, b), std::max(a, b)});
+        const Index lo = static_cast<Index>(std::min(a, b));
+        const int hi = std::max(a, b);
+        for (int i = start[lo]; i < start[lo + 1]; ++i)
+            if (entries[static_cast<Index>(i)][0] == hi) return entries[static_cast<Index>(i)][1];
+        return -1;
     }
+};
+
+/// Whether each vertex lies on a feature edge, and whether an edge is one.
+struct Features {
+    std::vector<char> on_vertex;
+    EdgeBuckets edges;
+
+    explicit Features(const TriangleMesh& mesh)
+        : on_vertex(mesh.positions.size(), 0),
+          edges(mesh.positions.size(), mesh.feature_edges.size(), [&](auto&& f) {
+              for (const auto& e : mesh.feature_edges) f(e[0], e[1], 1);
+          })
+    {
+        for (const auto& e : mesh.feature_edges) on_vertex[static_cast<Index>(e[0])] = on_vertex[static_cast<Index>(e[1])] = 1;
+    }
+    bool has(int a, int b) const { return on_vertex[static_cast<Index>(a)] && on_vertex[static_cast<Index>(b)] && edges.find(a, b) >= 0; }
 };
 
 MeshRegions regions_of(const TriangleMesh& mesh, const Features& features)
 {
     const Index nf = mesh.triangles.size();
-    // Every edge with the face it belongs to; the two faces of an edge end up side by side.
-    std::vector<std::array<int, 3>> edges; // (lower, higher, face)
-    edges.reserve(3 * nf);
-    for (Index f = 0; f < nf; ++f) {
-        const auto& t = mesh.triangles[f];
-        for (int k = 0; k < 3; ++k) {
-            const int a = t[static_cast<Index>(k)], b = t[static_cast<Index>((k + 1) % 3)];
-            edges.push_back({std::min(a, b), std::max(a, b), static_cast<int>(f)});
-        }
-    }
-    std::sort(edges.begin(), edges.end());
     std::vector<int> parent(nf);
     std::iota(parent.begin(), parent.end(), 0);
     auto find = [&](int x) {
@@ -59,12 +73,21 @@ MeshRegions regions_of(const TriangleMesh& mesh, const Features& features)
             x = parent[static_cast<Index>(x)] = parent[static_cast<Index>(parent[static_cast<Index>(x)])];
         return x;
     };
-    for (Index i = 0; i + 1 < edges.size(); ++i) {
-        const auto& e = edges[i];
-        const auto& g = edges[i + 1];
-        if (e[0] != g[0] || e[1] != g[1] || features.has(e[0], e[1])) continue;
-        const int a = find(e[2]), b = find(g[2]);
-        if (a != b) parent[static_cast<Index>(std::max(a, b))] = std::min(a, b);
+    // Every edge with one face; the second face of an edge joins the first's region.
+    const EdgeBuckets edges(mesh.positions.size(), 3 * nf, [&](auto&& f) {
+        for (Index i = 0; i < nf; ++i)
+            for (Index k = 0; k < 3; ++k) f(mesh.triangles[i][k], mesh.triangles[i][(k + 1) % 3], static_cast<int>(i));
+    });
+    for (Index v = 0; v + 1 < edges.start.size(); ++v) {
+        const int begin = edges.start[v], end = edges.start[v + 1];
+        for (int i = begin; i < end; ++i)
+            for (int j = i + 1; j < end; ++j) {
+                const auto& e = edges.entries[static_cast<Index>(i)];
+                const auto& g = edges.entries[static_cast<Index>(j)];
+                if (e[0] != g[0] || features.has(static_cast<int>(v), e[0])) continue;
+                const int a = find(e[1]), b = find(g[1]);
+                if (a != b) parent[static_cast<Index>(std::max(a, b))] = std::min(a, b);
+            }
     }
     MeshRegions out;
     out.face_region.assign(nf, -1);
@@ -216,8 +239,19 @@ KeptRegions keep_unchanged_regions(const LobeSurface& previous, LobeSurface& nex
         const Index first = static_cast<Index>(std::min_element(o.begin(), o.end()) - o.begin());
         out.mesh.triangles.push_back({o[first], o[(first + 1) % 3], o[(first + 2) % 3]});
     }
-    std::sort(out.mesh.triangles.begin(), out.mesh.triangles.end());
-    for (const auto& e : next_features.edges) {
+    {
+        // Sorted as build_lobe_surface sorts them: by first (lowest) index, then within.
+        auto& t = out.mesh.triangles;
+        std::vector<int> start(out.mesh.positions.size() + 1, 0);
+        for (const auto& x : t) ++start[static_cast<Index>(x[0]) + 1];
+        for (Index i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+        std::vector<std::array<int, 3>> sorted(t.size());
+        std::vector<int> next_slot(start.begin(), start.end() - 1);
+        for (const auto& x : t) sorted[static_cast<Index>(next_slot[static_cast<Index>(x[0])]++)] = x;
+        for (Index i = 0; i + 1 < start.size(); ++i) std::sort(sorted.begin() + start[i], sorted.begin() + start[i + 1]);
+        t = std::move(sorted);
+    }
+    for (const auto& e : next.mesh.feature_edges) {
         const int a = new_index[static_cast<Index>(e[0])], b = new_index[static_cast<Index>(e[1])];
         if (a >= 0 && b >= 0) out.mesh.feature_edges.push_back({std::min(a, b), std::max(a, b)});
     }

@@ -118,7 +118,7 @@ std::vector<Piece> stroke_pieces(const TriangleMesh& mesh)
             loop.push_back(cur);
             const auto& a = adjacent[static_cast<Index>(cur)];
             const int next = a[0] == prev ? a[1] : a[0];
-            mark(cur, next);
+            if (a.size() != 2 || !mark(cur, next)) break; // not a loop after all: ends here
             prev = cur;
             cur = next;
         }
@@ -335,20 +335,22 @@ TriangleMesh remesh_lobe_surface(const LobeSurface& surface, const RemeshOptions
 
     std::vector<Piece> pieces = stroke_pieces(mesh);
     for (Piece& p : pieces) resample(p, mesh, target);
-    // Every stroke edge → its piece.
-    std::vector<std::pair<std::array<int, 2>, int>> edge_piece;
+    // Every stroke edge → its piece, and whether the piece runs along it from its lower vertex.
+    std::vector<std::pair<std::array<int, 2>, std::pair<int, bool>>> edge_piece;
     for (Index i = 0; i < pieces.size(); ++i) {
         const auto& v = pieces[i].vertices;
         for (Index k = 0; k + 1 < v.size() + (pieces[i].loop ? 1 : 0); ++k) {
             const int a = v[k], b = v[(k + 1) % v.size()];
-            edge_piece.push_back({{std::min(a, b), std::max(a, b)}, static_cast<int>(i)});
+            edge_piece.push_back({{std::min(a, b), std::max(a, b)}, {static_cast<int>(i), a < b}});
         }
     }
     std::sort(edge_piece.begin(), edge_piece.end());
+    // (piece, 1 when the piece runs from a to b, 2 when from b to a), or (−1, 0).
     auto piece_of = [&](int a, int b) {
         const std::array<int, 2> e{std::min(a, b), std::max(a, b)};
-        const auto it = std::lower_bound(edge_piece.begin(), edge_piece.end(), std::make_pair(e, -1));
-        return it != edge_piece.end() && it->first == e ? it->second : -1;
+        const auto it = std::lower_bound(edge_piece.begin(), edge_piece.end(), std::make_pair(e, std::make_pair(-1, false)));
+        if (it == edge_piece.end() || it->first != e) return std::make_pair(-1, 0);
+        return std::make_pair(it->second.first, it->second.second == (a < b) ? 1 : 2);
     };
 
     const MeshRegions regions = mesh_regions(mesh);
@@ -370,14 +372,8 @@ TriangleMesh remesh_lobe_surface(const LobeSurface& surface, const RemeshOptions
                     seen[static_cast<Index>(a)] = r;
                     in.inner.push_back(a);
                 }
-                const int p = piece_of(a, b);
-                if (p < 0) continue;
-                // The direction the piece runs in along this edge.
-                const auto& v = pieces[static_cast<Index>(p)].vertices;
-                const Index i = static_cast<Index>(std::find(v.begin(), v.end(), a) - v.begin());
-                const bool loop = pieces[static_cast<Index>(p)].loop;
-                const bool forward = i < v.size() && (loop || i + 1 < v.size()) && v[(i + 1) % v.size()] == b;
-                sides[static_cast<Index>(r)].emplace_back(p, forward ? 1 : 2);
+                const auto [p, side] = piece_of(a, b);
+                if (p >= 0) sides[static_cast<Index>(r)].emplace_back(p, side);
             }
         }
         for (Index r = 0; r < input.size(); ++r) {
@@ -432,14 +428,22 @@ TriangleMesh remesh_lobe_surface(const LobeSurface& surface, const RemeshOptions
         }
         if (it == now.end()) {
             TriangleMesh start = triangulate_region(surface, in, pieces);
-            if (start.triangles.empty()) {
+            TriangleMesh done;
+            if (!start.triangles.empty()) {
+                try {
+                    done = remesh_isotropic(start, region_options);
+                } catch (const InvalidInput&) {
+                    done = TriangleMesh{}; // the whole lobe is remeshed instead (below)
+                }
+            }
+            if (done.triangles.empty()) {
                 if (cache) cache->regions.clear();
                 st = {};
                 st.regions = regions.count;
                 st.whole = true;
                 return remesh_whole(surface, options);
             }
-            it = now.emplace(key, remesh_isotropic(start, region_options)).first;
+            it = now.emplace(key, std::move(done)).first;
             ++st.remeshed;
         }
         remeshed[r] = &it->second;
