@@ -247,6 +247,10 @@ std::vector<BuiltLobe> build_lobes(const Document& doc, std::vector<std::string>
             if (it != cache->lobes.end() && it->second.key == key && it->second.steps.size() <= steps.size() &&
                 std::equal(it->second.steps.begin(), it->second.steps.end(), steps.begin())) {
                 work = std::move(it->second);
+            } else if (it != cache->lobes.end()) {
+                // Built again (a stroke edited, undone or moved): the regions of its last
+                // remeshing that the change left alone are still good (lobe_remesh.h).
+                work.regions = std::move(it->second.regions);
             }
             if (it != cache->lobes.end()) cache->lobes.erase(it);
         }

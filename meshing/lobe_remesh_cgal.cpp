@@ -188,8 +188,11 @@ TriangleMesh triangulate_region(const LobeSurface& surface, const RegionInput& r
     const TriangleMesh& mesh = surface.mesh;
     const glm::dvec3 centre = surface.centre;
     auto direction = [&](const glm::vec3& p) { return glm::normalize(glm::dvec3(p) - centre); };
-    // The pole: opposite the region's mean direction, outside every triangle of the region
-    // and more than 2° from every vertex of it.
+    // The pole: opposite the region's mean direction when that lies outside every triangle of
+    // the region and at least 10° from its vertices; otherwise (a strip that runs all the way
+    // round the centre has no useful mean) the direction of a fixed lattice that lies outside
+    // the region farthest from its vertices, if that is 2° or more.
+    std::vector<glm::dvec3> dirs;
     glm::dvec3 mean(0.0);
     for (int f : region.faces) {
         const auto& t = mesh.triangles[static_cast<Index>(f)];
@@ -197,18 +200,52 @@ TriangleMesh triangulate_region(const LobeSurface& surface, const RegionInput& r
         const glm::dvec3 b = direction(mesh.positions[static_cast<Index>(t[1])]);
         const glm::dvec3 c = direction(mesh.positions[static_cast<Index>(t[2])]);
         mean += 0.5 * glm::length(glm::cross(b - a, c - a)) * glm::normalize(a + b + c);
+        dirs.insert(dirs.end(), {a, b, c});
     }
-    if (!(glm::length(mean) > 1e-9)) return {};
-    const glm::dvec3 pole = -glm::normalize(mean);
-    const double near = std::cos(2.0 * kDegree);
-    for (int f : region.faces) {
-        const auto& t = mesh.triangles[static_cast<Index>(f)];
-        const glm::dvec3 a = direction(mesh.positions[static_cast<Index>(t[0])]);
-        const glm::dvec3 b = direction(mesh.positions[static_cast<Index>(t[1])]);
-        const glm::dvec3 c = direction(mesh.positions[static_cast<Index>(t[2])]);
-        if (orient3(a, b, pole) >= 0.0 && orient3(b, c, pole) >= 0.0 && orient3(c, a, pole) >= 0.0) return {};
-        if (glm::dot(a, pole) > near || glm::dot(b, pole) > near || glm::dot(c, pole) > near) return {};
+    auto nearest_cos = [&](const glm::dvec3& pole) {
+        double most = -1.0;
+        for (const glm::dvec3& d : dirs) most = std::max(most, glm::dot(d, pole));
+        return most;
+    };
+    auto outside = [&](const glm::dvec3& pole) {
+        for (int f : region.faces) {
+            const auto& t = mesh.triangles[static_cast<Index>(f)];
+            const glm::dvec3 a = direction(mesh.positions[static_cast<Index>(t[0])]);
+            const glm::dvec3 b = direction(mesh.positions[static_cast<Index>(t[1])]);
+            const glm::dvec3 c = direction(mesh.positions[static_cast<Index>(t[2])]);
+            if (orient3(a, b, pole) >= 0.0 && orient3(b, c, pole) >= 0.0 && orient3(c, a, pole) >= 0.0) return false;
+        }
+        return true;
+    };
+    glm::dvec3 pole(0.0);
+    if (glm::length(mean) > 1e-9) {
+        const glm::dvec3 p = -glm::normalize(mean);
+        if (nearest_cos(p) < std::cos(10.0 * kDegree) && outside(p)) pole = p;
     }
+    if (pole == glm::dvec3(0.0)) {
+        constexpr int kLattice = 64;
+        std::vector<std::pair<double, int>> ranked;
+        for (int i = 0; i < kLattice; ++i) {
+            // Fibonacci lattice of directions.
+            const double z = 1.0 - (2.0 * i + 1.0) / kLattice;
+            const double rho = std::sqrt(std::max(0.0, 1.0 - z * z));
+            const double phi = i * 2.39996322972865332;
+            ranked.emplace_back(nearest_cos({rho * std::cos(phi), rho * std::sin(phi), z}), i);
+        }
+        std::sort(ranked.begin(), ranked.end());
+        for (const auto& [cos_near, i] : ranked) {
+            if (cos_near > std::cos(2.0 * kDegree)) break;
+            const double z = 1.0 - (2.0 * i + 1.0) / kLattice;
+            const double rho = std::sqrt(std::max(0.0, 1.0 - z * z));
+            const double phi = i * 2.39996322972865332;
+            const glm::dvec3 p(rho * std::cos(phi), rho * std::sin(phi), z);
+            if (outside(p)) {
+                pole = p;
+                break;
+            }
+        }
+    }
+    if (pole == glm::dvec3(0.0)) return {};
     const Chart chart(pole);
 
     TriangleMesh out;

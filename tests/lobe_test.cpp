@@ -250,6 +250,55 @@ TEST(Lobes, EveryShippedRecordingGivesClosedManifoldOutwardLobesThroughEveryStro
     EXPECT_GE(share_sum / share_count, 0.98) << "mean share of triangles with all angles ≥ 30°";
 }
 
+TEST(Lobes, RegionByRegionRemeshingGivesValidLobesForEveryKindOfDrawingAndFallsBackWhereARegionWrapsTheCentre)
+{
+    const glm::dvec3 c(0.0, 1.3, -0.4);
+    const double r = 0.18;
+    std::vector<glm::vec3> arc; // an open arc over the top, alone: one region all round it
+    for (int i = 0; i <= 80; ++i) {
+        const double t = 0.3 + (kPi - 0.6) * i / 80.0;
+        arc.emplace_back(c + r * glm::dvec3(std::cos(t), std::sin(t), 0.1 * std::sin(3 * t)));
+    }
+    const auto tilted = [&](double deg) {
+        const double a = deg * kPi / 180.0;
+        return loop(c, {1, 0, 0}, {0, std::cos(a), std::sin(a)}, r, r, 160, 0.01);
+    };
+    struct Case {
+        const char* name;
+        std::vector<std::vector<glm::vec3>> strokes;
+        bool whole;
+    };
+    const std::vector<Case> cases = {
+        {"one ring", {sphere_ring(c, r, 0.0)}, false},
+        {"stacked rings", {sphere_ring(c, r, -0.1), sphere_ring(c, r, 0.0), sphere_ring(c, r, 0.1)}, false},
+        {"two loops at 60°", {tilted(0), tilted(60)}, false},
+        {"two loops at 90°", {tilted(0), tilted(90)}, false},
+        {"rings and an arc over the top", {sphere_ring(c, r, -0.08), sphere_ring(c, r, 0.08), arc}, false},
+        {"an open arc alone", {arc}, true},
+    };
+    RemeshOptions options;
+    options.iterations = 4;
+    for (const Case& k : cases) {
+        Lobe lobe;
+        for (std::size_t i = 0; i < k.strokes.size(); ++i) lobe.add_stroke(static_cast<std::int64_t>(i + 1), k.strokes[i]);
+        LobeRemeshStats stats;
+        const TriangleMesh mesh = remesh_lobe_surface(lobe.surface(), options, nullptr, &stats);
+        EXPECT_EQ(stats.whole, k.whole) << k.name;
+        expect_valid_lobe(mesh, k.name);
+        EXPECT_LT(worst_stroke_vertex_offset(mesh, lobe.surface().mesh), 1e-5) << k.name;
+        const MeshQuality q = measure_quality(mesh);
+        EXPECT_GE(q.share_all_angles_ge_30, 0.95) << k.name;
+        EXPECT_EQ(sharp_corners_off_strokes(mesh), 0u) << k.name << ": min angle " << q.min_angle_deg << "°";
+        if (k.whole) continue;
+        EXPECT_EQ(stats.remeshed, stats.regions) << k.name;
+        // Stroke edges: equal steps along each piece, none longer than 1.2 × the target.
+        for (const auto& e : mesh.feature_edges)
+            EXPECT_LE(glm::distance(mesh.positions[static_cast<std::size_t>(e[0])], mesh.positions[static_cast<std::size_t>(e[1])]),
+                      1.2 * options.target_edge_length_m + 1e-6)
+                << k.name;
+    }
+}
+
 TEST(Lobes, SurfaceBeforeRemeshingIsMadeOfStrokePointsStripsAndCaps)
 {
     const Document doc = replay_document(test::source_path("recordings/table1-1lobe-5strokes.lrec"));

@@ -113,6 +113,8 @@ void BM_LobesAfterOneMoreStroke(benchmark::State& state)
     if (state.range(0)) {
         state.counters["lobes_kept"] = static_cast<double>(cache.last_build().kept);
         state.counters["lobes_continued"] = static_cast<double>(cache.last_build().continued);
+        state.counters["regions_remeshed"] = static_cast<double>(cache.last_build().regions_remeshed);
+        state.counters["regions_reused"] = static_cast<double>(cache.last_build().regions_reused);
     }
 }
 BENCHMARK(BM_LobesAfterOneMoreStroke)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
@@ -316,6 +318,8 @@ void BM_LobesWhileBendingAStroke(benchmark::State& state)
     }
     state.counters["lobe_strokes"] = static_cast<double>(lobe->stroke_ids.size());
     state.counters["lobes_built"] = static_cast<double>(cache.last_build().built + cache.last_build().continued);
+    state.counters["regions_remeshed"] = static_cast<double>(cache.last_build().regions_remeshed);
+    state.counters["regions_reused"] = static_cast<double>(cache.last_build().regions_reused);
 }
 BENCHMARK(BM_LobesWhileBendingAStroke)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
