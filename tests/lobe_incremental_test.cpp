@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <iostream>
 #include <map>
@@ -292,6 +293,60 @@ TEST(LobeIncremental, EveryShippedLobeStrokeRemeshesOnlyTheRegionsItChangedAndKe
     // (GCC build); 24 % in all. Without region-by-region remeshing nothing was kept.
     EXPECT_LT(remeshed, regions);
     EXPECT_GT(100 * unchanged, 15 * triangles);
+}
+
+TEST(LobeIncremental, RandomLobesStayValidStrokeByStrokeAndTheirRemeshingDoesNotDependOnWhatWasKept)
+{
+    // Seeded random drawings: loops of random size, tilt and wobble round one centre and arcs
+    // over them, added one at a time; after each, the lobe remeshed with the regions of the last
+    // remeshing kept must be a valid lobe and the same bytes as a remeshing from nothing.
+    std::uint32_t state = 12345u;
+    auto uniform = [&](double lo, double hi) {
+        state = state * 1664525u + 1013904223u;
+        return lo + (hi - lo) * static_cast<double>(state >> 8) / static_cast<double>(1u << 24);
+    };
+    RemeshOptions remesh;
+    remesh.iterations = 4;
+    int checked = 0, whole = 0;
+    for (int lobe_index = 0; lobe_index < 12; ++lobe_index) {
+        const glm::dvec3 c(uniform(-0.3, 0.3), uniform(1.0, 1.6), uniform(-0.6, -0.2));
+        const double r = uniform(0.1, 0.3);
+        Lobe lobe;
+        LobeRemeshCache cache;
+        const int strokes = 2 + lobe_index % 5;
+        for (int k = 0; k < strokes; ++k) {
+            std::vector<glm::vec3> raw;
+            const double tilt = uniform(0.0, kPi), turn = uniform(0.0, 2 * kPi);
+            const glm::dvec3 axis(std::sin(tilt) * std::cos(turn), std::cos(tilt), std::sin(tilt) * std::sin(turn));
+            const glm::dvec3 u = glm::normalize(glm::cross(axis, glm::dvec3(0.3, 0.1, 0.9)));
+            const glm::dvec3 v = glm::cross(axis, u);
+            const double h = uniform(-0.6, 0.6) * r, rr = std::sqrt(r * r - h * h);
+            const bool arc = k > 0 && uniform(0.0, 1.0) < 0.3;
+            const int n = static_cast<int>(2 * kPi * rr / 0.005);
+            for (int i = 0; i < n; ++i) {
+                const double t = (arc ? 0.45 : 1.0) * 2 * kPi * i / n;
+                const double w = 0.002 * std::sin(5 * t + k);
+                raw.emplace_back(c + h * axis + (rr + w) * (std::cos(t) * u + std::sin(t) * v));
+            }
+            try {
+                lobe.add_stroke(k + 1, raw);
+            } catch (const InvalidInput&) {
+                continue; // refused, the lobe as it was (tested elsewhere)
+            }
+            const std::string what = "random lobe " + std::to_string(lobe_index) + ", stroke " + std::to_string(k + 1);
+            LobeRemeshStats stats;
+            const TriangleMesh mesh = remesh_lobe_surface(lobe.surface(), remesh, &cache, &stats);
+            const TriangleMesh fresh = remesh_lobe_surface(lobe.surface(), remesh);
+            EXPECT_TRUE(fresh.positions == mesh.positions) << what;
+            EXPECT_EQ(fresh.triangles, mesh.triangles) << what;
+            expect_valid(mesh, what);
+            ++checked;
+            whole += stats.whole ? 1 : 0;
+        }
+    }
+    std::cout << checked << " random lobe states, " << whole << " remeshed whole\n";
+    EXPECT_GE(checked, 30);
+    EXPECT_LT(whole, checked / 4) << "lobes remeshed whole instead of region by region";
 }
 
 TEST(LobeIncremental, TheSameStrokesInTheSameOrderGiveTheSameBytes)
