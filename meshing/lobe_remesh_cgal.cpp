@@ -432,7 +432,8 @@ TriangleMesh remesh_lobe_surface(const LobeSurface& surface, const RemeshOptions
     region_options.iterations = options.iterations;
     region_options.protect_feature_edges = true;
     region_options.relax_feature_edges = false;
-    region_options.repair_small_angles = true;
+    region_options.own_rounds = true; // with the small-angle repairs
+
     std::map<std::vector<float>, TriangleMesh> now;
     std::vector<const TriangleMesh*> remeshed(input.size(), nullptr);
     for (Index r = 0; r < input.size(); ++r) {

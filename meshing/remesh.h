@@ -29,10 +29,13 @@ struct RemeshOptions {
     /// edges are never flipped, and their vertices end on the input polylines. Whole-mesh
     /// remeshing only (`faces` empty).
     bool relax_feature_edges = false;
-    /// After the rounds, the local repairs of angles under 30° that remeshing with relaxed
-    /// feature edges always makes (free vertices collapsed, free edges flipped; feature edges
-    /// and border edges stay). Whole-mesh remeshing with relax_feature_edges makes them anyway.
-    bool repair_small_angles = false;
+    /// With protect_feature_edges and feature edges that stay (relax_feature_edges off): run
+    /// the rounds as relax_feature_edges does, CGAL's split, collapse and flip one round at a
+    /// time, then our tangential relaxation and a projection onto the input by walking it,
+    /// then the small-angle repairs; instead of CGAL's relaxation (its vertex normals) and
+    /// projection (an AABB tree built on every call), which took about half of remeshing a
+    /// lobe region by region. Whole-mesh remeshing only (`faces` empty).
+    bool own_rounds = false;
     /// Triangle indices to remesh (incremental remeshing of a changed region); empty: all.
     /// The region's border edges are constrained too (split first when longer than the
     /// target), so every vertex outside the region keeps its position.

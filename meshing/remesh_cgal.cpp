@@ -498,10 +498,10 @@ void relax_tangentially(OMesh& om, OpenMesh::EPropHandleT<bool> constrained, con
 /// splits left them, and the triangles along strokes (above all where strokes run one target
 /// length apart) stay poorly shaped.
 void remesh_relaxing_features(OMesh& om, const TriangleMesh& input, double target, unsigned iterations,
-                              OpenMesh::EPropHandleT<bool> constrained)
+                              OpenMesh::EPropHandleT<bool> constrained, bool slide_features)
 {
     SurfaceProjector surface(input);
-    const FeatureSegments strokes(om, constrained, target);
+    const FeatureSegments strokes(om, constrained, slide_features ? target : 1e300);
     // The triangle of the input surface each vertex was last projected to (at first one at
     // its own place: the first vertices are the input's), where its next walk starts.
     // Vertices that splits made have none and start from a neighbour's.
@@ -533,7 +533,7 @@ void remesh_relaxing_features(OMesh& om, const TriangleMesh& input, double targe
         PMP::isotropic_remeshing(faces(om), target, om,
                                  CGAL::parameters::number_of_iterations(1)
                                      .edge_is_constrained_map(ecm)
-                                     .protect_constraints(false)
+                                     .protect_constraints(!slide_features)
                                      .number_of_relaxation_steps(0)
                                      .do_project(false)
                                      // Never called (do_project is off); without a functor
@@ -546,6 +546,9 @@ void remesh_relaxing_features(OMesh& om, const TriangleMesh& input, double targe
                 ++stroke_edges[static_cast<std::size_t>(om.from_vertex_handle(h).idx())];
                 ++stroke_edges[static_cast<std::size_t>(om.to_vertex_handle(h).idx())];
             }
+        if (!slide_features)
+            for (int& c : stroke_edges)
+                if (c == 2) c = -1; // stroke vertices stay (relax_tangentially moves only 0 and 2)
         relax_tangentially(om, constrained, stroke_edges, face_normal, moves);
         for (auto v : om.vertices()) {
             const int c = stroke_edges[static_cast<std::size_t>(v.idx())];
@@ -664,8 +667,8 @@ TriangleMesh remesh_isotropic(const TriangleMesh& mesh, const RemeshOptions& opt
         for (OMesh::EdgeHandle e : long_edges) split_edge(om, e, 0.5, constrained, in_region);
     }
 
-    if (options.protect_feature_edges && options.relax_feature_edges && whole) {
-        remesh_relaxing_features(om, mesh, target, options.iterations, constrained);
+    if (options.protect_feature_edges && (options.relax_feature_edges || options.own_rounds) && whole) {
+        remesh_relaxing_features(om, mesh, target, options.iterations, constrained, options.relax_feature_edges);
     } else {
         std::vector<OMesh::FaceHandle> region;
         for (auto f : om.faces())
@@ -675,7 +678,6 @@ TriangleMesh remesh_isotropic(const TriangleMesh& mesh, const RemeshOptions& opt
                                  CGAL::parameters::number_of_iterations(options.iterations)
                                      .edge_is_constrained_map(ecm)
                                      .protect_constraints(!(options.relax_feature_edges && whole)));
-        if (options.repair_small_angles && options.iterations > 0) improve_small_angles(om, constrained, target);
     }
 
     // The mesh still holds what remeshing deleted (a garbage collection would cost as much as
