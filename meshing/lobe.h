@@ -79,6 +79,7 @@ private:
     std::optional<LobeSurface> surface_;
     glm::dvec3 centre_{0.0};
     KeptRegions last_kept_;
+    SurfaceRegions regions_; ///< of surface_ (kept for the next stroke)
 };
 
 } // namespace lobe

@@ -185,6 +185,7 @@ bool Lobe::remove_stroke(std::int64_t id)
         surface_.reset();
         centre_ = glm::dvec3(0.0);
         last_kept_ = {};
+        regions_ = {};
         return true;
     }
     rebuild(std::move(next), false);
@@ -225,12 +226,18 @@ void Lobe::rebuild(std::vector<LobeStrokeSamples> strokes, bool keep_regions)
     // radius model, which every stroke refits, by up to millimetres, and nothing of the
     // lobe's remeshing could be kept.
     KeptRegions kept_regions;
-    if (keep_regions && surface_ && centre == centre_) kept_regions = keep_unchanged_regions(*surface_, surface);
-    else kept_regions.regions = mesh_regions(surface.mesh).count;
+    SurfaceRegions regions;
+    if (keep_regions && surface_ && centre == centre_) {
+        kept_regions = keep_unchanged_regions(*surface_, regions_, surface, regions);
+    } else {
+        regions = surface_regions(surface.mesh);
+        kept_regions.regions = regions.regions.count;
+    }
     strokes_ = std::move(strokes);
     surface_ = std::move(surface);
     centre_ = centre;
     last_kept_ = kept_regions;
+    regions_ = std::move(regions);
 }
 
 } // namespace lobe

@@ -128,19 +128,31 @@ std::vector<std::vector<RegionStrokeEdge>> region_stroke_edges(const TriangleMes
     return region_keys(mesh, Features(mesh), regions);
 }
 
-KeptRegions keep_unchanged_regions(const LobeSurface& previous, LobeSurface& next)
+SurfaceRegions surface_regions(const TriangleMesh& mesh)
+{
+    const Features features(mesh);
+    SurfaceRegions out;
+    out.regions = regions_of(mesh, features);
+    out.edges = region_keys(mesh, features, out.regions);
+    return out;
+}
+
+KeptRegions keep_unchanged_regions(const LobeSurface& previous, const SurfaceRegions& previous_regions,
+                                   LobeSurface& next, SurfaceRegions& next_regions_out)
 {
     KeptRegions result;
     const Features next_features(next.mesh);
-    const MeshRegions next_regions = regions_of(next.mesh, next_features);
+    next_regions_out.regions = regions_of(next.mesh, next_features);
+    next_regions_out.edges = region_keys(next.mesh, next_features, next_regions_out.regions);
+    const MeshRegions& next_regions = next_regions_out.regions;
+    const auto& next_keys = next_regions_out.edges;
     result.regions = next_regions.count;
     if (previous.centre != next.centre || previous.reference_radius != next.reference_radius ||
-        previous.mesh.triangles.empty())
+        previous.mesh.triangles.empty() || previous_regions.regions.face_region.size() != previous.mesh.triangles.size())
         return result;
     const Features prev_features(previous.mesh);
-    const MeshRegions prev_regions = regions_of(previous.mesh, prev_features);
-    const auto prev_keys = region_keys(previous.mesh, prev_features, prev_regions);
-    const auto next_keys = region_keys(next.mesh, next_features, next_regions);
+    const MeshRegions& prev_regions = previous_regions.regions;
+    const auto& prev_keys = previous_regions.edges;
     std::map<std::vector<DirectedEdge>, int> prev_by_key;
     for (Index r = 0; r < prev_keys.size(); ++r)
         if (!prev_keys[r].empty()) prev_by_key.emplace(prev_keys[r], static_cast<int>(r));
@@ -171,14 +183,20 @@ KeptRegions keep_unchanged_regions(const LobeSurface& previous, LobeSurface& nex
     for (Index v = 0; v < next.mesh.positions.size(); ++v) all.push_back({next.mesh.positions[v], next.origins[v]});
     std::vector<int> from_previous(previous.mesh.positions.size(), -1);
     std::vector<std::array<int, 3>> tris;
+    std::vector<int> tri_region; // region of `next` each triangle belongs to
     tris.reserve(next.mesh.triangles.size());
     for (Index f = 0; f < next.mesh.triangles.size(); ++f)
-        if (source[static_cast<Index>(next_regions.face_region[f])] < 0) tris.push_back(next.mesh.triangles[f]);
-    std::vector<char> kept_region(static_cast<Index>(prev_regions.count), 0);
-    for (int r : source)
-        if (r >= 0) kept_region[static_cast<Index>(r)] = 1;
+        if (source[static_cast<Index>(next_regions.face_region[f])] < 0) {
+            tris.push_back(next.mesh.triangles[f]);
+            tri_region.push_back(next_regions.face_region[f]);
+        }
+    std::vector<int> kept_as(static_cast<Index>(prev_regions.count), -1); // region of `previous` → of `next`
+    for (Index r = 0; r < source.size(); ++r)
+        if (source[r] >= 0) kept_as[static_cast<Index>(source[r])] = static_cast<int>(r);
     for (Index f = 0; f < previous.mesh.triangles.size(); ++f) {
-        if (!kept_region[static_cast<Index>(prev_regions.face_region[f])]) continue;
+        const int as = kept_as[static_cast<Index>(prev_regions.face_region[f])];
+        if (as < 0) continue;
+        tri_region.push_back(as);
         std::array<int, 3> t{};
         for (int k = 0; k < 3; ++k) {
             const int v = previous.mesh.triangles[f][static_cast<Index>(k)];
@@ -187,7 +205,7 @@ KeptRegions keep_unchanged_regions(const LobeSurface& previous, LobeSurface& nex
                 const glm::vec3& p = previous.mesh.positions[static_cast<Index>(v)];
                 if (prev_features.on_vertex[static_cast<Index>(v)]) {
                     const auto it = std::lower_bound(on_stroke.begin(), on_stroke.end(), std::make_pair(key_of(p), -1));
-                    if (it == on_stroke.end() || it->first != key_of(p)) return KeptRegions{next_regions.count, 0, 0};
+                    if (it == on_stroke.end() || it->first != key_of(p)) return KeptRegions{result.regions, 0, 0};
                     mapped = it->second;
                 } else {
                     mapped = static_cast<int>(all.size());
@@ -232,24 +250,41 @@ KeptRegions keep_unchanged_regions(const LobeSurface& previous, LobeSurface& nex
         out.mesh.positions.push_back(all[static_cast<Index>(v)].position);
         out.origins.push_back(all[static_cast<Index>(v)].origin);
     }
-    out.mesh.triangles.reserve(tris.size());
-    for (const auto& t : tris) {
-        const std::array<int, 3> o{new_index[static_cast<Index>(t[0])], new_index[static_cast<Index>(t[1])],
-                                   new_index[static_cast<Index>(t[2])]};
-        const Index first = static_cast<Index>(std::min_element(o.begin(), o.end()) - o.begin());
-        out.mesh.triangles.push_back({o[first], o[(first + 1) % 3], o[(first + 2) % 3]});
-    }
     {
-        // Sorted as build_lobe_surface sorts them: by first (lowest) index, then within.
-        auto& t = out.mesh.triangles;
+        // Sorted as build_lobe_surface sorts them: by first (lowest) index, then within; each
+        // with its region.
+        std::vector<std::pair<std::array<int, 3>, int>> tagged;
+        tagged.reserve(tris.size());
+        for (Index i = 0; i < tris.size(); ++i) {
+            const auto& t = tris[i];
+            const std::array<int, 3> o{new_index[static_cast<Index>(t[0])], new_index[static_cast<Index>(t[1])],
+                                       new_index[static_cast<Index>(t[2])]};
+            const Index first = static_cast<Index>(std::min_element(o.begin(), o.end()) - o.begin());
+            tagged.push_back({{o[first], o[(first + 1) % 3], o[(first + 2) % 3]}, tri_region[i]});
+        }
         std::vector<int> start(out.mesh.positions.size() + 1, 0);
-        for (const auto& x : t) ++start[static_cast<Index>(x[0]) + 1];
+        for (const auto& x : tagged) ++start[static_cast<Index>(x.first[0]) + 1];
         for (Index i = 1; i < start.size(); ++i) start[i] += start[i - 1];
-        std::vector<std::array<int, 3>> sorted(t.size());
+        std::vector<std::pair<std::array<int, 3>, int>> sorted(tagged.size());
         std::vector<int> next_slot(start.begin(), start.end() - 1);
-        for (const auto& x : t) sorted[static_cast<Index>(next_slot[static_cast<Index>(x[0])]++)] = x;
+        for (const auto& x : tagged) sorted[static_cast<Index>(next_slot[static_cast<Index>(x.first[0])]++)] = x;
         for (Index i = 0; i + 1 < start.size(); ++i) std::sort(sorted.begin() + start[i], sorted.begin() + start[i + 1]);
-        t = std::move(sorted);
+        // The result's regions are `next`'s, numbered again by their first triangle.
+        std::vector<int> renumber(static_cast<Index>(next_regions.count), -1);
+        MeshRegions regions;
+        regions.face_region.reserve(sorted.size());
+        out.mesh.triangles.reserve(sorted.size());
+        for (const auto& [t, r] : sorted) {
+            int& n = renumber[static_cast<Index>(r)];
+            if (n < 0) n = regions.count++;
+            regions.face_region.push_back(n);
+            out.mesh.triangles.push_back(t);
+        }
+        std::vector<std::vector<RegionStrokeEdge>> edges(static_cast<Index>(regions.count));
+        for (Index r = 0; r < renumber.size(); ++r)
+            if (renumber[r] >= 0) edges[static_cast<Index>(renumber[r])] = std::move(next_regions_out.edges[r]);
+        next_regions_out.regions = std::move(regions);
+        next_regions_out.edges = std::move(edges);
     }
     for (const auto& e : next.mesh.feature_edges) {
         const int a = new_index[static_cast<Index>(e[0])], b = new_index[static_cast<Index>(e[1])];

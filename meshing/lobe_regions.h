@@ -34,6 +34,13 @@ using RegionStrokeEdge = std::array<float, 6>;
 /// Every region's stroke edges, sorted: what identifies a region from one surface to the next.
 std::vector<std::vector<RegionStrokeEdge>> region_stroke_edges(const TriangleMesh& mesh, const MeshRegions& regions);
 
+/// A surface's regions and their stroke edges.
+struct SurfaceRegions {
+    MeshRegions regions;
+    std::vector<std::vector<RegionStrokeEdge>> edges; ///< per region, as region_stroke_edges
+};
+SurfaceRegions surface_regions(const TriangleMesh& mesh);
+
 /// What keep_unchanged_regions did.
 struct KeptRegions {
     int regions = 0;          ///< regions of the new surface
@@ -47,6 +54,9 @@ struct KeptRegions {
 /// radius (the fill of a region depends on them); otherwise nothing is kept. The result is
 /// canonical as build_lobe_surface's: stroke vertices in their order, interpolated vertices
 /// sorted by direction, triangles sorted, each starting at its lowest index.
-KeptRegions keep_unchanged_regions(const LobeSurface& previous, LobeSurface& next);
+/// `previous_regions` are surface_regions(previous.mesh); `next_regions` is set to the
+/// regions of the result (kept, so that the next stroke need not find them again).
+KeptRegions keep_unchanged_regions(const LobeSurface& previous, const SurfaceRegions& previous_regions,
+                                   LobeSurface& next, SurfaceRegions& next_regions);
 
 } // namespace lobe
