@@ -71,7 +71,6 @@ std::vector<Piece> stroke_pieces(const TriangleMesh& mesh)
         adjacent[static_cast<Index>(e[1])].push_back(e[0]);
     }
     auto less = [&](int a, int b) { return key_of(mesh.positions[static_cast<Index>(a)]) < key_of(mesh.positions[static_cast<Index>(b)]); };
-    std::vector<std::array<int, 2>> used;
     auto edge = [](int a, int b) { return std::array<int, 2>{std::min(a, b), std::max(a, b)}; };
     std::vector<std::array<int, 2>> all;
     for (const auto& e : mesh.feature_edges) all.push_back(edge(e[0], e[1]));
@@ -104,7 +103,10 @@ std::vector<Piece> stroke_pieces(const TriangleMesh& mesh)
                 cur = next;
                 p.vertices.push_back(cur);
             }
-            if (less(p.vertices.back(), p.vertices.front())) std::reverse(p.vertices.begin(), p.vertices.end());
+            const auto& walk = p.vertices;
+            const bool round = walk.front() == walk.back() && walk.size() > 2; // back to its own corner
+            if (round ? less(walk[walk.size() - 2], walk[1]) : less(walk.back(), walk.front()))
+                std::reverse(p.vertices.begin(), p.vertices.end());
             pieces.push_back(std::move(p));
         }
     }
@@ -118,7 +120,7 @@ std::vector<Piece> stroke_pieces(const TriangleMesh& mesh)
             loop.push_back(cur);
             const auto& a = adjacent[static_cast<Index>(cur)];
             const int next = a[0] == prev ? a[1] : a[0];
-            if (a.size() != 2 || !mark(cur, next)) break; // not a loop after all: ends here
+            if (a.size() != 2 || !mark(cur, next)) return {}; // not a loop after all (never from a lobe surface)
             prev = cur;
             cur = next;
         }
@@ -144,7 +146,7 @@ void resample(Piece& piece, const TriangleMesh& mesh, double target)
     for (Index i = 1; i < p.size(); ++i) arc[i] = arc[i - 1] + glm::distance(p[i - 1], p[i]);
     const double length = arc.back();
     long n = std::max({1L, std::lround(length / target), static_cast<long>(std::ceil(length / (1.2 * target)))});
-    if (piece.loop) n = std::max(n, 3L);
+    if (piece.loop || piece.vertices.front() == piece.vertices.back()) n = std::max(n, 3L); // a ring: a triangle at least
     piece.samples.clear();
     piece.samples.push_back(mesh.positions[static_cast<Index>(piece.vertices.front())]);
     Index seg = 0;
@@ -323,7 +325,24 @@ TriangleMesh triangulate_region(const LobeSurface& surface, const RegionInput& r
         out.triangles.push_back(t);
     }
     if (out.triangles.empty()) return {};
-    return out;
+    // An inner vertex the resampled border left outside (between a piece's chord and the
+    // drawn stroke) is used by no triangle: dropped, so that it becomes no attractor.
+    std::vector<int> index(out.positions.size(), -1);
+    for (const auto& t : out.triangles)
+        for (int v : t) index[static_cast<Index>(v)] = 0;
+    for (const auto& e : out.feature_edges)
+        if (index[static_cast<Index>(e[0])] < 0 || index[static_cast<Index>(e[1])] < 0) return {}; // a piece outside
+    int used = 0;
+    for (int& i : index)
+        if (i == 0) i = used++;
+    if (used == static_cast<int>(out.positions.size())) return out;
+    TriangleMesh compact;
+    for (Index v = 0; v < out.positions.size(); ++v)
+        if (index[v] >= 0) compact.positions.push_back(out.positions[v]);
+    for (const auto& t : out.triangles)
+        compact.triangles.push_back({index[static_cast<Index>(t[0])], index[static_cast<Index>(t[1])], index[static_cast<Index>(t[2])]});
+    for (const auto& e : out.feature_edges) compact.feature_edges.push_back({index[static_cast<Index>(e[0])], index[static_cast<Index>(e[1])]});
+    return compact;
 }
 
 TriangleMesh remesh_whole(const LobeSurface& surface, const RemeshOptions& options)
@@ -371,6 +390,10 @@ TriangleMesh remesh_lobe_surface(const LobeSurface& surface, const RemeshOptions
     }
 
     std::vector<Piece> pieces = stroke_pieces(mesh);
+    if (pieces.empty()) {
+        st.whole = true;
+        return remesh_whole(surface, options);
+    }
     for (Piece& p : pieces) resample(p, mesh, target);
     // Every stroke edge → its piece, and whether the piece runs along it from its lower vertex.
     std::vector<std::pair<std::array<int, 2>, std::pair<int, bool>>> edge_piece;
@@ -514,7 +537,11 @@ TriangleMesh remesh_lobe_surface(const LobeSurface& surface, const RemeshOptions
     std::sort(out.feature_edges.begin(), out.feature_edges.end());
     out.feature_edges.erase(std::unique(out.feature_edges.begin(), out.feature_edges.end()), out.feature_edges.end());
     const MeshQuality q = measure_quality(out);
-    if (!q.closed || !q.manifold || !q.outward) {
+    std::vector<char> used(out.positions.size(), 0);
+    for (const auto& t : out.triangles)
+        for (int v : t) used[static_cast<Index>(v)] = 1;
+    const bool all_used = std::find(used.begin(), used.end(), 0) == used.end();
+    if (!q.closed || !q.manifold || !q.outward || !all_used) {
         if (cache) cache->regions.clear();
         st = {};
         st.regions = regions.count;
