@@ -17,6 +17,8 @@
 #include <map>
 #include <vector>
 
+#include <glm/vec3.hpp>
+
 #include "core/mesh.h"
 #include "meshing/lobe_surface.h"
 #include "meshing/remesh.h"
@@ -27,6 +29,7 @@ namespace lobe {
 struct LobeRemeshCache {
     double target = 0.0;
     unsigned iterations = 0;
+    glm::dvec3 centre{0.0}; ///< the surface's centre: each region is charted around it
     /// A region's triangles (corner positions) and the resampled stroke pieces around it →
     /// the region remeshed (its feature_edges: the pieces' edges).
     std::map<std::vector<float>, TriangleMesh> regions;

@@ -383,10 +383,13 @@ TriangleMesh remesh_lobe_surface(const LobeSurface& surface, const RemeshOptions
             return remesh_whole(surface, options); // which refuses it with its message
         }
     }
-    if (cache && (cache->target != target || cache->iterations != options.iterations)) {
+    if (cache && (cache->target != target || cache->iterations != options.iterations || cache->centre != surface.centre)) {
+        // A region's remeshing depends on these too (a paper strip has no inner vertex, so its
+        // triangles stay the same when the centre moves; its chart does not).
         cache->regions.clear();
         cache->target = target;
         cache->iterations = options.iterations;
+        cache->centre = surface.centre;
     }
 
     std::vector<Piece> pieces = stroke_pieces(mesh);

@@ -349,6 +349,27 @@ TEST(LobeIncremental, RandomLobesStayValidStrokeByStrokeAndTheirRemeshingDoesNot
     EXPECT_LT(whole, checked / 4) << "lobes remeshed whole instead of region by region";
 }
 
+TEST(LobeIncremental, KeptRegionsAreNotTakenForASurfaceAroundAnotherCentre)
+{
+    // Stacked rings: their strips are the paper's, with no inner vertex, so they stay the same
+    // triangles whatever the centre; but each region is charted around the centre.
+    Lobe lobe;
+    const auto strokes = rings_and_arcs();
+    for (std::size_t i = 0; i < 3; ++i) lobe.add_stroke(static_cast<std::int64_t>(i + 1), strokes[i]);
+    RemeshOptions remesh;
+    remesh.iterations = 4;
+    LobeRemeshCache cache;
+    remesh_lobe_surface(lobe.surface(), remesh, &cache);
+    LobeSurface moved = lobe.surface();
+    moved.centre += glm::dvec3(0.01, 0.02, -0.01);
+    LobeRemeshStats stats;
+    const TriangleMesh kept = remesh_lobe_surface(moved, remesh, &cache, &stats);
+    const TriangleMesh fresh = remesh_lobe_surface(moved, remesh);
+    EXPECT_EQ(stats.reused, 0);
+    EXPECT_TRUE(kept.positions == fresh.positions);
+    EXPECT_EQ(kept.triangles, fresh.triangles);
+}
+
 TEST(LobeIncremental, TheSameStrokesInTheSameOrderGiveTheSameBytes)
 {
     const auto strokes = eleven_strokes();
