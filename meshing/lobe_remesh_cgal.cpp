@@ -463,8 +463,11 @@ TriangleMesh remesh_lobe_surface(const LobeSurface& surface, const RemeshOptions
     std::map<std::vector<float>, TriangleMesh> now;
     std::vector<const TriangleMesh*> remeshed(input.size(), nullptr);
     for (Index r = 0; r < input.size(); ++r) {
-        const RegionInput& in = input[r];
-        std::vector<std::array<float, 9>> tris;
+        // The region's faces, inner vertices and pieces in an order of their own (by position),
+        // so that what is made of them does not depend on how the surface numbers them: the
+        // same region in the next surface, numbered otherwise, is remeshed the same.
+        RegionInput& in = input[r];
+        std::vector<std::pair<std::array<float, 9>, int>> tagged;
         for (int f : in.faces) {
             std::array<Key3, 3> c{};
             for (Index k = 0; k < 3; ++k) c[k] = key_of(mesh.positions[static_cast<Index>(mesh.triangles[static_cast<Index>(f)][k])]);
@@ -472,9 +475,28 @@ TriangleMesh remesh_lobe_surface(const LobeSurface& surface, const RemeshOptions
             std::array<float, 9> t{};
             for (Index k = 0; k < 3; ++k)
                 for (Index j = 0; j < 3; ++j) t[3 * k + j] = c[(first + k) % 3][j];
-            tris.push_back(t);
+            tagged.emplace_back(t, f);
         }
-        std::sort(tris.begin(), tris.end());
+        std::sort(tagged.begin(), tagged.end());
+        std::vector<std::array<float, 9>> tris;
+        for (Index i = 0; i < tagged.size(); ++i) {
+            tris.push_back(tagged[i].first);
+            in.faces[i] = tagged[i].second;
+        }
+        std::sort(in.inner.begin(), in.inner.end(), [&](int a, int b) {
+            return key_of(mesh.positions[static_cast<Index>(a)]) < key_of(mesh.positions[static_cast<Index>(b)]);
+        });
+        std::sort(in.pieces.begin(), in.pieces.end(), [&](const std::pair<int, bool>& a, const std::pair<int, bool>& b) {
+            const auto& x = pieces[static_cast<Index>(a.first)].samples;
+            const auto& y = pieces[static_cast<Index>(b.first)].samples;
+            const bool less = std::lexicographical_compare(x.begin(), x.end(), y.begin(), y.end(), [](const glm::vec3& u, const glm::vec3& w) {
+                return key_of(u) < key_of(w);
+            });
+            const bool more = std::lexicographical_compare(y.begin(), y.end(), x.begin(), x.end(), [](const glm::vec3& u, const glm::vec3& w) {
+                return key_of(u) < key_of(w);
+            });
+            return less || (!more && a.second < b.second);
+        });
         std::vector<float> key;
         key.reserve(9 * tris.size() + 16);
         for (const auto& t : tris) key.insert(key.end(), t.begin(), t.end());
