@@ -31,6 +31,7 @@
 #include "core/errors.h"
 #include "meshing/lobe_regions.h"
 #include "meshing/mesh_quality.h"
+#include "meshing/stereographic.h"
 
 namespace lobe {
 
@@ -160,22 +161,6 @@ void resample(Piece& piece, const TriangleMesh& mesh, double target)
     if (!piece.loop) piece.samples.push_back(mesh.positions[static_cast<Index>(piece.vertices.back())]);
 }
 
-/// Stereographic projection from `pole` (unit) onto the plane through the centre normal to it.
-struct Chart {
-    glm::dvec3 pole, e1, e2;
-    explicit Chart(const glm::dvec3& n) : pole(n)
-    {
-        const glm::dvec3 a = std::abs(n.x) < 0.6 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
-        e1 = glm::normalize(glm::cross(n, a));
-        e2 = glm::cross(n, e1);
-    }
-    K::Point_2 to_plane(const glm::dvec3& d) const
-    {
-        const double w = 1.0 - glm::dot(d, pole);
-        return {glm::dot(d, e1) / w, glm::dot(d, e2) / w};
-    }
-};
-
 /// One region ready to be triangulated: its inner vertices and the pieces around it.
 struct RegionInput {
     std::vector<int> faces;
@@ -248,12 +233,16 @@ TriangleMesh triangulate_region(const LobeSurface& surface, const RegionInput& r
         }
     }
     if (pole == glm::dvec3(0.0)) return {};
-    const Chart chart(pole);
+    const Stereo chart(pole);
 
+    auto plane_point = [&](const glm::dvec3& d) {
+        const glm::dvec2 x = chart.to_plane(d);
+        return K::Point_2(x.x, x.y);
+    };
     TriangleMesh out;
     std::vector<std::pair<K::Point_2, int>> points;
     for (int v : region.inner) {
-        points.emplace_back(chart.to_plane(direction(mesh.positions[static_cast<Index>(v)])), static_cast<int>(out.positions.size()));
+        points.emplace_back(plane_point(direction(mesh.positions[static_cast<Index>(v)])), static_cast<int>(out.positions.size()));
         out.positions.push_back(mesh.positions[static_cast<Index>(v)]);
     }
     // Piece samples: their ends (corners) may be shared by several pieces.
@@ -265,7 +254,7 @@ TriangleMesh triangulate_region(const LobeSurface& surface, const RegionInput& r
         }
         const int i = static_cast<int>(out.positions.size());
         out.positions.push_back(p);
-        points.emplace_back(chart.to_plane(direction(p)), i);
+        points.emplace_back(plane_point(direction(p)), i);
         if (end) corner.emplace_back(key_of(p), i);
         return i;
     };

@@ -43,6 +43,7 @@
 
 #include "core/errors.h"
 #include "meshing/polyline.h"
+#include "meshing/stereographic.h"
 #include "meshing/stitch.h"
 
 namespace lobe {
@@ -65,30 +66,6 @@ using CDT = CGAL::Constrained_Delaunay_triangulation_2<K, Tds, CGAL::Exact_predi
 using VH = CDT::Vertex_handle;
 using FH = CDT::Face_handle;
 using Index = std::size_t;
-
-/// Stereographic projection from `pole` onto the plane through the centre normal to it:
-/// circles map to circles, so the planar constrained Delaunay triangulation is the
-/// spherical one.
-struct Stereo {
-    glm::dvec3 pole, e1, e2;
-
-    explicit Stereo(const glm::dvec3& n) : pole(n)
-    {
-        const glm::dvec3 a = std::abs(n.x) < 0.6 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
-        e1 = glm::normalize(glm::cross(n, a));
-        e2 = glm::cross(n, e1);
-    }
-    glm::dvec2 to_plane(const glm::dvec3& d) const
-    {
-        const double w = 1.0 - glm::dot(d, pole);
-        return {glm::dot(d, e1) / w, glm::dot(d, e2) / w};
-    }
-    glm::dvec3 to_sphere(const glm::dvec2& x) const
-    {
-        const double s = glm::dot(x, x);
-        return (2.0 * x.x * e1 + 2.0 * x.y * e2 + (s - 1.0) * pole) / (s + 1.0);
-    }
-};
 
 /// A vertex of the surface before lifting.
 struct Node {
