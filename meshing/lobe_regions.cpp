@@ -150,7 +150,9 @@ KeptRegions keep_unchanged_regions(const LobeSurface& previous, const SurfaceReg
     if (previous.centre != next.centre || previous.reference_radius != next.reference_radius ||
         previous.mesh.triangles.empty() || previous_regions.regions.face_region.size() != previous.mesh.triangles.size())
         return result;
-    const Features prev_features(previous.mesh);
+    std::vector<char> prev_on_stroke(previous.mesh.positions.size(), 0);
+    for (const auto& e : previous.mesh.feature_edges)
+        prev_on_stroke[static_cast<Index>(e[0])] = prev_on_stroke[static_cast<Index>(e[1])] = 1;
     const MeshRegions& prev_regions = previous_regions.regions;
     const auto& prev_keys = previous_regions.edges;
     std::map<std::vector<DirectedEdge>, int> prev_by_key;
@@ -203,7 +205,7 @@ KeptRegions keep_unchanged_regions(const LobeSurface& previous, const SurfaceReg
             int& mapped = from_previous[static_cast<Index>(v)];
             if (mapped < 0) {
                 const glm::vec3& p = previous.mesh.positions[static_cast<Index>(v)];
-                if (prev_features.on_vertex[static_cast<Index>(v)]) {
+                if (prev_on_stroke[static_cast<Index>(v)]) {
                     const auto it = std::lower_bound(on_stroke.begin(), on_stroke.end(), std::make_pair(key_of(p), -1));
                     if (it == on_stroke.end() || it->first != key_of(p)) return KeptRegions{result.regions, 0, 0};
                     mapped = it->second;

@@ -194,14 +194,11 @@ TriangleMesh triangulate_region(const LobeSurface& surface, const RegionInput& r
         for (const glm::dvec3& d : dirs) most = std::max(most, glm::dot(d, pole));
         return most;
     };
-    auto outside = [&](const glm::dvec3& pole) {
-        for (int f : region.faces) {
-            const auto& t = mesh.triangles[static_cast<Index>(f)];
-            const glm::dvec3 a = direction(mesh.positions[static_cast<Index>(t[0])]);
-            const glm::dvec3 b = direction(mesh.positions[static_cast<Index>(t[1])]);
-            const glm::dvec3 c = direction(mesh.positions[static_cast<Index>(t[2])]);
-            if (orient3(a, b, pole) >= 0.0 && orient3(b, c, pole) >= 0.0 && orient3(c, a, pole) >= 0.0) return false;
-        }
+    auto outside = [&](const glm::dvec3& pole) { // dirs holds each face's three corners in turn
+        for (Index i = 0; i + 2 < dirs.size(); i += 3)
+            if (orient3(dirs[i], dirs[i + 1], pole) >= 0.0 && orient3(dirs[i + 1], dirs[i + 2], pole) >= 0.0 &&
+                orient3(dirs[i + 2], dirs[i], pole) >= 0.0)
+                return false;
         return true;
     };
     glm::dvec3 pole(0.0);
@@ -358,19 +355,10 @@ TriangleMesh remesh_lobe_surface(const LobeSurface& surface, const RemeshOptions
         st.whole = true;
         return remesh_whole(surface, options);
     }
-    {
-        // The limit of remesh_isotropic on the whole surface, before anything is allocated.
-        double area = 0.0;
-        for (const auto& t : mesh.triangles) {
-            const glm::dvec3 a(mesh.positions[static_cast<Index>(t[0])]), b(mesh.positions[static_cast<Index>(t[1])]),
-                c(mesh.positions[static_cast<Index>(t[2])]);
-            area += 0.5 * glm::length(glm::cross(b - a, c - a));
-        }
-        const double estimate = area / (std::sqrt(3.0) / 4.0 * target * target);
-        if (!(estimate <= static_cast<double>(kMaxRemeshTriangles))) {
-            st.whole = true;
-            return remesh_whole(surface, options); // which refuses it with its message
-        }
+    // The limit of remesh_isotropic on the whole surface, before anything is allocated.
+    if (!(remesh_triangle_estimate(remesh_area(mesh), target) <= static_cast<double>(kMaxRemeshTriangles))) {
+        st.whole = true;
+        return remesh_whole(surface, options); // which refuses it with its message
     }
     if (cache && (cache->target != target || cache->iterations != options.iterations || cache->centre != surface.centre)) {
         // A region's remeshing depends on these too (a paper strip has no inner vertex, so its

@@ -48,6 +48,11 @@ struct RemeshOptions {
 /// memory (docs/limits.md). 3 cm spacing reaches it at about 1,500 m², 5 mm at about 43 m².
 inline constexpr std::size_t kMaxRemeshTriangles = 4000000;
 
+/// The area remesh_isotropic remeshes (every triangle, or those of `faces` in range), m², and
+/// the triangles it would make of it at `target` (each about √3/4 · target²).
+double remesh_area(const TriangleMesh& mesh, const std::vector<int>& faces = {});
+double remesh_triangle_estimate(double area, double target);
+
 /// Remeshes `mesh` towards edges of options.target_edge_length_m with
 /// CGAL::Polygon_mesh_processing::isotropic_remeshing on an OpenMesh TriMesh, projecting
 /// onto the input surface. The output's feature_edges are the constrained edges after

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -501,7 +502,8 @@ void remesh_relaxing_features(OMesh& om, const TriangleMesh& input, double targe
                               OpenMesh::EPropHandleT<bool> constrained, bool slide_features)
 {
     SurfaceProjector surface(input);
-    const FeatureSegments strokes(om, constrained, slide_features ? target : 1e300);
+    std::optional<FeatureSegments> strokes; // where slid stroke vertices are put back
+    if (slide_features) strokes.emplace(om, constrained, target);
     // The triangle of the input surface each vertex was last projected to (at first one at
     // its own place: the first vertices are the input's), where its next walk starts.
     // Vertices that splits made have none and start from a neighbour's.
@@ -559,7 +561,7 @@ void remesh_relaxing_features(OMesh& om, const TriangleMesh& input, double targe
                 // A stroke vertex that the 1-D relaxation moved towards the midpoint of its
                 // stroke neighbours: off its stroke by the bend there, millimetres, well
                 // within the half target length searched.
-                const glm::dvec3 q = strokes.nearest(FeatureSegments::to_glm(om.point(v)), 0.5 * target);
+                const glm::dvec3 q = strokes->nearest(FeatureSegments::to_glm(om.point(v)), 0.5 * target);
                 om.point(v) = OMesh::Point(q.x, q.y, q.z);
             }
         }
@@ -569,6 +571,27 @@ void remesh_relaxing_features(OMesh& om, const TriangleMesh& input, double targe
 }
 
 } // namespace
+
+double remesh_area(const TriangleMesh& mesh, const std::vector<int>& faces)
+{
+    auto area_of = [&](std::size_t f) {
+        const auto& t = mesh.triangles[f];
+        const glm::dvec3 a(mesh.positions[static_cast<std::size_t>(t[0])]);
+        const glm::dvec3 b(mesh.positions[static_cast<std::size_t>(t[1])]);
+        const glm::dvec3 c(mesh.positions[static_cast<std::size_t>(t[2])]);
+        return 0.5 * glm::length(glm::cross(b - a, c - a));
+    };
+    double area = 0.0;
+    if (faces.empty()) {
+        for (std::size_t f = 0; f < mesh.triangles.size(); ++f) area += area_of(f);
+    } else {
+        for (int f : faces)
+            if (f >= 0 && f < static_cast<int>(mesh.triangles.size())) area += area_of(static_cast<std::size_t>(f));
+    }
+    return area;
+}
+
+double remesh_triangle_estimate(double area, double target) { return area / (std::sqrt(3.0) / 4.0 * target * target); }
 
 TriangleMesh remesh_isotropic(const TriangleMesh& mesh, const RemeshOptions& options)
 {
@@ -585,21 +608,8 @@ TriangleMesh remesh_isotropic(const TriangleMesh& mesh, const RemeshOptions& opt
                            "(run repair_mesh first)");
     {
         // What the remeshing would make, before it allocates anything (kMaxRemeshTriangles).
-        auto area_of = [&](std::size_t f) {
-            const auto& t = mesh.triangles[f];
-            const glm::dvec3 a(mesh.positions[static_cast<std::size_t>(t[0])]);
-            const glm::dvec3 b(mesh.positions[static_cast<std::size_t>(t[1])]);
-            const glm::dvec3 c(mesh.positions[static_cast<std::size_t>(t[2])]);
-            return 0.5 * glm::length(glm::cross(b - a, c - a));
-        };
-        double area = 0.0;
-        if (options.faces.empty()) {
-            for (std::size_t f = 0; f < mesh.triangles.size(); ++f) area += area_of(f);
-        } else {
-            for (int f : options.faces)
-                if (f >= 0 && f < static_cast<int>(mesh.triangles.size())) area += area_of(static_cast<std::size_t>(f));
-        }
-        const double estimate = area / (std::sqrt(3.0) / 4.0 * target * target);
+        const double area = remesh_area(mesh, options.faces);
+        const double estimate = remesh_triangle_estimate(area, target);
         if (!(estimate <= static_cast<double>(kMaxRemeshTriangles))) {
             char buf[200];
             std::snprintf(buf, sizeof buf,
