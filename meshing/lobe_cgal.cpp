@@ -213,24 +213,30 @@ void Lobe::rebuild(std::vector<LobeStrokeSamples> strokes, bool keep_regions)
     // The fill density stays with the centre: the radius it was derived from is kept too.
     LobeSurfaceOptions kept = options_.surface;
     if (surface_ && centre == centre_) kept.reference_radius_m = surface_->reference_radius;
+    // Regions the stroke did not reach stay as they were (with the centre and the fill
+    // density they were made with): the fill of those regions would otherwise follow the
+    // radius model, which every stroke refits, by up to millimetres, and nothing of the
+    // lobe's remeshing could be kept. Only the regions the stroke changed are built.
     LobeSurface surface;
+    KeptRegions kept_regions;
+    SurfaceRegions regions;
+    bool continued = false;
     try {
-        surface = build_lobe_surface(strokes, centre, kept);
+        if (keep_regions && surface_ && centre == centre_) {
+            surface = continue_lobe_surface(*surface_, regions_, strokes, centre, kept, regions, kept_regions);
+            continued = true;
+        } else {
+            surface = build_lobe_surface(strokes, centre, kept);
+        }
     } catch (const InvalidInput&) {
         if (centre == centroid) throw;
         centre = centroid;
         surface = build_lobe_surface(strokes, centre, options_.surface);
+        continued = false;
     }
-    // Regions the stroke did not reach stay as they were (with the centre and the fill
-    // density they were made with): the fill of those regions would otherwise follow the
-    // radius model, which every stroke refits, by up to millimetres, and nothing of the
-    // lobe's remeshing could be kept.
-    KeptRegions kept_regions;
-    SurfaceRegions regions;
-    if (keep_regions && surface_ && centre == centre_) {
-        kept_regions = keep_unchanged_regions(*surface_, regions_, surface, regions);
-    } else {
+    if (!continued) {
         regions = surface_regions(surface.mesh);
+        kept_regions = {};
         kept_regions.regions = regions.regions.count;
     }
     strokes_ = std::move(strokes);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <tuple>
@@ -55,12 +56,18 @@ struct Features {
     explicit Features(const TriangleMesh& mesh)
         : on_vertex(mesh.positions.size(), 0),
           edges(mesh.positions.size(), mesh.feature_edges.size(), [&](auto&& f) {
-              for (const auto& e : mesh.feature_edges) f(e[0], e[1], 1);
+              for (Index i = 0; i < mesh.feature_edges.size(); ++i)
+                  f(mesh.feature_edges[i][0], mesh.feature_edges[i][1], static_cast<int>(i));
           })
     {
         for (const auto& e : mesh.feature_edges) on_vertex[static_cast<Index>(e[0])] = on_vertex[static_cast<Index>(e[1])] = 1;
     }
-    bool has(int a, int b) const { return on_vertex[static_cast<Index>(a)] && on_vertex[static_cast<Index>(b)] && edges.find(a, b) >= 0; }
+    bool has(int a, int b) const { return find(a, b) >= 0; }
+    /// Index of the feature edge (a, b), or −1.
+    int find(int a, int b) const
+    {
+        return on_vertex[static_cast<Index>(a)] && on_vertex[static_cast<Index>(b)] ? edges.find(a, b) : -1;
+    }
 };
 
 MeshRegions regions_of(const TriangleMesh& mesh, const Features& features)
@@ -137,10 +144,15 @@ SurfaceRegions surface_regions(const TriangleMesh& mesh)
     return out;
 }
 
-KeptRegions keep_unchanged_regions(const LobeSurface& previous, const SurfaceRegions& previous_regions,
-                                   LobeSurface& next, SurfaceRegions& next_regions_out)
+namespace {
+
+/// keep_unchanged_regions and complete_with_kept_regions: `also_keep` (may be null) flags the
+/// regions of `previous` that `next` lacks and that complete it. False when a stroke vertex of
+/// a kept region is not one of `next`'s (nothing is changed then).
+bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_regions, const std::vector<char>* also_keep,
+                  LobeSurface& next, SurfaceRegions& next_regions_out, KeptRegions& result)
 {
-    KeptRegions result;
+    result = {};
     const Features next_features(next.mesh);
     next_regions_out.regions = regions_of(next.mesh, next_features);
     next_regions_out.edges = region_keys(next.mesh, next_features, next_regions_out.regions);
@@ -149,29 +161,41 @@ KeptRegions keep_unchanged_regions(const LobeSurface& previous, const SurfaceReg
     result.regions = next_regions.count;
     if (previous.centre != next.centre || previous.reference_radius != next.reference_radius ||
         previous.mesh.triangles.empty() || previous_regions.regions.face_region.size() != previous.mesh.triangles.size())
-        return result;
-    std::vector<char> prev_on_stroke(previous.mesh.positions.size(), 0);
-    for (const auto& e : previous.mesh.feature_edges)
-        prev_on_stroke[static_cast<Index>(e[0])] = prev_on_stroke[static_cast<Index>(e[1])] = 1;
+        return also_keep == nullptr;
+    const Features prev_features(previous.mesh);
     const MeshRegions& prev_regions = previous_regions.regions;
     const auto& prev_keys = previous_regions.edges;
-    std::map<std::vector<DirectedEdge>, int> prev_by_key;
-    for (Index r = 0; r < prev_keys.size(); ++r)
-        if (!prev_keys[r].empty()) prev_by_key.emplace(prev_keys[r], static_cast<int>(r));
-    std::vector<int> source(static_cast<Index>(next_regions.count), -1); // region of `previous` kept
-    for (Index r = 0; r < next_keys.size(); ++r) {
-        const auto it = next_keys[r].empty() ? prev_by_key.end() : prev_by_key.find(next_keys[r]);
-        if (it == prev_by_key.end()) continue;
-        source[r] = it->second;
-        ++result.kept;
+    // Region of the result each kept region of `previous` becomes: the region of `next` with
+    // the same stroke edges, or (also_keep) one after `next`'s.
+    std::vector<int> kept_as(static_cast<Index>(prev_regions.count), -1);
+    {
+        std::map<std::vector<DirectedEdge>, int> prev_by_key;
+        for (Index r = 0; r < prev_keys.size(); ++r)
+            if (!prev_keys[r].empty()) prev_by_key.emplace(prev_keys[r], static_cast<int>(r));
+        for (Index r = 0; r < next_keys.size(); ++r) {
+            const auto it = next_keys[r].empty() ? prev_by_key.end() : prev_by_key.find(next_keys[r]);
+            if (it == prev_by_key.end()) continue;
+            kept_as[static_cast<Index>(it->second)] = static_cast<int>(r);
+            ++result.kept;
+        }
     }
-    if (result.kept == 0) return result;
+    int region_count = next_regions.count;
+    if (also_keep)
+        for (Index r = 0; r < also_keep->size() && r < kept_as.size(); ++r)
+            if ((*also_keep)[r] && kept_as[r] < 0) {
+                kept_as[r] = region_count++;
+                ++result.kept;
+            }
+    result.regions = region_count;
+    if (result.kept == 0) return true;
 
     // Vertices on strokes are shared by position: every stroke edge of a kept region is one
-    // of `next` (the keys matched), so its ends are vertices of `next` at the same place.
+    // of `next` (the keys matched; a build of the changed regions has every stroke vertex),
+    // so its ends are vertices of `next` at the same place.
     std::vector<std::pair<Key3, int>> on_stroke;
     for (Index v = 0; v < next.mesh.positions.size(); ++v)
-        if (next_features.on_vertex[v]) on_stroke.emplace_back(key_of(next.mesh.positions[v]), static_cast<int>(v));
+        if (next_features.on_vertex[v] || next.origins[v].kind != LobeVertexKind::Fill)
+            on_stroke.emplace_back(key_of(next.mesh.positions[v]), static_cast<int>(v));
     std::sort(on_stroke.begin(), on_stroke.end());
 
     // All vertices of both surfaces that the result may use: `next`'s, then `previous`'s
@@ -185,29 +209,39 @@ KeptRegions keep_unchanged_regions(const LobeSurface& previous, const SurfaceReg
     for (Index v = 0; v < next.mesh.positions.size(); ++v) all.push_back({next.mesh.positions[v], next.origins[v]});
     std::vector<int> from_previous(previous.mesh.positions.size(), -1);
     std::vector<std::array<int, 3>> tris;
-    std::vector<int> tri_region; // region of `next` each triangle belongs to
+    std::vector<int> tri_region; // region of the result each triangle belongs to
+    std::vector<std::uint8_t> tri_strip;
+    const bool next_strips = next.paper_strip_faces.size() == next.mesh.triangles.size();
+    const bool prev_strips = previous.paper_strip_faces.size() == previous.mesh.triangles.size();
     tris.reserve(next.mesh.triangles.size());
+    std::vector<char> next_kept(static_cast<Index>(next_regions.count), 0);
+    for (int as : kept_as)
+        if (as >= 0 && as < next_regions.count) next_kept[static_cast<Index>(as)] = 1;
     for (Index f = 0; f < next.mesh.triangles.size(); ++f)
-        if (source[static_cast<Index>(next_regions.face_region[f])] < 0) {
+        if (!next_kept[static_cast<Index>(next_regions.face_region[f])]) {
             tris.push_back(next.mesh.triangles[f]);
             tri_region.push_back(next_regions.face_region[f]);
+            tri_strip.push_back(next_strips ? next.paper_strip_faces[f] : 0);
         }
-    std::vector<int> kept_as(static_cast<Index>(prev_regions.count), -1); // region of `previous` → of `next`
-    for (Index r = 0; r < source.size(); ++r)
-        if (source[r] >= 0) kept_as[static_cast<Index>(source[r])] = static_cast<int>(r);
+    std::vector<std::array<int, 2>> kept_features; // stroke edges of kept triangles (also_keep)
     for (Index f = 0; f < previous.mesh.triangles.size(); ++f) {
         const int as = kept_as[static_cast<Index>(prev_regions.face_region[f])];
         if (as < 0) continue;
         tri_region.push_back(as);
+        tri_strip.push_back(prev_strips ? previous.paper_strip_faces[f] : 0);
         std::array<int, 3> t{};
         for (int k = 0; k < 3; ++k) {
             const int v = previous.mesh.triangles[f][static_cast<Index>(k)];
             int& mapped = from_previous[static_cast<Index>(v)];
             if (mapped < 0) {
                 const glm::vec3& p = previous.mesh.positions[static_cast<Index>(v)];
-                if (prev_on_stroke[static_cast<Index>(v)]) {
+                if (prev_features.on_vertex[static_cast<Index>(v)]) {
                     const auto it = std::lower_bound(on_stroke.begin(), on_stroke.end(), std::make_pair(key_of(p), -1));
-                    if (it == on_stroke.end() || it->first != key_of(p)) return KeptRegions{result.regions, 0, 0};
+                    if (it == on_stroke.end() || it->first != key_of(p)) {
+                        if (also_keep) return false;
+                        result = KeptRegions{next_regions.count, 0, 0, false};
+                        return true;
+                    }
                     mapped = it->second;
                 } else {
                     mapped = static_cast<int>(all.size());
@@ -216,6 +250,13 @@ KeptRegions keep_unchanged_regions(const LobeSurface& previous, const SurfaceReg
             }
             t[static_cast<Index>(k)] = mapped;
         }
+        if (also_keep)
+            for (int k = 0; k < 3; ++k) {
+                const int a = previous.mesh.triangles[f][static_cast<Index>(k)];
+                const int b = previous.mesh.triangles[f][static_cast<Index>((k + 1) % 3)];
+                if (a < b && prev_features.has(a, b))
+                    kept_features.push_back({t[static_cast<Index>(k)], t[static_cast<Index>((k + 1) % 3)]});
+            }
         tris.push_back(t);
         ++result.kept_triangles;
     }
@@ -243,7 +284,6 @@ KeptRegions keep_unchanged_regions(const LobeSurface& previous, const SurfaceReg
     LobeSurface out;
     out.centre = next.centre;
     out.reference_radius = next.reference_radius;
-    out.paper_strip_triangles = next.paper_strip_triangles;
     out.crossings = next.crossings;
     out.mesh.positions.reserve(order.size());
     out.origins.reserve(order.size());
@@ -254,37 +294,52 @@ KeptRegions keep_unchanged_regions(const LobeSurface& previous, const SurfaceReg
     }
     {
         // Sorted as build_lobe_surface sorts them: by first (lowest) index, then within; each
-        // with its region.
-        std::vector<std::pair<std::array<int, 3>, int>> tagged;
+        // with its region and whether it is a paper strip's.
+        struct Tagged {
+            std::array<int, 3> t;
+            int region;
+            std::uint8_t strip;
+        };
+        std::vector<Tagged> tagged;
         tagged.reserve(tris.size());
         for (Index i = 0; i < tris.size(); ++i) {
             const auto& t = tris[i];
             const std::array<int, 3> o{new_index[static_cast<Index>(t[0])], new_index[static_cast<Index>(t[1])],
                                        new_index[static_cast<Index>(t[2])]};
             const Index first = static_cast<Index>(std::min_element(o.begin(), o.end()) - o.begin());
-            tagged.push_back({{o[first], o[(first + 1) % 3], o[(first + 2) % 3]}, tri_region[i]});
+            tagged.push_back({{o[first], o[(first + 1) % 3], o[(first + 2) % 3]}, tri_region[i], tri_strip[i]});
         }
         std::vector<int> start(out.mesh.positions.size() + 1, 0);
-        for (const auto& x : tagged) ++start[static_cast<Index>(x.first[0]) + 1];
+        for (const auto& x : tagged) ++start[static_cast<Index>(x.t[0]) + 1];
         for (Index i = 1; i < start.size(); ++i) start[i] += start[i - 1];
-        std::vector<std::pair<std::array<int, 3>, int>> sorted(tagged.size());
+        std::vector<Tagged> sorted(tagged.size());
         std::vector<int> next_slot(start.begin(), start.end() - 1);
-        for (const auto& x : tagged) sorted[static_cast<Index>(next_slot[static_cast<Index>(x.first[0])]++)] = x;
-        for (Index i = 0; i + 1 < start.size(); ++i) std::sort(sorted.begin() + start[i], sorted.begin() + start[i + 1]);
-        // The result's regions are `next`'s, numbered again by their first triangle.
-        std::vector<int> renumber(static_cast<Index>(next_regions.count), -1);
+        for (const auto& x : tagged) sorted[static_cast<Index>(next_slot[static_cast<Index>(x.t[0])]++)] = x;
+        for (Index i = 0; i + 1 < start.size(); ++i)
+            std::sort(sorted.begin() + start[i], sorted.begin() + start[i + 1],
+                      [](const Tagged& x, const Tagged& y) { return x.t < y.t; });
+        // The result's regions, numbered again by their first triangle.
+        std::vector<int> renumber(static_cast<Index>(region_count), -1);
         MeshRegions regions;
         regions.face_region.reserve(sorted.size());
         out.mesh.triangles.reserve(sorted.size());
-        for (const auto& [t, r] : sorted) {
-            int& n = renumber[static_cast<Index>(r)];
+        out.paper_strip_faces.reserve(sorted.size());
+        for (const auto& x : sorted) {
+            int& n = renumber[static_cast<Index>(x.region)];
             if (n < 0) n = regions.count++;
             regions.face_region.push_back(n);
-            out.mesh.triangles.push_back(t);
+            out.mesh.triangles.push_back(x.t);
+            out.paper_strip_faces.push_back(x.strip);
+            out.paper_strip_triangles += x.strip;
         }
         std::vector<std::vector<RegionStrokeEdge>> edges(static_cast<Index>(regions.count));
-        for (Index r = 0; r < renumber.size(); ++r)
+        for (Index r = 0; r < static_cast<Index>(next_regions.count); ++r)
             if (renumber[r] >= 0) edges[static_cast<Index>(renumber[r])] = std::move(next_regions_out.edges[r]);
+        for (Index r = 0; r < kept_as.size(); ++r) {
+            const int as = kept_as[r];
+            if (as >= next_regions.count && renumber[static_cast<Index>(as)] >= 0)
+                edges[static_cast<Index>(renumber[static_cast<Index>(as)])] = prev_keys[r];
+        }
         next_regions_out.regions = std::move(regions);
         next_regions_out.edges = std::move(edges);
     }
@@ -292,9 +347,154 @@ KeptRegions keep_unchanged_regions(const LobeSurface& previous, const SurfaceReg
         const int a = new_index[static_cast<Index>(e[0])], b = new_index[static_cast<Index>(e[1])];
         if (a >= 0 && b >= 0) out.mesh.feature_edges.push_back({std::min(a, b), std::max(a, b)});
     }
+    for (const auto& e : kept_features) {
+        const int a = new_index[static_cast<Index>(e[0])], b = new_index[static_cast<Index>(e[1])];
+        out.mesh.feature_edges.push_back({std::min(a, b), std::max(a, b)});
+    }
     std::sort(out.mesh.feature_edges.begin(), out.mesh.feature_edges.end());
+    out.mesh.feature_edges.erase(std::unique(out.mesh.feature_edges.begin(), out.mesh.feature_edges.end()),
+                                 out.mesh.feature_edges.end());
     next = std::move(out);
+    return true;
+}
+
+/// The region of `surface` whose triangles cover `direction` as seen from the centre (the
+/// triangle it lies deepest inside), or −1.
+int region_at(const LobeSurface& surface, const MeshRegions& regions, const glm::dvec3& direction)
+{
+    std::vector<glm::dvec3> dirs(surface.mesh.positions.size());
+    for (Index v = 0; v < dirs.size(); ++v) dirs[v] = glm::normalize(glm::dvec3(surface.mesh.positions[v]) - surface.centre);
+    double best = -std::numeric_limits<double>::infinity();
+    int region = -1;
+    for (Index f = 0; f < surface.mesh.triangles.size(); ++f) {
+        const auto& t = surface.mesh.triangles[f];
+        const glm::dvec3& a = dirs[static_cast<Index>(t[0])];
+        const glm::dvec3& b = dirs[static_cast<Index>(t[1])];
+        const glm::dvec3& c = dirs[static_cast<Index>(t[2])];
+        if (glm::dot(direction, a + b + c) <= 0.0) continue;
+        const double m = std::min({glm::dot(glm::cross(a, b), direction), glm::dot(glm::cross(b, c), direction),
+                                   glm::dot(glm::cross(c, a), direction)});
+        if (m > best) {
+            best = m;
+            region = regions.face_region[f];
+        }
+    }
+    return best >= -1e-12 ? region : -1;
+}
+
+} // namespace
+
+KeptRegions keep_unchanged_regions(const LobeSurface& previous, const SurfaceRegions& previous_regions,
+                                   LobeSurface& next, SurfaceRegions& next_regions)
+{
+    KeptRegions result;
+    keep_regions(previous, previous_regions, nullptr, next, next_regions, result);
     return result;
+}
+
+bool complete_with_kept_regions(const LobeSurface& previous, const SurfaceRegions& previous_regions,
+                                const std::vector<char>& keep, LobeSurface& next, SurfaceRegions& next_regions,
+                                KeptRegions& kept)
+{
+    return keep_regions(previous, previous_regions, &keep, next, next_regions, kept);
+}
+
+ChangedRegions find_changed_regions(const LobeSurface& previous, const SurfaceRegions& previous_regions,
+                                    const std::vector<RegionChain>& chains)
+{
+    ChangedRegions out;
+    const TriangleMesh& mesh = previous.mesh;
+    const MeshRegions& regions = previous_regions.regions;
+    if (mesh.triangles.empty() || regions.face_region.size() != mesh.triangles.size() || regions.count < 2) {
+        out.everything = true;
+        return out;
+    }
+    const Features features(mesh);
+    std::vector<std::pair<Key3, int>> on_stroke;
+    for (Index v = 0; v < mesh.positions.size(); ++v)
+        if (features.on_vertex[v]) on_stroke.emplace_back(key_of(mesh.positions[v]), static_cast<int>(v));
+    std::sort(on_stroke.begin(), on_stroke.end());
+    auto vertex_at = [&](const glm::vec3& p) {
+        const auto it = std::lower_bound(on_stroke.begin(), on_stroke.end(), std::make_pair(key_of(p), -1));
+        return it != on_stroke.end() && it->first == key_of(p) ? it->second : -1;
+    };
+    // The regions on the two sides of every stroke edge: [0] where the triangles run round it
+    // from its lower to its higher vertex, [1] the other way.
+    const auto& fe = mesh.feature_edges;
+    std::vector<std::array<int, 2>> side(fe.size(), {-1, -1});
+    for (Index f = 0; f < mesh.triangles.size(); ++f)
+        for (Index k = 0; k < 3; ++k) {
+            const int a = mesh.triangles[f][k], b = mesh.triangles[f][(k + 1) % 3];
+            const int e = features.find(a, b);
+            if (e >= 0) side[static_cast<Index>(e)][a < b ? 0 : 1] = regions.face_region[f];
+        }
+    std::vector<char> present(fe.size(), 0), changed(static_cast<Index>(regions.count), 0);
+    std::vector<std::vector<int>> chain_vertex(chains.size()), chain_edge(chains.size());
+    std::vector<glm::dvec3> to_locate;
+    for (Index c = 0; c < chains.size(); ++c) {
+        const auto& pts = chains[c].points;
+        const Index n = pts.size();
+        const Index m = chains[c].closed ? n : (n > 0 ? n - 1 : 0);
+        auto& vid = chain_vertex[c];
+        vid.resize(n);
+        for (Index i = 0; i < n; ++i) vid[i] = vertex_at(pts[i]);
+        chain_edge[c].assign(m, -1);
+        Index first_new = m;
+        for (Index i = 0; i < m; ++i) {
+            const int a = vid[i], b = vid[(i + 1) % n];
+            const int e = a >= 0 && b >= 0 ? features.find(a, b) : -1;
+            if (e >= 0) {
+                present[static_cast<Index>(e)] = 1;
+                chain_edge[c][i] = e;
+            } else if (first_new == m) {
+                first_new = i;
+            }
+        }
+        // A chain with new edges and no crossing lies inside one region; a crossed one splits
+        // an edge of every region it enters.
+        if (first_new < m && !chains[c].crossed)
+            to_locate.push_back(glm::dvec3(pts[first_new]) + glm::dvec3(pts[(first_new + 1) % n]) - 2.0 * previous.centre);
+    }
+    for (Index e = 0; e < fe.size(); ++e)
+        if (!present[e])
+            for (int r : side[e])
+                if (r >= 0) changed[static_cast<Index>(r)] = 1;
+    for (const glm::dvec3& d : to_locate) {
+        const double len = glm::length(d);
+        const int r = len > 0.0 ? region_at(previous, regions, d / len) : -1;
+        if (r < 0) {
+            out.everything = true;
+            return out;
+        }
+        changed[static_cast<Index>(r)] = 1;
+    }
+    const auto changed_count = std::count(changed.begin(), changed.end(), 1);
+    if (changed_count == 0 || changed_count == regions.count) {
+        out.everything = true;
+        return out;
+    }
+    out.keep.resize(changed.size());
+    for (Index r = 0; r < changed.size(); ++r) out.keep[r] = !changed[r];
+    out.edges.resize(chains.size());
+    for (Index c = 0; c < chains.size(); ++c) {
+        const Index n = chains[c].points.size();
+        auto& edges = out.edges[c];
+        edges.assign(chain_edge[c].size(), ChangedRegions::Inside);
+        for (Index i = 0; i < edges.size(); ++i) {
+            const int e = chain_edge[c][i];
+            if (e < 0) continue;
+            const auto [s0, s1] = side[static_cast<Index>(e)];
+            const bool c0 = s0 >= 0 && changed[static_cast<Index>(s0)], c1 = s1 >= 0 && changed[static_cast<Index>(s1)];
+            if (!c0 && !c1) {
+                edges[i] = ChangedRegions::Outside;
+            } else if (c0 != c1) {
+                // Side 0 runs from the lower vertex to the higher.
+                const bool ahead = (chain_vertex[c][i] < chain_vertex[c][(i + 1) % n]) == c0;
+                edges[i] = ahead ? ChangedRegions::BorderAhead : ChangedRegions::BorderBack;
+            }
+        }
+    }
+    return out;
 }
 
 } // namespace lobe

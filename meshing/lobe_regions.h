@@ -13,7 +13,10 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
+
+#include <glm/vec3.hpp>
 
 #include "core/mesh.h"
 #include "meshing/lobe_surface.h"
@@ -41,11 +44,14 @@ struct SurfaceRegions {
 };
 SurfaceRegions surface_regions(const TriangleMesh& mesh);
 
-/// What keep_unchanged_regions did.
+/// What keep_unchanged_regions (or continue_lobe_surface) did.
 struct KeptRegions {
     int regions = 0;          ///< regions of the new surface
     int kept = 0;             ///< of them, taken from the previous surface
     std::size_t kept_triangles = 0;
+    /// Only the regions that changed were built (continue_lobe_surface); false when the
+    /// whole surface was built and the unchanged regions then swapped back.
+    bool built_changed_only = false;
 };
 
 /// Replaces every region of `next` whose stroke edges (directed, by position) are exactly
@@ -58,5 +64,55 @@ struct KeptRegions {
 /// regions of the result (kept, so that the next stroke need not find them again).
 KeptRegions keep_unchanged_regions(const LobeSurface& previous, const SurfaceRegions& previous_regions,
                                    LobeSurface& next, SurfaceRegions& next_regions);
+
+/// A stroke of the next surface as its vertices will lie: the stroke's samples, crossings and
+/// subdivisions in order (the nodes the surface joins), at the positions the surface gives them.
+struct RegionChain {
+    std::vector<glm::vec3> points;
+    bool closed = false;
+    bool crossed = false; ///< crosses another stroke somewhere
+};
+
+/// Which regions of `previous` the next surface, through `chains`, leaves as they were, and
+/// what a build of the rest needs. A region changes when one of its stroke edges is no
+/// longer an edge of the chains (a new crossing split it, a sample next to the crossing was
+/// dropped), or a chain runs through it (found by where an uncrossed new chain lies; a crossed
+/// one enters every region it reaches across an edge it splits).
+struct ChangedRegions {
+    bool everything = false;  ///< no region of `previous` can be kept: build the whole surface
+    std::vector<char> keep;   ///< per region of `previous`: left as it was
+    /// Per chain, per edge (point i → i + 1): what the build of the changed regions does with it.
+    enum Edge : std::uint8_t {
+        Outside = 0,     ///< between two kept regions: not needed
+        Inside = 1,      ///< in or between changed regions
+        BorderAhead = 2, ///< between a changed and a kept region; the changed region's
+                         ///< triangles run round it point i → i + 1 (as the surface faces outward)
+        BorderBack = 3,  ///< … and the changed region's triangles run round it i + 1 → i
+    };
+    std::vector<std::vector<Edge>> edges;
+};
+ChangedRegions find_changed_regions(const LobeSurface& previous, const SurfaceRegions& previous_regions,
+                                    const std::vector<RegionChain>& chains);
+
+/// The second half of a build of only the changed regions: `next` has the triangles of the
+/// changed regions (and every stroke vertex), `keep` (ChangedRegions::keep) says which regions
+/// of `previous` complete it. Adds them, bit for bit, and any region of `next` whose stroke
+/// edges are a region's of `previous` is swapped for it as keep_unchanged_regions does; the
+/// result is canonical as build_lobe_surface's. False (and `next` unchanged) when a kept
+/// region's stroke vertex is not one of `next`'s: then the whole surface must be built.
+bool complete_with_kept_regions(const LobeSurface& previous, const SurfaceRegions& previous_regions,
+                                const std::vector<char>& keep, LobeSurface& next, SurfaceRegions& next_regions,
+                                KeptRegions& kept);
+
+/// The surface of `strokes` around `centre` after a stroke was added to (or changed in) the
+/// lobe whose surface was `previous`: the same, bit for bit, as build_lobe_surface followed by
+/// keep_unchanged_regions, but only the regions that changed are built (a constrained
+/// triangulation of their strokes alone, filled and solved region by region), so its time
+/// follows what the stroke changed rather than the lobe's size. Falls back to the whole build
+/// where the changed part cannot be told apart (`kept.built_changed_only` says which).
+/// \throw InvalidInput as build_lobe_surface.
+LobeSurface continue_lobe_surface(const LobeSurface& previous, const SurfaceRegions& previous_regions,
+                                  const std::vector<LobeStrokeSamples>& strokes, const glm::dvec3& centre,
+                                  const LobeSurfaceOptions& options, SurfaceRegions& regions, KeptRegions& kept);
 
 } // namespace lobe

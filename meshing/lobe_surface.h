@@ -83,6 +83,7 @@ struct LobeSurface {
     glm::dvec3 centre{0.0};
     double reference_radius = 0;           ///< see LobeSurfaceOptions::reference_radius_m
     std::size_t paper_strip_triangles = 0; ///< triangles from stitch_closed_closed strips
+    std::vector<std::uint8_t> paper_strip_faces; ///< #F: 1 for those triangles
     std::size_t crossings = 0;             ///< crossing vertices (crossings closer than the merge distance share one)
 };
 

@@ -42,6 +42,7 @@
 #pragma GCC diagnostic pop
 
 #include "core/errors.h"
+#include "meshing/lobe_regions.h"
 #include "meshing/polyline.h"
 #include "meshing/stereographic.h"
 #include "meshing/stitch.h"
@@ -257,6 +258,11 @@ struct Adjacency {
     Range operator[](Index i) const { return {list.data() + start[i], list.data() + start[i + 1]}; }
 };
 
+/// A build of the changed regions only met something it cannot tell apart (a kept region
+/// the new strokes run into, a stroke edge the triangulation split): the whole surface is
+/// built instead.
+struct PartialFailed {};
+
 /// Everything one build needs.
 class Builder {
 public:
@@ -264,6 +270,17 @@ public:
         : strokes_(strokes), centre_(centre), options_(options)
     {
     }
+
+    /// Builds only the regions that changed since `previous` (see continue_lobe_surface)
+    /// where they can be told apart: run() then returns those regions' triangles and every
+    /// stroke vertex, and partial() is true.
+    void set_previous(const LobeSurface& previous, const SurfaceRegions& regions)
+    {
+        previous_ = &previous;
+        previous_regions_ = &regions;
+    }
+    bool partial() const { return partial_; }
+    const std::vector<char>& kept_previous_regions() const { return changed_.keep; }
 
     LobeSurface run();
 
@@ -276,16 +293,25 @@ private:
     void choose_pole();
     void find_crossings();
     void build_chains();
+    void plan_partial();
+    glm::vec3 emitted_position(int id) const
+    {
+        const Node& n = nodes_[static_cast<Index>(id)];
+        return n.origin.kind == LobeVertexKind::Sample
+                   ? strokes_[static_cast<Index>(n.origin.stroke)].points[static_cast<Index>(n.origin.sample)]
+                   : glm::vec3(centre_ + n.radius * n.dir);
+    }
     void triangulate();
     void mark_regions();
+    void mark_inside();
     void find_paper_regions();
     void refine();
     void seed_fill(double max_edge, int& added);
     void insert_fill(const glm::dvec2& x, int region, VH& hint, int& added);
     void insert_fill(const Node& n, const glm::dvec2& x, int region, VH& hint, int& added);
     void emit(LobeSurface& out);
-    void solve_fill_radii(const std::vector<std::array<int, 3>>& triangles);
-    bool fit_radius_model(const std::vector<char>& used, std::vector<double>& model) const;
+    void solve_fill_radii(const std::vector<std::array<int, 3>>& triangles, const std::vector<char>& on_chain);
+    bool fit_radius_model(const std::vector<char>& fit, const std::vector<char>& used, std::vector<double>& model) const;
 
     int add_node(const Node& n)
     {
@@ -321,6 +347,17 @@ private:
     bool regions_stale_ = false;                   ///< faces' regions must be marked again
     int pole_node_ = -1;
     double max_piece_angle_ = 6.0 * M_PI / 180.0;
+
+    // A build of the changed regions only (partial_): the stroke edges in or around them
+    // are triangulated, and the regions outside them (the kept ones, seen as one or more
+    // regions bounded by the border edges) are left out.
+    const LobeSurface* previous_ = nullptr;
+    const SurfaceRegions* previous_regions_ = nullptr;
+    ChangedRegions changed_;
+    bool partial_ = false;
+    std::vector<char> region_inside_;              ///< per region: to be emitted
+    std::vector<std::array<int, 2>> border_;       ///< node pairs (u, v): changed side runs u → v outward
+    std::vector<std::array<int, 2>> inserted_;     ///< constrained node pairs
     double ring_angle_ = 0;
 };
 
@@ -629,12 +666,30 @@ void Builder::build_chains()
     }
 }
 
+void Builder::plan_partial()
+{
+    partial_ = false;
+    const double reference = options_.reference_radius_m > 0 ? options_.reference_radius_m : mean_radius_;
+    if (previous_->centre != centre_ || previous_->reference_radius != reference) return;
+    std::vector<RegionChain> chains(chains_.size());
+    for (Index s = 0; s < chains_.size(); ++s) {
+        chains[s].points.reserve(chains_[s].size());
+        for (int id : chains_[s]) chains[s].points.push_back(emitted_position(id));
+        chains[s].closed = strokes_[s].closed;
+        chains[s].crossed = crossing_count_[s] > 0;
+    }
+    changed_ = find_changed_regions(*previous_, *previous_regions_, chains);
+    partial_ = !changed_.everything;
+}
+
 VH Builder::insert_node(int id, VH hint)
 {
     const glm::dvec2 x = stereo_.to_plane(nodes_[static_cast<Index>(id)].dir);
     const K::Point_2 p(x.x, x.y);
     VH v = hint == VH() ? cdt_.insert(p) : cdt_.insert(p, hint->face());
-    if (v->info().id < 0) v->info().id = id;
+    // Nodes at one point (two strokes through the same sample) share the vertex: it is the
+    // first node's, whatever order they went in.
+    if (v->info().id < 0 || id < v->info().id) v->info().id = id;
     return v;
 }
 
@@ -646,6 +701,17 @@ void Builder::triangulate()
         std::vector<K::Point_2> where(nodes_.size());
         std::vector<std::size_t> order;
         std::vector<char> seen(nodes_.size(), 0);
+        if (partial_) {
+            // Only the nodes of the stroke edges in or around the changed regions.
+            std::fill(seen.begin(), seen.end(), 1);
+            for (Index s = 0; s < chains_.size(); ++s) {
+                const auto& chain = chains_[s];
+                const auto& edges = changed_.edges[s];
+                for (Index i = 0; i < edges.size(); ++i)
+                    if (edges[i] != ChangedRegions::Outside)
+                        seen[static_cast<Index>(chain[i])] = seen[static_cast<Index>(chain[(i + 1) % chain.size()])] = 0;
+            }
+        }
         for (const auto& chain : chains_)
             for (int id : chain)
                 if (!seen[static_cast<Index>(id)]) {
@@ -675,8 +741,16 @@ void Builder::triangulate()
         const Index n = chain.size();
         const Index count = strokes_[s].closed ? n : n - 1;
         for (Index i = 0; i < count; ++i) {
-            const VH a = node_vertex_[static_cast<Index>(chain[i])];
-            const VH b = node_vertex_[static_cast<Index>(chain[(i + 1) % n])];
+            const int u = chain[i], v = chain[(i + 1) % n];
+            if (partial_) {
+                const auto kind = changed_.edges[s][i];
+                if (kind == ChangedRegions::Outside) continue;
+                inserted_.push_back({u, v});
+                if (kind == ChangedRegions::BorderAhead) border_.push_back({u, v});
+                if (kind == ChangedRegions::BorderBack) border_.push_back({v, u});
+            }
+            const VH a = node_vertex_[static_cast<Index>(u)];
+            const VH b = node_vertex_[static_cast<Index>(v)];
             if (a != b) cdt_.insert_constraint(a, b);
         }
     }
@@ -707,6 +781,32 @@ void Builder::mark_regions()
         }
         ++region_count_;
     }
+    mark_inside();
+}
+
+void Builder::mark_inside()
+{
+    region_inside_.assign(static_cast<Index>(region_count_), 1);
+    if (!partial_) return;
+    // The changed side of every border edge is in, the kept side out; every region is one
+    // or the other (the border edges enclose the changed regions).
+    std::vector<char> in(static_cast<Index>(region_count_), 0), out(static_cast<Index>(region_count_), 0);
+    for (const auto& [u, v] : border_) {
+        const VH a = node_vertex_[static_cast<Index>(u)], b = node_vertex_[static_cast<Index>(v)];
+        FH f;
+        int i = 0;
+        if (a == b || !cdt_.is_edge(a, b, f, i)) throw PartialFailed{};
+        // Outward u → v is planar clockwise: the changed side's face runs v → u counter-clockwise.
+        const FH changed = f->vertex(CDT::ccw(i)) == b ? f : f->neighbor(i);
+        const FH kept = changed == f ? f->neighbor(i) : f;
+        if (cdt_.is_infinite(changed) || cdt_.is_infinite(kept)) throw PartialFailed{};
+        in[static_cast<Index>(changed->info().region)] = 1;
+        out[static_cast<Index>(kept->info().region)] = 1;
+    }
+    for (Index r = 0; r < in.size(); ++r) {
+        if (in[r] && out[r]) throw PartialFailed{};
+        region_inside_[r] = !out[r];
+    }
 }
 
 void Builder::find_paper_regions()
@@ -721,6 +821,8 @@ void Builder::find_paper_regions()
         const auto& o = nodes_[static_cast<Index>(id)].origin;
         return o.kind == LobeVertexKind::Sample || o.kind == LobeVertexKind::Segment ? o.stroke : -1;
     };
+    for (Index r = 0; r < static_cast<Index>(region_count_); ++r)
+        if (!region_inside_[r]) bad[r] = 1;
     std::vector<std::array<int, 2>> edge_counts(static_cast<Index>(region_count_), {0, 0});
     for (FH f : cdt_.finite_face_handles()) {
         const Index r = static_cast<Index>(f->info().region);
@@ -869,7 +971,8 @@ void Builder::seed_fill(double max_edge, int& added)
         hint_face = cdt_.locate(p, lt, li, hint_face);
         const bool inside = hint_face != FH() && !cdt_.is_infinite(hint_face) && hint_face->info().region >= 0;
         if (inside && static_cast<Index>(hint_face->info().region) < paper_region_.size() &&
-            paper_region_[static_cast<Index>(hint_face->info().region)])
+            (paper_region_[static_cast<Index>(hint_face->info().region)] ||
+             !region_inside_[static_cast<Index>(hint_face->info().region)]))
             continue;
         candidates.push_back({d, inside && lt == CDT::FACE ? hint_face->info().region : -1});
     }
@@ -915,7 +1018,7 @@ void Builder::refine()
         for (FH f : cdt_.finite_face_handles()) {
             if (f->info().fine) continue;
             const int region = f->info().region;
-            if (paper_region_[static_cast<Index>(region)]) {
+            if (paper_region_[static_cast<Index>(region)] || !region_inside_[static_cast<Index>(region)]) {
                 f->info().fine = true;
                 continue;
             }
@@ -979,7 +1082,7 @@ void Builder::refine()
     }
 }
 
-void Builder::solve_fill_radii(const std::vector<std::array<int, 3>>& triangles)
+void Builder::solve_fill_radii(const std::vector<std::array<int, 3>>& triangles, const std::vector<char>& on_chain)
 {
     // Fill vertices (and vertices CGAL made at residual crossings) get the radius of a smooth
     // model of the whole lobe plus the harmonic interpolation of the strokes' residuals:
@@ -990,69 +1093,125 @@ void Builder::solve_fill_radii(const std::vector<std::array<int, 3>>& triangles)
     //   strokes around it suggest;
     // - the residuals (stroke radius − model) are interpolated harmonically, so the surface
     //   passes through every stroke and stays within their range.
-    // When the model is implausible (it leaves 0.5–1.5 times the strokes' radii), the
+    // Where the model is implausible (it leaves 0.5–1.5 times the strokes' radii), the
     // radius itself is interpolated harmonically.
+    // Strokes separate the interpolated vertices of one region from those of every other, so
+    // the system falls apart into one small system per group of connected interpolated
+    // vertices, solved (and judged plausible) each on its own: a region's radii depend on the
+    // region alone (and the model), whichever other regions are built with it.
     const Index n = nodes_.size();
+    std::vector<char> used(n, 0);
+    for (const auto& t : triangles)
+        for (int id : t) used[static_cast<Index>(id)] = 1;
     std::vector<int> unknown(n, -1);
     int count = 0;
     for (Index i = 0; i < n; ++i)
-        if (nodes_[i].origin.kind == LobeVertexKind::Fill) unknown[i] = count++;
+        if (nodes_[i].origin.kind == LobeVertexKind::Fill && used[i]) unknown[i] = count++;
     if (count == 0) return;
-    // Which nodes the triangles use, and the neighbours of the interpolated ones (the rows
-    // of the system; the other nodes' neighbours are not needed).
-    std::vector<char> used(n, 0), rows(n, 0);
-    for (const auto& t : triangles)
-        for (int id : t) used[static_cast<Index>(id)] = 1;
+    std::vector<char> rows(n, 0);
     for (Index i = 0; i < n; ++i) rows[i] = unknown[i] >= 0 ? 1 : 0;
     const Adjacency adj(n, triangles, rows);
     double lo = std::numeric_limits<double>::infinity(), hi = 0;
+    std::vector<char> fit(n, 0);
     for (Index i = 0; i < n; ++i)
-        if (unknown[i] < 0 && used[i]) {
+        if (on_chain[i] && nodes_[i].origin.kind != LobeVertexKind::Fill) {
+            fit[i] = 1;
             lo = std::min(lo, nodes_[i].radius);
             hi = std::max(hi, nodes_[i].radius);
         }
     std::vector<double> model(n, 0.0);
-    bool use_model = fit_radius_model(used, model);
-    if (use_model)
-        for (Index i = 0; i < n; ++i)
-            if (unknown[i] >= 0 && !(model[i] >= 0.5 * lo && model[i] <= 1.5 * hi)) use_model = false;
-    if (!use_model) std::fill(model.begin(), model.end(), 0.0);
+    const bool have_model = fit_radius_model(fit, used, model);
+    // Groups: connected interpolated vertices (union–find over their rows).
+    std::vector<int> parent(static_cast<Index>(count));
+    for (Index r = 0; r < parent.size(); ++r) parent[r] = static_cast<int>(r);
+    auto find = [&](int x) {
+        while (parent[static_cast<Index>(x)] != x)
+            x = parent[static_cast<Index>(x)] = parent[static_cast<Index>(parent[static_cast<Index>(x)])];
+        return x;
+    };
+    std::vector<int> row_node(static_cast<Index>(count));
+    for (Index i = 0; i < n; ++i) {
+        if (unknown[i] < 0) continue;
+        row_node[static_cast<Index>(unknown[i])] = static_cast<int>(i);
+        for (int j : adj[i]) {
+            const int col = unknown[static_cast<Index>(j)];
+            if (col < 0) continue;
+            const int a = find(unknown[i]), b = find(col);
+            if (a != b) parent[static_cast<Index>(std::max(a, b))] = std::min(a, b);
+        }
+    }
+    // Members of each group in row order, and their place in it.
+    std::vector<int> group_of_root(static_cast<Index>(count), -1), local(static_cast<Index>(count));
+    std::vector<std::vector<int>> groups;
+    for (int r = 0; r < count; ++r) {
+        int& g = group_of_root[static_cast<Index>(find(r))];
+        if (g < 0) {
+            g = static_cast<int>(groups.size());
+            groups.emplace_back();
+        }
+        local[static_cast<Index>(r)] = static_cast<int>(groups[static_cast<Index>(g)].size());
+        groups[static_cast<Index>(g)].push_back(r);
+    }
     // The harmonic interpolation of the residuals: (Σ_j w_ij) x_i − Σ_j w_ij x_j = 0 at every
     // free vertex, with w_ij the inverse angular length of edge ij (so long strip edges and
     // short cap edges measure slope alike). Symmetric positive definite; only its lower
-    // triangle is stored, which is all SimplicialLDLT reads.
+    // triangle is stored, which is all SimplicialLDLT reads. Small groups are solved dense.
+    constexpr Index kDense = 48;
     std::vector<Eigen::Triplet<double>> entries;
-    entries.reserve(static_cast<Index>(count) * 4);
-    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(count);
-    for (Index i = 0; i < n; ++i) {
-        const int row = unknown[i];
-        if (row < 0) continue;
-        double sum = 0;
-        for (int j : adj[i]) {
-            const double w = 1.0 / std::max(1e-6, angle_between(nodes_[i].dir, nodes_[static_cast<Index>(j)].dir));
-            sum += w;
-            const int col = unknown[static_cast<Index>(j)];
-            if (col < 0) rhs[row] += w * (nodes_[static_cast<Index>(j)].radius - model[static_cast<Index>(j)]);
-            else if (col < row) entries.emplace_back(row, col, -w);
+    Eigen::MatrixXd dense;
+    for (const auto& members : groups) {
+        const Index m = members.size();
+        bool use_model = have_model;
+        for (int r : members) {
+            const double v = model[static_cast<Index>(row_node[static_cast<Index>(r)])];
+            if (!(v >= 0.5 * lo && v <= 1.5 * hi)) use_model = false;
         }
-        entries.emplace_back(row, row, sum);
+        auto model_at = [&](Index i) { return use_model ? model[i] : 0.0; };
+        entries.clear();
+        if (m <= kDense) dense.setZero(static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(m));
+        Eigen::VectorXd rhs = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(m));
+        for (int r : members) {
+            const Index i = static_cast<Index>(row_node[static_cast<Index>(r)]);
+            const int row = local[static_cast<Index>(r)];
+            double sum = 0;
+            for (int j : adj[i]) {
+                const double w = 1.0 / std::max(1e-6, angle_between(nodes_[i].dir, nodes_[static_cast<Index>(j)].dir));
+                sum += w;
+                const int c = unknown[static_cast<Index>(j)];
+                if (c < 0) {
+                    rhs[row] += w * (nodes_[static_cast<Index>(j)].radius - model_at(static_cast<Index>(j)));
+                } else if (local[static_cast<Index>(c)] < row) {
+                    if (m <= kDense) dense(row, local[static_cast<Index>(c)]) = -w;
+                    else entries.emplace_back(row, local[static_cast<Index>(c)], -w);
+                }
+            }
+            if (m <= kDense) dense(row, row) = sum;
+            else entries.emplace_back(row, row, sum);
+        }
+        Eigen::VectorXd x;
+        bool ok = false;
+        if (m <= kDense) {
+            const Eigen::LLT<Eigen::MatrixXd, Eigen::Lower> llt(dense);
+            ok = llt.info() == Eigen::Success;
+            if (ok) x = llt.solve(rhs);
+        } else {
+            Eigen::SparseMatrix<double> system(static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(m));
+            system.setFromTriplets(entries.begin(), entries.end());
+            const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(system);
+            ok = solver.info() == Eigen::Success;
+            if (ok) x = solver.solve(rhs);
+        }
+        if (!ok || !solver_ok(x)) throw InvalidInput("the lobe's strokes leave a gap that cannot be closed around its centre");
+        for (int r : members) {
+            const Index i = static_cast<Index>(row_node[static_cast<Index>(r)]);
+            const double radius = x[local[static_cast<Index>(r)]] + model_at(i);
+            if (!(radius > 0.25 * lo)) throw InvalidInput("the lobe's strokes leave a gap too wide to close around its centre");
+            nodes_[i].radius = radius;
+        }
     }
-    Eigen::SparseMatrix<double> system(count, count);
-    system.setFromTriplets(entries.begin(), entries.end());
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(system);
-    Eigen::VectorXd x;
-    if (solver.info() == Eigen::Success) x = solver.solve(rhs);
-    if (solver.info() != Eigen::Success || !solver_ok(x))
-        throw InvalidInput("the lobe's strokes leave a gap that cannot be closed around its centre");
-    for (Index i = 0; i < n; ++i)
-        if (unknown[i] >= 0) {
-            const double r = x[unknown[i]] + model[i];
-            if (!(r > 0.25 * lo)) throw InvalidInput("the lobe's strokes leave a gap too wide to close around its centre");
-            nodes_[i].radius = r;
-        }
 }
 
-bool Builder::fit_radius_model(const std::vector<char>& used, std::vector<double>& model) const
+bool Builder::fit_radius_model(const std::vector<char>& fit, const std::vector<char>& used, std::vector<double>& model) const
 {
     // Monomials x^a y^b z^c of the direction, a + b + c ≤ 3: 20 functions spanning the
     // spherical harmonics up to degree 3 on the sphere.
@@ -1081,13 +1240,13 @@ bool Builder::fit_radius_model(const std::vector<char>& used, std::vector<double
     // the normal equations as one matrix product.
     Index samples = 0;
     for (Index i = 0; i < nodes_.size(); ++i)
-        if (nodes_[i].origin.kind != LobeVertexKind::Fill && used[i]) ++samples;
+        if (fit[i]) ++samples;
     if (samples < static_cast<Index>(kTerms)) return false;
     Basis phi(static_cast<Eigen::Index>(samples), kTerms);
     Eigen::VectorXd radius(static_cast<Eigen::Index>(samples));
     Eigen::Index row = 0;
     for (Index i = 0; i < nodes_.size(); ++i) {
-        if (nodes_[i].origin.kind == LobeVertexKind::Fill || !used[i]) continue;
+        if (!fit[i]) continue;
         basis(nodes_[i].dir, phi.row(row));
         radius[row++] = nodes_[i].radius;
     }
@@ -1167,8 +1326,24 @@ void Builder::emit(LobeSurface& out)
         out.paper_strip_triangles += region.size();
         tris.insert(tris.end(), region.begin(), region.end());
     }
+    const std::size_t strip_count = tris.size();
+    if (partial_)
+        // Every stroke edge triangulated lies in or around the changed regions: one that lies
+        // in a kept region means the new strokes ran into a region taken for unchanged.
+        for (const auto& [u, v] : inserted_) {
+            const VH a = node_vertex_[static_cast<Index>(u)], b = node_vertex_[static_cast<Index>(v)];
+            FH f;
+            int i = 0;
+            if (a == b) continue;
+            if (!cdt_.is_edge(a, b, f, i)) throw PartialFailed{};
+            const FH g = f->neighbor(i);
+            if (!region_inside_[static_cast<Index>(f->info().region)] &&
+                (cdt_.is_infinite(g) || !region_inside_[static_cast<Index>(g->info().region)]))
+                throw PartialFailed{};
+        }
     for (FH f : cdt_.finite_face_handles()) {
-        if (paper_region_[static_cast<Index>(f->info().region)]) continue;
+        if (paper_region_[static_cast<Index>(f->info().region)] || !region_inside_[static_cast<Index>(f->info().region)])
+            continue;
         // Planar counter-clockwise is clockwise seen from outside the sphere.
         tris.push_back({node_of(f->vertex(0)), node_of(f->vertex(2)), node_of(f->vertex(1))});
     }
@@ -1176,6 +1351,7 @@ void Builder::emit(LobeSurface& out)
     for (FH f : cdt_.all_face_handles()) {
         if (!cdt_.is_infinite(f)) continue;
         const int i = f->index(cdt_.infinite_vertex());
+        if (!region_inside_[static_cast<Index>(f->neighbor(i)->info().region)]) continue;
         std::array<int, 3> t{pole_node_, node_of(f->vertex((i + 1) % 3)), node_of(f->vertex((i + 2) % 3))};
         if (orient3(nodes_[static_cast<Index>(t[0])].dir, nodes_[static_cast<Index>(t[1])].dir,
                     nodes_[static_cast<Index>(t[2])].dir) < 0)
@@ -1208,12 +1384,19 @@ void Builder::emit(LobeSurface& out)
         for (auto& t : tris)
             for (int& id : t) id = new_id[static_cast<Index>(id)];
     }
-    solve_fill_radii(tris);
+    std::vector<char> on_chain(nodes_.size(), 0);
+    for (const auto& chain : chains_)
+        for (int id : chain) on_chain[static_cast<Index>(new_id[static_cast<Index>(id)])] = 1;
+    solve_fill_radii(tris, on_chain);
 
-    // Output: only nodes used by triangles, in node order (samples first, by stroke).
+    // Output: only nodes used by triangles, in node order (samples first, by stroke); a
+    // build of the changed regions has every stroke node (the kept regions use them).
     std::vector<int> out_index(nodes_.size(), -1);
     for (const auto& t : tris)
         for (int id : t) out_index[static_cast<Index>(id)] = 0;
+    if (partial_)
+        for (Index i = 0; i < nodes_.size(); ++i)
+            if (on_chain[i]) out_index[i] = 0;
     for (Index i = 0; i < nodes_.size(); ++i) {
         if (out_index[i] < 0) continue;
         out_index[i] = static_cast<int>(out.mesh.positions.size());
@@ -1241,17 +1424,23 @@ void Builder::emit(LobeSurface& out)
         const Index first = static_cast<Index>(std::min_element(o.begin(), o.end()) - o.begin());
         out.mesh.triangles.push_back({o[first], o[(first + 1) % 3], o[(first + 2) % 3]});
     }
-    // Sorted: bucketed by first (lowest) index, each bucket (a vertex's few triangles) sorted.
+    // Sorted: bucketed by first (lowest) index, each bucket (a vertex's few triangles) sorted;
+    // the paper strips' triangles (the first strip_count) flagged.
     {
         auto& tris_out = out.mesh.triangles;
         std::vector<int> start(out.mesh.positions.size() + 1, 0);
         for (const auto& t : tris_out) ++start[static_cast<Index>(t[0]) + 1];
         for (Index i = 1; i < start.size(); ++i) start[i] += start[i - 1];
-        std::vector<std::array<int, 3>> sorted(tris_out.size());
+        std::vector<std::pair<std::array<int, 3>, std::uint8_t>> sorted(tris_out.size());
         std::vector<int> next(start.begin(), start.end() - 1);
-        for (const auto& t : tris_out) sorted[static_cast<Index>(next[static_cast<Index>(t[0])]++)] = t;
+        for (Index k = 0; k < tris_out.size(); ++k)
+            sorted[static_cast<Index>(next[static_cast<Index>(tris_out[k][0])]++)] = {tris_out[k], k < strip_count ? 1 : 0};
         for (Index i = 0; i + 1 < start.size(); ++i) std::sort(sorted.begin() + start[i], sorted.begin() + start[i + 1]);
-        tris_out = std::move(sorted);
+        out.paper_strip_faces.resize(sorted.size());
+        for (Index k = 0; k < sorted.size(); ++k) {
+            tris_out[k] = sorted[k].first;
+            out.paper_strip_faces[k] = sorted[k].second;
+        }
     }
     // Stroke segments (split at crossings) are the constraints of remeshing.
     auto out_of = [&](VH v) { return out_index[static_cast<Index>(new_id[static_cast<Index>(node_of(v))])]; };
@@ -1288,6 +1477,7 @@ LobeSurface Builder::run()
     choose_pole();
     find_crossings();
     build_chains();
+    if (previous_) plan_partial();
     LobeSurface out;
     out.centre = centre_;
     out.reference_radius = options_.reference_radius_m > 0 ? options_.reference_radius_m : mean_radius_;
@@ -1332,6 +1522,29 @@ LobeSurface build_lobe_surface(const std::vector<LobeStrokeSamples>& strokes, co
 {
     Builder b(strokes, centre, options);
     return b.run();
+}
+
+LobeSurface continue_lobe_surface(const LobeSurface& previous, const SurfaceRegions& previous_regions,
+                                  const std::vector<LobeStrokeSamples>& strokes, const glm::dvec3& centre,
+                                  const LobeSurfaceOptions& options, SurfaceRegions& regions, KeptRegions& kept)
+{
+    try {
+        Builder b(strokes, centre, options);
+        b.set_previous(previous, previous_regions);
+        LobeSurface surface = b.run();
+        if (!b.partial()) {
+            kept = keep_unchanged_regions(previous, previous_regions, surface, regions);
+            return surface;
+        }
+        if (complete_with_kept_regions(previous, previous_regions, b.kept_previous_regions(), surface, regions, kept)) {
+            kept.built_changed_only = true;
+            return surface;
+        }
+    } catch (const PartialFailed&) {
+    }
+    LobeSurface surface = build_lobe_surface(strokes, centre, options);
+    kept = keep_unchanged_regions(previous, previous_regions, surface, regions);
+    return surface;
 }
 
 } // namespace lobe

@@ -161,6 +161,17 @@ int expect_scratch_or_kept_regions(const Lobe& lobe, const LobeSurface& before, 
     EXPECT_TRUE(kept_strokes == scratch_strokes) << what;
     EXPECT_EQ(kept.crossings, scratch.crossings) << what;
     EXPECT_EQ(kept.paper_strip_triangles, scratch.paper_strip_triangles) << what;
+    // The same stroke edges, by the positions of their ends.
+    auto stroke_edges = [](const LobeSurface& s) {
+        std::set<std::array<float, 6>> out;
+        for (const auto& e : s.mesh.feature_edges) {
+            glm::vec3 a = s.mesh.positions[static_cast<std::size_t>(e[0])], b = s.mesh.positions[static_cast<std::size_t>(e[1])];
+            if (std::tie(b.x, b.y, b.z) < std::tie(a.x, a.y, a.z)) std::swap(a, b);
+            out.insert({a.x, a.y, a.z, b.x, b.y, b.z});
+        }
+        return out;
+    };
+    EXPECT_TRUE(stroke_edges(kept) == stroke_edges(scratch)) << what << ": stroke edges differ";
     const auto now = regions_by_stroke_edges(kept.mesh);
     const auto fresh = regions_by_stroke_edges(scratch.mesh);
     const auto old = regions_by_stroke_edges(before.mesh);

@@ -65,15 +65,20 @@ std::vector<std::vector<glm::vec3>> ten_strokes()
     return s;
 }
 
-/// Adds the 11th stroke (a loop tilted by 45°) to a lobe of ten; the lobe is copied back
-/// outside the timed region each round.
+/// Adds an 11th stroke to a lobe of ten; the lobe is copied back outside the timed region
+/// each round. Arg 0: a loop tilted by 45°, which crosses every stroke (twice) and changes
+/// about half of the lobe; arg 1: a ring round the equator, between the two middle rings,
+/// which changes the strip between them (the paper's Fig. 5 case).
 void BM_AddStrokeToTenStrokeLobe(benchmark::State& state)
 {
     Lobe base;
     const auto strokes = ten_strokes();
     for (std::size_t i = 0; i < strokes.size(); ++i) base.add_stroke(static_cast<std::int64_t>(i + 1), strokes[i]);
-    const auto extra = raw_loop(kCentre, glm::normalize(glm::dvec3(1, 1, 0)), {0, 0, 1}, kRadius, 11);
+    const auto extra = state.range(0) ? raw_loop(kCentre, {1, 0, 0}, {0, 0, 1}, kRadius, 5)
+                                      : raw_loop(kCentre, glm::normalize(glm::dvec3(1, 1, 0)), {0, 0, 1}, kRadius, 11);
     const LobeStrokeSamples prepared = prepare_lobe_stroke(11, extra);
+    Lobe after = base;
+    after.add_prepared(prepared);
     for (auto _ : state) {
         state.PauseTiming();
         Lobe lobe = base;
@@ -84,8 +89,11 @@ void BM_AddStrokeToTenStrokeLobe(benchmark::State& state)
     const LobeSurface& s = base.surface();
     state.counters["vertices"] = static_cast<double>(s.mesh.positions.size());
     state.counters["crossings"] = static_cast<double>(s.crossings);
+    state.counters["regions"] = static_cast<double>(after.last_kept().regions);
+    state.counters["kept"] = static_cast<double>(after.last_kept().kept);
+    state.counters["built_changed_only"] = after.last_kept().built_changed_only ? 1.0 : 0.0;
 }
-BENCHMARK(BM_AddStrokeToTenStrokeLobe)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_AddStrokeToTenStrokeLobe)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 /// What a regrowth does with the lobes after the person drew one more lobe stroke: every lobe
 /// of table1-4lobes-22strokes (4 lobes, 22 strokes) built from its strokes and remeshed.
