@@ -306,6 +306,84 @@ TEST(LobeIncremental, EveryShippedLobeStrokeRemeshesOnlyTheRegionsItChangedAndKe
     EXPECT_GT(100 * unchanged, 15 * triangles);
 }
 
+TEST(LobeIncremental, ShippedAndRandomLobeStrokesBuildOnlyTheRegionsTheyChangeAndGiveTheWholeBuildsSurface)
+{
+    // Every lobe stroke of the shipped recordings and of seeded random drawings (loops of
+    // random size and tilt, arcs over them), added one at a time: the surface built from the
+    // changed regions alone has every region of the whole build (or, bit for bit, the one
+    // before), and the changed regions alone are what was built for nearly every stroke that
+    // left a region as it was (one that changes every region builds the whole surface).
+    int continued = 0, leaving = 0, changed_only = 0;
+    auto check = [&](Lobe& lobe, std::int64_t id, const std::vector<glm::vec3>& raw, const std::string& what) {
+        const LobeSurface before = lobe.empty() ? LobeSurface{} : lobe.surface();
+        const glm::dvec3 centre = lobe.centre();
+        const bool first = lobe.empty();
+        try {
+            lobe.add_stroke(id, raw);
+        } catch (const InvalidInput&) {
+            return; // refused, the lobe as it was (tested elsewhere)
+        }
+        if (first || centre != lobe.centre()) {
+            EXPECT_FALSE(lobe.last_kept().built_changed_only) << what;
+            return;
+        }
+        expect_scratch_or_kept_regions(lobe, before, what);
+        ++continued;
+        if (lobe.last_kept().kept == 0) {
+            EXPECT_FALSE(lobe.last_kept().built_changed_only) << what;
+            return;
+        }
+        ++leaving;
+        changed_only += lobe.last_kept().built_changed_only ? 1 : 0;
+    };
+    for (const char* name : {"table1-1lobe-5strokes", "table1-3lobes-16strokes", "table1-4lobes-22strokes", "pinch-edit"}) {
+        const Document doc = test::replay_document(name);
+        for (const LobeRecord& rec : doc.lobes) {
+            Lobe lobe(lobe_options_from(doc.settings));
+            for (std::int64_t id : rec.stroke_ids) {
+                const auto it = std::find_if(doc.strokes.begin(), doc.strokes.end(), [&](const Stroke& s) { return s.id == id; });
+                ASSERT_NE(it, doc.strokes.end());
+                std::vector<glm::vec3> raw;
+                for (const StrokePoint& p : it->points) raw.push_back(p.position);
+                check(lobe, id, raw, std::string(name) + " lobe " + std::to_string(rec.id) + " stroke " + std::to_string(id));
+            }
+        }
+    }
+    const int shipped = continued;
+    std::uint32_t state = 777u;
+    auto uniform = [&](double lo, double hi) {
+        state = state * 1664525u + 1013904223u;
+        return lo + (hi - lo) * static_cast<double>(state >> 8) / static_cast<double>(1u << 24);
+    };
+    for (int lobe_index = 0; lobe_index < 12; ++lobe_index) {
+        const glm::dvec3 c(uniform(-0.3, 0.3), uniform(1.0, 1.6), uniform(-0.6, -0.2));
+        const double r = uniform(0.1, 0.3);
+        Lobe lobe;
+        for (int k = 0; k < 3 + lobe_index % 6; ++k) {
+            std::vector<glm::vec3> raw;
+            const double tilt = uniform(0.0, kPi), turn = uniform(0.0, 2 * kPi);
+            const glm::dvec3 axis(std::sin(tilt) * std::cos(turn), std::cos(tilt), std::sin(tilt) * std::sin(turn));
+            const glm::dvec3 u = glm::normalize(glm::cross(axis, glm::dvec3(0.3, 0.1, 0.9)));
+            const glm::dvec3 v = glm::cross(axis, u);
+            const double h = uniform(-0.6, 0.6) * r, rr = std::sqrt(r * r - h * h);
+            const bool arc = k > 0 && uniform(0.0, 1.0) < 0.3;
+            const int n = static_cast<int>(2 * kPi * rr / 0.005);
+            for (int i = 0; i < n; ++i) {
+                const double t = (arc ? 0.45 : 1.0) * 2 * kPi * i / n;
+                const double w = 0.002 * std::sin(5 * t + k);
+                raw.emplace_back(c + h * axis + (rr + w) * (std::cos(t) * u + std::sin(t) * v));
+            }
+            check(lobe, k + 1, raw, "random lobe " + std::to_string(lobe_index) + ", stroke " + std::to_string(k + 1));
+        }
+    }
+    std::cout << continued << " strokes added to a lobe whose centre stayed (" << shipped << " shipped), " << leaving
+              << " of them left some region as it was: " << changed_only << " built from the changed regions alone\n";
+    EXPECT_GE(shipped, 30);
+    EXPECT_GE(continued - shipped, 20);
+    // The rest meet a stroke edge the triangulation split where strokes nearly touch.
+    EXPECT_GE(100 * changed_only, 85 * leaving) << "strokes fell back to building the whole surface";
+}
+
 TEST(LobeIncremental, RandomLobesStayValidStrokeByStrokeAndTheirRemeshingDoesNotDependOnWhatWasKept)
 {
     // Seeded random drawings: loops of random size, tilt and wobble round one centre and arcs
