@@ -169,9 +169,11 @@ bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_re
     // the same stroke edges, or (also_keep) one after `next`'s.
     std::vector<int> kept_as(static_cast<Index>(prev_regions.count), -1);
     {
+        // A region kept already (also_keep) is no region of `next`: only the others can match.
         std::map<std::vector<DirectedEdge>, int> prev_by_key;
         for (Index r = 0; r < prev_keys.size(); ++r)
-            if (!prev_keys[r].empty()) prev_by_key.emplace(prev_keys[r], static_cast<int>(r));
+            if (!prev_keys[r].empty() && !(also_keep && r < also_keep->size() && (*also_keep)[r]))
+                prev_by_key.emplace(prev_keys[r], static_cast<int>(r));
         for (Index r = 0; r < next_keys.size(); ++r) {
             const auto it = next_keys[r].empty() ? prev_by_key.end() : prev_by_key.find(next_keys[r]);
             if (it == prev_by_key.end()) continue;

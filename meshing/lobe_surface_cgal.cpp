@@ -1250,7 +1250,9 @@ bool Builder::fit_radius_model(const std::vector<char>& fit, const std::vector<c
         basis(nodes_[i].dir, phi.row(row));
         radius[row++] = nodes_[i].radius;
     }
-    Eigen::Matrix<double, kTerms, kTerms> ata = phi.transpose() * phi;
+    // Only the lower triangle of the normal matrix is formed: all the LDLT below reads.
+    Eigen::Matrix<double, kTerms, kTerms> ata = Eigen::Matrix<double, kTerms, kTerms>::Zero();
+    ata.selfadjointView<Eigen::Lower>().rankUpdate(phi.transpose());
     const Eigen::Matrix<double, kTerms, 1> atb = phi.transpose() * radius;
     // Penalty growing with degree (d(d+1))², scaled to the number of samples.
     for (Index j = 0; j < static_cast<Index>(kTerms); ++j) {

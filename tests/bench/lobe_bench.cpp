@@ -74,8 +74,18 @@ void BM_AddStrokeToTenStrokeLobe(benchmark::State& state)
     Lobe base;
     const auto strokes = ten_strokes();
     for (std::size_t i = 0; i < strokes.size(); ++i) base.add_stroke(static_cast<std::int64_t>(i + 1), strokes[i]);
-    const auto extra = state.range(0) ? raw_loop(kCentre, {1, 0, 0}, {0, 0, 1}, kRadius, 5)
-                                      : raw_loop(kCentre, glm::normalize(glm::dvec3(1, 1, 0)), {0, 0, 1}, kRadius, 11);
+    std::vector<glm::vec3> extra;
+    if (state.range(0) == 0) extra = raw_loop(kCentre, glm::normalize(glm::dvec3(1, 1, 0)), {0, 0, 1}, kRadius, 11);
+    if (state.range(0) == 1) extra = raw_loop(kCentre, {1, 0, 0}, {0, 0, 1}, kRadius, 5);
+    if (state.range(0) == 2) {
+        // A small loop on the lobe inside one cell between the upper rings (latitude 36°,
+        // between the loops at 0° and 30° of longitude).
+        const double lat = 36.0 * kPi / 180.0, lon = 15.0 * kPi / 180.0;
+        const glm::dvec3 axis(std::cos(lat) * std::cos(lon), std::sin(lat), std::cos(lat) * std::sin(lon));
+        const glm::dvec3 u = glm::normalize(glm::cross(axis, glm::dvec3(0, 1, 0))), v = glm::cross(axis, u);
+        const double a = 0.04;
+        extra = raw_loop(kCentre + std::sqrt(kRadius * kRadius - a * a) * axis, u, v, a, 2);
+    }
     const LobeStrokeSamples prepared = prepare_lobe_stroke(11, extra);
     Lobe after = base;
     after.add_prepared(prepared);
@@ -93,7 +103,7 @@ void BM_AddStrokeToTenStrokeLobe(benchmark::State& state)
     state.counters["kept"] = static_cast<double>(after.last_kept().kept);
     state.counters["built_changed_only"] = after.last_kept().built_changed_only ? 1.0 : 0.0;
 }
-BENCHMARK(BM_AddStrokeToTenStrokeLobe)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_AddStrokeToTenStrokeLobe)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 
 /// What a regrowth does with the lobes after the person drew one more lobe stroke: every lobe
 /// of table1-4lobes-22strokes (4 lobes, 22 strokes) built from its strokes and remeshed.
