@@ -48,9 +48,10 @@ public:
 
     /// Adds a raw stroke: sampled, closed when its ends meet, then joined to the surface.
     /// While the centre stays, every region of the surface that the stroke leaves as it was
-    /// keeps its triangles and vertices bit for bit (keep_unchanged_regions): the surface
-    /// after a stroke depends on the surface before it, so a lobe is the strokes added in
-    /// their order (as LobeBuildCache and a replay both add them).
+    /// keeps its triangles and vertices bit for bit, and only the changed regions are built
+    /// (continue_lobe_surface): the surface after a stroke depends on the surface before it,
+    /// so a lobe is the strokes added in their order (as LobeBuildCache and a replay both add
+    /// them).
     void add_stroke(std::int64_t id, const std::vector<glm::vec3>& raw);
     /// Adds an already prepared stroke.
     void add_prepared(LobeStrokeSamples stroke);
