@@ -78,6 +78,40 @@ std::vector<std::vector<glm::vec3>> rings_and_arcs()
     return s;
 }
 
+/// Seeded random drawings: loops of random size, tilt and wobble round a centre, and (after
+/// the first stroke, three times in ten) arcs over them, raw points 5 mm apart.
+struct RandomDrawing {
+    std::uint32_t state;
+    double uniform(double lo, double hi)
+    {
+        state = state * 1664525u + 1013904223u;
+        return lo + (hi - lo) * static_cast<double>(state >> 8) / static_cast<double>(1u << 24);
+    }
+    glm::dvec3 centre()
+    {
+        const double x = uniform(-0.3, 0.3), y = uniform(1.0, 1.6), z = uniform(-0.6, -0.2);
+        return {x, y, z};
+    }
+    /// Stroke k (from 0) of a lobe of radius r round c.
+    std::vector<glm::vec3> stroke(const glm::dvec3& c, double r, int k)
+    {
+        std::vector<glm::vec3> raw;
+        const double tilt = uniform(0.0, kPi), turn = uniform(0.0, 2 * kPi);
+        const glm::dvec3 axis(std::sin(tilt) * std::cos(turn), std::cos(tilt), std::sin(tilt) * std::sin(turn));
+        const glm::dvec3 u = glm::normalize(glm::cross(axis, glm::dvec3(0.3, 0.1, 0.9)));
+        const glm::dvec3 v = glm::cross(axis, u);
+        const double h = uniform(-0.6, 0.6) * r, rr = std::sqrt(r * r - h * h);
+        const bool arc = k > 0 && uniform(0.0, 1.0) < 0.3;
+        const int n = static_cast<int>(2 * kPi * rr / 0.005);
+        for (int i = 0; i < n; ++i) {
+            const double t = (arc ? 0.45 : 1.0) * 2 * kPi * i / n;
+            const double w = 0.002 * std::sin(5 * t + k);
+            raw.emplace_back(c + h * axis + (rr + w) * (std::cos(t) * u + std::sin(t) * v));
+        }
+        return raw;
+    }
+};
+
 void expect_valid(const TriangleMesh& mesh, const std::string& what)
 {
     const MeshQuality q = measure_quality(mesh);
@@ -350,29 +384,13 @@ TEST(LobeIncremental, ShippedAndRandomLobeStrokesBuildOnlyTheRegionsTheyChangeAn
         }
     }
     const int shipped = continued;
-    std::uint32_t state = 777u;
-    auto uniform = [&](double lo, double hi) {
-        state = state * 1664525u + 1013904223u;
-        return lo + (hi - lo) * static_cast<double>(state >> 8) / static_cast<double>(1u << 24);
-    };
+    RandomDrawing random{777u};
     for (int lobe_index = 0; lobe_index < 12; ++lobe_index) {
-        const glm::dvec3 c(uniform(-0.3, 0.3), uniform(1.0, 1.6), uniform(-0.6, -0.2));
-        const double r = uniform(0.1, 0.3);
+        const glm::dvec3 c = random.centre();
+        const double r = random.uniform(0.1, 0.3);
         Lobe lobe;
         for (int k = 0; k < 3 + lobe_index % 6; ++k) {
-            std::vector<glm::vec3> raw;
-            const double tilt = uniform(0.0, kPi), turn = uniform(0.0, 2 * kPi);
-            const glm::dvec3 axis(std::sin(tilt) * std::cos(turn), std::cos(tilt), std::sin(tilt) * std::sin(turn));
-            const glm::dvec3 u = glm::normalize(glm::cross(axis, glm::dvec3(0.3, 0.1, 0.9)));
-            const glm::dvec3 v = glm::cross(axis, u);
-            const double h = uniform(-0.6, 0.6) * r, rr = std::sqrt(r * r - h * h);
-            const bool arc = k > 0 && uniform(0.0, 1.0) < 0.3;
-            const int n = static_cast<int>(2 * kPi * rr / 0.005);
-            for (int i = 0; i < n; ++i) {
-                const double t = (arc ? 0.45 : 1.0) * 2 * kPi * i / n;
-                const double w = 0.002 * std::sin(5 * t + k);
-                raw.emplace_back(c + h * axis + (rr + w) * (std::cos(t) * u + std::sin(t) * v));
-            }
+            const std::vector<glm::vec3> raw = random.stroke(c, r, k);
             check(lobe, k + 1, raw, "random lobe " + std::to_string(lobe_index) + ", stroke " + std::to_string(k + 1));
         }
     }
@@ -389,34 +407,18 @@ TEST(LobeIncremental, RandomLobesStayValidStrokeByStrokeAndTheirRemeshingDoesNot
     // Seeded random drawings: loops of random size, tilt and wobble round one centre and arcs
     // over them, added one at a time; after each, the lobe remeshed with the regions of the last
     // remeshing kept must be a valid lobe and the same bytes as a remeshing from nothing.
-    std::uint32_t state = 12345u;
-    auto uniform = [&](double lo, double hi) {
-        state = state * 1664525u + 1013904223u;
-        return lo + (hi - lo) * static_cast<double>(state >> 8) / static_cast<double>(1u << 24);
-    };
+    RandomDrawing random{12345u};
     RemeshOptions remesh;
     remesh.iterations = 4;
     int checked = 0, whole = 0;
     for (int lobe_index = 0; lobe_index < 12; ++lobe_index) {
-        const glm::dvec3 c(uniform(-0.3, 0.3), uniform(1.0, 1.6), uniform(-0.6, -0.2));
-        const double r = uniform(0.1, 0.3);
+        const glm::dvec3 c = random.centre();
+        const double r = random.uniform(0.1, 0.3);
         Lobe lobe;
         LobeRemeshCache cache;
         const int strokes = 2 + lobe_index % 5;
         for (int k = 0; k < strokes; ++k) {
-            std::vector<glm::vec3> raw;
-            const double tilt = uniform(0.0, kPi), turn = uniform(0.0, 2 * kPi);
-            const glm::dvec3 axis(std::sin(tilt) * std::cos(turn), std::cos(tilt), std::sin(tilt) * std::sin(turn));
-            const glm::dvec3 u = glm::normalize(glm::cross(axis, glm::dvec3(0.3, 0.1, 0.9)));
-            const glm::dvec3 v = glm::cross(axis, u);
-            const double h = uniform(-0.6, 0.6) * r, rr = std::sqrt(r * r - h * h);
-            const bool arc = k > 0 && uniform(0.0, 1.0) < 0.3;
-            const int n = static_cast<int>(2 * kPi * rr / 0.005);
-            for (int i = 0; i < n; ++i) {
-                const double t = (arc ? 0.45 : 1.0) * 2 * kPi * i / n;
-                const double w = 0.002 * std::sin(5 * t + k);
-                raw.emplace_back(c + h * axis + (rr + w) * (std::cos(t) * u + std::sin(t) * v));
-            }
+            const std::vector<glm::vec3> raw = random.stroke(c, r, k);
             try {
                 lobe.add_stroke(k + 1, raw);
             } catch (const InvalidInput&) {
