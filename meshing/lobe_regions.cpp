@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 #include <map>
 #include <numeric>
@@ -14,10 +16,70 @@ namespace lobe {
 namespace {
 
 using Index = std::size_t;
-using Key3 = std::array<float, 3>;
 using DirectedEdge = RegionStrokeEdge;
 
-Key3 key_of(const glm::vec3& p) { return {p.x, p.y, p.z}; }
+/// Vertices by exact position: an open-addressing hash table (linear probing, at most half
+/// full). This runs on every stroke vertex of the lobe twice per stroke added; a sorted
+/// array and binary searches cost several times as much.
+class PositionIndex {
+public:
+    /// Room for `count` vertices.
+    explicit PositionIndex(Index count)
+    {
+        Index size = 16;
+        while (size < 2 * count) size *= 2;
+        mask_ = size - 1;
+        slots_.assign(size, Slot{});
+    }
+    /// Adds vertex `v` at `p` unless a vertex was added there before (the first one stays).
+    void add(const glm::vec3& p, int v)
+    {
+        const Bits k = bits(p);
+        for (Index i = hash(k) & mask_;; i = (i + 1) & mask_) {
+            Slot& s = slots_[i];
+            if (s.vertex < 0) {
+                s = {k, v};
+                return;
+            }
+            if (s.key == k) return;
+        }
+    }
+    /// The vertex at `p`, or −1.
+    int find(const glm::vec3& p) const
+    {
+        const Bits k = bits(p);
+        for (Index i = hash(k) & mask_;; i = (i + 1) & mask_) {
+            const Slot& s = slots_[i];
+            if (s.vertex < 0) return -1;
+            if (s.key == k) return s.vertex;
+        }
+    }
+
+private:
+    using Bits = std::array<std::uint32_t, 3>;
+    struct Slot {
+        Bits key{};
+        int vertex = -1;
+    };
+    static Bits bits(const glm::vec3& p)
+    {
+        // + 0.0f makes −0 and +0 (equal positions) one key.
+        Bits b{};
+        const float c[3] = {p.x + 0.0f, p.y + 0.0f, p.z + 0.0f};
+        std::memcpy(b.data(), c, sizeof c);
+        return b;
+    }
+    static Index hash(const Bits& b)
+    {
+        std::uint64_t h = b[0] * 0x9E3779B97F4A7C15ull;
+        h ^= (h >> 29) ^ (b[1] * 0xC2B2AE3D27D4EB4Full);
+        h ^= (h >> 31) ^ (b[2] * 0x165667B19E3779F9ull);
+        h ^= h >> 32;
+        return static_cast<Index>(h);
+    }
+    std::vector<Slot> slots_;
+    Index mask_ = 0;
+};
 
 /// Edges bucketed by their lower vertex (a counting sort: a vertex has a handful), so that
 /// finding an edge is a scan of a few entries instead of a search in all of them. This runs
@@ -69,6 +131,26 @@ struct Features {
         return on_vertex[static_cast<Index>(a)] && on_vertex[static_cast<Index>(b)] ? edges.find(a, b) : -1;
     }
 };
+
+/// Sorts edges (lower, higher) and drops repeats: bucketed by the lower vertex (a counting
+/// sort), each bucket (a vertex's few edges) sorted on its own.
+void sort_unique_edges(std::vector<std::array<int, 2>>& edges, Index vertices)
+{
+    std::vector<int> start(vertices + 1, 0);
+    for (const auto& e : edges) ++start[static_cast<Index>(e[0]) + 1];
+    for (Index i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+    std::vector<int> sorted(edges.size());
+    std::vector<int> next(start.begin(), start.end() - 1);
+    for (const auto& e : edges) sorted[static_cast<Index>(next[static_cast<Index>(e[0])]++)] = e[1];
+    Index out = 0;
+    for (Index v = 0; v + 1 < start.size(); ++v) {
+        const auto first = sorted.begin() + start[v], last = sorted.begin() + start[v + 1];
+        std::sort(first, last);
+        for (auto it = first; it != last; ++it)
+            if (it == first || *it != *(it - 1)) edges[out++] = {static_cast<int>(v), *it};
+    }
+    edges.resize(out);
+}
 
 MeshRegions regions_of(const TriangleMesh& mesh, const Features& features)
 {
@@ -194,11 +276,14 @@ bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_re
     // Vertices on strokes are shared by position: every stroke edge of a kept region is one
     // of `next` (the keys matched; a build of the changed regions has every stroke vertex),
     // so its ends are vertices of `next` at the same place.
-    std::vector<std::pair<Key3, int>> on_stroke;
+    auto on_stroke_of_next = [&](Index v) {
+        return next_features.on_vertex[v] || next.origins[v].kind != LobeVertexKind::Fill;
+    };
+    Index stroke_vertices = 0;
+    for (Index v = 0; v < next.mesh.positions.size(); ++v) stroke_vertices += on_stroke_of_next(v) ? 1 : 0;
+    PositionIndex on_stroke(stroke_vertices);
     for (Index v = 0; v < next.mesh.positions.size(); ++v)
-        if (next_features.on_vertex[v] || next.origins[v].kind != LobeVertexKind::Fill)
-            on_stroke.emplace_back(key_of(next.mesh.positions[v]), static_cast<int>(v));
-    std::sort(on_stroke.begin(), on_stroke.end());
+        if (on_stroke_of_next(v)) on_stroke.add(next.mesh.positions[v], static_cast<int>(v));
 
     // All vertices of both surfaces that the result may use: `next`'s, then `previous`'s
     // inner vertices of kept regions.
@@ -225,39 +310,45 @@ bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_re
             tri_region.push_back(next_regions.face_region[f]);
             tri_strip.push_back(next_strips ? next.paper_strip_faces[f] : 0);
         }
+    // The kept triangles' vertices: stroke vertices are `next`'s at the same place; inner ones
+    // are added in `previous`'s order (canonical there, so the order below is a merge).
+    constexpr int kNeeded = -2;
+    for (Index f = 0; f < previous.mesh.triangles.size(); ++f) {
+        if (kept_as[static_cast<Index>(prev_regions.face_region[f])] < 0) continue;
+        for (int v : previous.mesh.triangles[f]) {
+            int& mapped = from_previous[static_cast<Index>(v)];
+            if (mapped != -1) continue;
+            if (!prev_features.on_vertex[static_cast<Index>(v)]) {
+                mapped = kNeeded;
+                continue;
+            }
+            mapped = on_stroke.find(previous.mesh.positions[static_cast<Index>(v)]);
+            if (mapped < 0) {
+                if (also_keep) return false;
+                result = KeptRegions{next_regions.count, 0, 0, false};
+                return true;
+            }
+        }
+    }
+    const Index from_next = all.size();
+    for (Index v = 0; v < from_previous.size(); ++v)
+        if (from_previous[v] == kNeeded) {
+            from_previous[v] = static_cast<int>(all.size());
+            all.push_back({previous.mesh.positions[v], previous.origins[v]});
+        }
     std::vector<std::array<int, 2>> kept_features; // stroke edges of kept triangles (also_keep)
     for (Index f = 0; f < previous.mesh.triangles.size(); ++f) {
         const int as = kept_as[static_cast<Index>(prev_regions.face_region[f])];
         if (as < 0) continue;
         tri_region.push_back(as);
         tri_strip.push_back(prev_strips ? previous.paper_strip_faces[f] : 0);
-        std::array<int, 3> t{};
-        for (int k = 0; k < 3; ++k) {
-            const int v = previous.mesh.triangles[f][static_cast<Index>(k)];
-            int& mapped = from_previous[static_cast<Index>(v)];
-            if (mapped < 0) {
-                const glm::vec3& p = previous.mesh.positions[static_cast<Index>(v)];
-                if (prev_features.on_vertex[static_cast<Index>(v)]) {
-                    const auto it = std::lower_bound(on_stroke.begin(), on_stroke.end(), std::make_pair(key_of(p), -1));
-                    if (it == on_stroke.end() || it->first != key_of(p)) {
-                        if (also_keep) return false;
-                        result = KeptRegions{next_regions.count, 0, 0, false};
-                        return true;
-                    }
-                    mapped = it->second;
-                } else {
-                    mapped = static_cast<int>(all.size());
-                    all.push_back({p, previous.origins[static_cast<Index>(v)]});
-                }
-            }
-            t[static_cast<Index>(k)] = mapped;
-        }
+        const auto& pt = previous.mesh.triangles[f];
+        const std::array<int, 3> t{from_previous[static_cast<Index>(pt[0])], from_previous[static_cast<Index>(pt[1])],
+                                   from_previous[static_cast<Index>(pt[2])]};
         if (also_keep)
-            for (int k = 0; k < 3; ++k) {
-                const int a = previous.mesh.triangles[f][static_cast<Index>(k)];
-                const int b = previous.mesh.triangles[f][static_cast<Index>((k + 1) % 3)];
-                if (a < b && prev_features.has(a, b))
-                    kept_features.push_back({t[static_cast<Index>(k)], t[static_cast<Index>((k + 1) % 3)]});
+            for (Index k = 0; k < 3; ++k) {
+                const int a = pt[k], b = pt[(k + 1) % 3];
+                if (a < b && prev_features.has(a, b)) kept_features.push_back({t[k], t[(k + 1) % 3]});
             }
         tris.push_back(t);
         ++result.kept_triangles;
@@ -280,7 +371,18 @@ bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_re
         const glm::dvec3 d = glm::normalize(glm::dvec3(p) - next.centre);
         fill.emplace_back(d.x, d.y, d.z, p.x, p.y, p.z, static_cast<int>(v));
     }
-    std::sort(fill.begin(), fill.end());
+    // `next`'s interpolated vertices, then `previous`'s: each list is sorted already when it
+    // came from a surface made by this function (a whole build orders them by the direction
+    // of its nodes, which rounding to positions may swap).
+    {
+        const auto middle = std::partition_point(fill.begin(), fill.end(), [&](const auto& f) {
+            return static_cast<Index>(std::get<6>(f)) < from_next;
+        });
+        if (std::is_sorted(fill.begin(), middle) && std::is_sorted(middle, fill.end()))
+            std::inplace_merge(fill.begin(), middle, fill.end());
+        else
+            std::sort(fill.begin(), fill.end());
+    }
     for (const auto& f : fill) order.push_back(std::get<6>(f));
     std::vector<int> new_index(all.size(), -1);
     LobeSurface out;
@@ -353,9 +455,7 @@ bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_re
         const int a = new_index[static_cast<Index>(e[0])], b = new_index[static_cast<Index>(e[1])];
         out.mesh.feature_edges.push_back({std::min(a, b), std::max(a, b)});
     }
-    std::sort(out.mesh.feature_edges.begin(), out.mesh.feature_edges.end());
-    out.mesh.feature_edges.erase(std::unique(out.mesh.feature_edges.begin(), out.mesh.feature_edges.end()),
-                                 out.mesh.feature_edges.end());
+    sort_unique_edges(out.mesh.feature_edges, out.mesh.positions.size());
     next = std::move(out);
     return true;
 }
@@ -412,14 +512,10 @@ ChangedRegions find_changed_regions(const LobeSurface& previous, const SurfaceRe
         return out;
     }
     const Features features(mesh);
-    std::vector<std::pair<Key3, int>> on_stroke;
+    PositionIndex on_stroke(static_cast<Index>(std::count(features.on_vertex.begin(), features.on_vertex.end(), 1)));
     for (Index v = 0; v < mesh.positions.size(); ++v)
-        if (features.on_vertex[v]) on_stroke.emplace_back(key_of(mesh.positions[v]), static_cast<int>(v));
-    std::sort(on_stroke.begin(), on_stroke.end());
-    auto vertex_at = [&](const glm::vec3& p) {
-        const auto it = std::lower_bound(on_stroke.begin(), on_stroke.end(), std::make_pair(key_of(p), -1));
-        return it != on_stroke.end() && it->first == key_of(p) ? it->second : -1;
-    };
+        if (features.on_vertex[v]) on_stroke.add(mesh.positions[v], static_cast<int>(v));
+    auto vertex_at = [&](const glm::vec3& p) { return on_stroke.find(p); };
     // The regions on the two sides of every stroke edge: [0] where the triangles run round it
     // from its lower to its higher vertex, [1] the other way.
     const auto& fe = mesh.feature_edges;
