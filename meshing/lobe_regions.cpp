@@ -389,6 +389,7 @@ bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_re
     out.centre = next.centre;
     out.reference_radius = next.reference_radius;
     out.crossings = next.crossings;
+    out.memo = next.memo;
     out.mesh.positions.reserve(order.size());
     out.origins.reserve(order.size());
     for (int v : order) {

@@ -20,6 +20,7 @@
 /// the harmonic interpolation of the strokes' distances, so a cap is a smooth dome.
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -74,6 +75,11 @@ struct LobeVertexOrigin {
     int other_stroke = -1;
 };
 
+/// What a build found over all of its strokes (the pole and its search, the crossings), kept
+/// so that the build after one more stroke looks only at that stroke where the answer
+/// cannot differ (lobe_surface_cgal.cpp). Never changes the result.
+struct LobeBuildMemo;
+
 /// The surface and how it was made.
 struct LobeSurface {
     /// Closed, outward-oriented 2-manifold; feature_edges are the stroke segments (split at
@@ -85,6 +91,7 @@ struct LobeSurface {
     std::size_t paper_strip_triangles = 0; ///< triangles from stitch_closed_closed strips
     std::vector<std::uint8_t> paper_strip_faces; ///< #F: 1 for those triangles
     std::size_t crossings = 0;             ///< crossing vertices (crossings closer than the merge distance share one)
+    std::shared_ptr<const LobeBuildMemo> memo; ///< for continue_lobe_surface; may be null
 };
 
 /// The length-weighted centroid of the strokes (of the closed ones when there is any).

@@ -75,29 +75,64 @@ struct Node {
     LobeVertexOrigin origin;
 };
 
-/// A crossing of segment `seg` of stroke `a` (at parameter `s`) with segment `other_seg`
-/// of stroke `b` (at `t`).
-struct Crossing {
-    int a, seg, b, other_seg;
-    double s, t;
-    int node = -1;
+} // namespace
+
+/// See lobe_surface.h. Filled by every build; read by the next (Builder::usable_memo) only
+/// when the strokes it was made from are the first strokes of that build, unchanged, around
+/// the same centre.
+struct LobeBuildMemo {
+    /// A crossing of segment `seg` of stroke `a` (at parameter `s`) with segment `other_seg`
+    /// of stroke `b` (at `t`).
+    struct Crossing {
+        int a, seg, b, other_seg;
+        double s, t;
+        int node = -1;
+    };
+    glm::dvec3 centre{0.0};
+    std::vector<std::vector<glm::dvec3>> dirs; ///< per stroke, per sample: its direction
+    std::vector<char> closed;                  ///< per stroke
+    /// The pole search (Builder::choose_pole): per lattice candidate, the largest dot product
+    /// of its direction with any sample, exact or (when it was pruned) a lower bound of it.
+    std::vector<double> candidate_bound;
+    std::vector<char> candidate_exact;
+    glm::dvec3 start{0.0};  ///< the best candidate
+    double start_dot = 0.0; ///< … its largest dot product
+    /// Each round of pushing the pole away from its nearest sample.
+    struct Step {
+        int nearest = -1;       ///< index of the nearest sample (over all strokes, in order)
+        bool accepted = false;  ///< the trial direction became the pole
+        double value = 0.0;     ///< accepted: its largest dot product; else a lower bound ≥ the pole's
+    };
+    std::vector<Step> steps;
+    /// The crossings of the strokes, as find_crossings found them.
+    std::vector<Crossing> crossings;
 };
 
-double cross2(const glm::dvec2& u, const glm::dvec2& v) { return u.x * v.y - u.y * v.x; }
+namespace {
 
-/// Proper intersection of segments p0p1 and q0q1 (end points shared or touching count as
-/// none: adjacent segments meet there by construction).
-bool segment_crossing(const glm::dvec2& p0, const glm::dvec2& p1, const glm::dvec2& q0, const glm::dvec2& q1,
-                      double& s, double& t)
+using Crossing = LobeBuildMemo::Crossing;
+
+double orient3(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c)
 {
-    const glm::dvec2 r = p1 - p0, q = q1 - q0;
-    const double den = cross2(r, q);
-    if (std::abs(den) < 1e-300) return false;
-    const glm::dvec2 w = q0 - p0;
-    s = cross2(w, q) / den;
-    t = cross2(w, r) / den;
-    const double eps = 1e-12;
-    return s > eps && s < 1.0 - eps && t > eps && t < 1.0 - eps;
+    return glm::dot(a, glm::cross(b, c));
+}
+
+/// Proper crossing of the arcs a0a1 and b0b1 between unit directions, each shorter than 90°
+/// (make_directions): each arc's ends lie strictly on opposite sides of the other's great
+/// circle, and the two arcs lie on the same side of the sphere. `s` and `t` are where each
+/// chord meets the other's plane. Ends touching or on the other arc count as none (adjacent
+/// segments meet there by construction).
+bool arc_crossing(const glm::dvec3& a0, const glm::dvec3& a1, const glm::dvec3& b0, const glm::dvec3& b1, double& s,
+                  double& t)
+{
+    const double sa0 = orient3(a0, a1, b0), sa1 = orient3(a0, a1, b1);
+    if (!((sa0 > 0.0 && sa1 < 0.0) || (sa0 < 0.0 && sa1 > 0.0))) return false;
+    const double sb0 = orient3(b0, b1, a0), sb1 = orient3(b0, b1, a1);
+    if (!((sb0 > 0.0 && sb1 < 0.0) || (sb0 < 0.0 && sb1 > 0.0))) return false;
+    if (!(glm::dot(a0 + a1, b0 + b1) > 0.0)) return false;
+    s = sb0 / (sb0 - sb1);
+    t = sa0 / (sa0 - sa1);
+    return true;
 }
 
 /// Angular radius of the circle through three unit directions.
@@ -120,11 +155,6 @@ bool solver_ok(const Eigen::VectorXd& x)
     return x.allFinite();
 }
 
-double orient3(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c)
-{
-    return glm::dot(a, glm::cross(b, c));
-}
-
 /// Sorts `order` (indices into `where`) along a space-filling curve: points inserted into
 /// the triangulation in that order stay near the last one, where points taken along a
 /// stroke, or along the Fibonacci lattice, make insertions flip long fans or walk far.
@@ -134,40 +164,48 @@ void spatially_sort(std::vector<std::size_t>& order, std::vector<K::Point_2>& wh
     CGAL::spatial_sort(order.begin(), order.end(), CGAL::Spatial_sort_traits_adapter_2<K, Map>(CGAL::make_property_map(where)));
 }
 
-/// Segments of all strokes binned in a uniform grid over the plane, so crossings are
-/// found in time about linear in the number of segments.
+/// The segments of all strokes, as arcs between unit directions, binned in a uniform grid
+/// over [-1, 1]³ by the box of each arc (its chord's box grown by the arc's sagitta), so
+/// that every pair of arcs that cross shares a cell and crossings are found in time about
+/// linear in the number of segments. On the sphere, not in the projection: which strokes
+/// cross does not depend on the pole.
 class SegmentGrid {
 public:
     struct Seg {
         int stroke, index;
-        glm::dvec2 p0, p1;
+        glm::dvec3 p0, p1;
     };
 
     SegmentGrid(std::vector<Seg> segs) : segs_(std::move(segs))
     {
-        lo_ = glm::dvec2(std::numeric_limits<double>::max());
-        glm::dvec2 hi(-std::numeric_limits<double>::max());
+        lo_ = glm::dvec3(std::numeric_limits<double>::max());
+        glm::dvec3 hi(-std::numeric_limits<double>::max());
         std::vector<double> lengths;
         lengths.reserve(segs_.size());
+        pad_.reserve(segs_.size());
         for (const Seg& s : segs_) {
-            lo_ = glm::min(lo_, glm::min(s.p0, s.p1));
-            hi = glm::max(hi, glm::max(s.p0, s.p1));
+            // The arc leaves its chord by at most 1 − cos(θ/2) = 1 − √((1 + cos θ) / 2).
+            const double c = std::clamp(glm::dot(s.p0, s.p1), -1.0, 1.0);
+            pad_.push_back(1.0 - std::sqrt(0.5 * (1.0 + c)) + 1e-12);
+            lo_ = glm::min(lo_, glm::min(s.p0, s.p1) - pad_.back());
+            hi = glm::max(hi, glm::max(s.p0, s.p1) + pad_.back());
             lengths.push_back(glm::distance(s.p0, s.p1));
         }
         std::nth_element(lengths.begin(), lengths.begin() + static_cast<long>(lengths.size() / 2), lengths.end());
-        const glm::dvec2 extent = hi - lo_;
-        const double cap = std::max(extent.x, extent.y) / 512.0;
+        const glm::dvec3 extent = hi - lo_;
+        const double cap = std::max({extent.x, extent.y, extent.z}) / 64.0;
         cell_ = std::max({lengths[lengths.size() / 2] * 2.0, cap, 1e-12});
-        nx_ = static_cast<int>(extent.x / cell_) + 1;
-        ny_ = static_cast<int>(extent.y / cell_) + 1;
+        n_[0] = static_cast<int>(extent.x / cell_) + 1;
+        n_[1] = static_cast<int>(extent.y / cell_) + 1;
+        n_[2] = static_cast<int>(extent.z / cell_) + 1;
         // Cells in one array: cell c holds cells_[start_[c] .. start_[c + 1]), segments in order.
-        start_.assign(static_cast<Index>(nx_) * static_cast<Index>(ny_) + 1, 0);
-        for (const Seg& s : segs_) for_cells(s, [&](Index c) { ++start_[c + 1]; });
+        start_.assign(static_cast<Index>(n_[0]) * static_cast<Index>(n_[1]) * static_cast<Index>(n_[2]) + 1, 0);
+        for (Index i = 0; i < segs_.size(); ++i) for_cells(i, [&](Index c) { ++start_[c + 1]; });
         for (Index c = 1; c < start_.size(); ++c) start_[c] += start_[c - 1];
         cells_.resize(static_cast<Index>(start_.back()));
         std::vector<int> next(start_.begin(), start_.end() - 1);
-        for (int i = 0; i < static_cast<int>(segs_.size()); ++i)
-            for_cells(segs_[static_cast<Index>(i)], [&](Index c) { cells_[static_cast<Index>(next[c]++)] = i; });
+        for (Index i = 0; i < segs_.size(); ++i)
+            for_cells(i, [&](Index c) { cells_[static_cast<Index>(next[c]++)] = static_cast<int>(i); });
     }
 
     /// Calls f(seg_i, seg_j) once for each pair of segments whose boxes share a cell, in
@@ -175,17 +213,11 @@ public:
     template <typename F>
     void for_each_candidate(F&& f) const
     {
-        // Bounded work and memory on any input (a dense scribble in one spot).
-        std::size_t total = 0;
-        for (Index c = 0; c + 1 < start_.size(); ++c) {
-            const std::size_t k = static_cast<std::size_t>(start_[c + 1] - start_[c]);
-            total += k * (k - (k > 0 ? 1 : 0)) / 2;
-        }
-        if (total > 20000000) throw InvalidInput("the lobe's strokes are too densely tangled to mesh");
+        check_density();
         std::vector<int> others;
         for (int i = 0; i < static_cast<int>(segs_.size()); ++i) {
             others.clear();
-            for_cells(segs_[static_cast<Index>(i)], [&](Index c) {
+            for_cells(static_cast<Index>(i), [&](Index c) {
                 // Cells list their segments in increasing order.
                 for (int k = start_[c + 1] - 1; k >= start_[c] && cells_[static_cast<Index>(k)] > i; --k)
                     others.push_back(cells_[static_cast<Index>(k)]);
@@ -196,25 +228,66 @@ public:
         }
     }
 
-private:
+    /// As for_each_candidate, but only the pairs with a segment at or after `first` (each
+    /// still as f(seg_i, seg_j), i < j).
     template <typename F>
-    void for_cells(const Seg& s, F&& f) const
+    void for_each_candidate_from(int first, F&& f) const
     {
-        const auto [x0, y0] = cell_of(glm::min(s.p0, s.p1));
-        const auto [x1, y1] = cell_of(glm::max(s.p0, s.p1));
-        for (int y = y0; y <= y1; ++y)
-            for (int x = x0; x <= x1; ++x) f(static_cast<Index>(y * nx_ + x));
+        check_density();
+        std::vector<int> others;
+        for (int i = first; i < static_cast<int>(segs_.size()); ++i) {
+            others.clear();
+            for_cells(static_cast<Index>(i), [&](Index c) {
+                for (int k = start_[c]; k < start_[c + 1]; ++k) {
+                    const int j = cells_[static_cast<Index>(k)];
+                    if (j < first || j > i) others.push_back(j);
+                }
+            });
+            std::sort(others.begin(), others.end());
+            others.erase(std::unique(others.begin(), others.end()), others.end());
+            for (int j : others) {
+                if (j < i) f(segs_[static_cast<Index>(j)], segs_[static_cast<Index>(i)]);
+                else f(segs_[static_cast<Index>(i)], segs_[static_cast<Index>(j)]);
+            }
+        }
     }
-    std::pair<int, int> cell_of(const glm::dvec2& p) const
+
+private:
+    /// Bounded work and memory on any input (a dense scribble in one spot).
+    void check_density() const
     {
-        const int x = std::clamp(static_cast<int>((p.x - lo_.x) / cell_), 0, nx_ - 1);
-        const int y = std::clamp(static_cast<int>((p.y - lo_.y) / cell_), 0, ny_ - 1);
-        return {x, y};
+        std::size_t total = 0;
+        for (Index c = 0; c + 1 < start_.size(); ++c) {
+            const std::size_t k = static_cast<std::size_t>(start_[c + 1] - start_[c]);
+            total += k * (k - (k > 0 ? 1 : 0)) / 2;
+        }
+        if (total > 20000000) throw InvalidInput("the lobe's strokes are too densely tangled to mesh");
+    }
+
+    template <typename F>
+    void for_cells(Index i, F&& f) const
+    {
+        const Seg& s = segs_[i];
+        const auto c0 = cell_of(glm::min(s.p0, s.p1) - pad_[i]);
+        const auto c1 = cell_of(glm::max(s.p0, s.p1) + pad_[i]);
+        for (int z = c0[2]; z <= c1[2]; ++z)
+            for (int y = c0[1]; y <= c1[1]; ++y)
+                for (int x = c0[0]; x <= c1[0]; ++x)
+                    f((static_cast<Index>(z) * static_cast<Index>(n_[1]) + static_cast<Index>(y)) * static_cast<Index>(n_[0]) +
+                      static_cast<Index>(x));
+    }
+    std::array<int, 3> cell_of(const glm::dvec3& p) const
+    {
+        std::array<int, 3> c{};
+        for (int k = 0; k < 3; ++k)
+            c[static_cast<Index>(k)] = std::clamp(static_cast<int>((p[k] - lo_[k]) / cell_), 0, n_[static_cast<Index>(k)] - 1);
+        return c;
     }
     std::vector<Seg> segs_;
-    glm::dvec2 lo_;
+    std::vector<double> pad_;
+    glm::dvec3 lo_{0.0};
     double cell_ = 1;
-    int nx_ = 1, ny_ = 1;
+    std::array<int, 3> n_{1, 1, 1};
     std::vector<int> start_, cells_;
 };
 
@@ -274,12 +347,17 @@ public:
     /// Builds only the regions that changed since `previous` (see continue_lobe_surface)
     /// where they can be told apart: run() then returns those regions' triangles and every
     /// stroke vertex, and partial() is true.
-    void set_previous(const LobeSurface& previous, const SurfaceRegions& regions)
+    /// With `changed_only` false, only the previous build's memo is used (the whole surface
+    /// is built).
+    void set_previous(const LobeSurface& previous, const SurfaceRegions& regions, bool changed_only = true)
     {
         previous_ = &previous;
         previous_regions_ = &regions;
+        changed_only_ = changed_only;
     }
     bool partial() const { return partial_; }
+    /// The pole search and the crossings followed the previous build's (its memo was usable).
+    bool followed_previous() const { return old_memo_ != nullptr; }
     const std::vector<char>& kept_previous_regions() const { return changed_.keep; }
 
     LobeSurface run();
@@ -291,7 +369,12 @@ private:
     }
     void make_directions();
     void choose_pole();
+    /// The previous build's memo when its strokes are this build's first ones, unchanged,
+    /// around the same centre (else null); `old_strokes_` is how many.
+    const LobeBuildMemo* usable_memo();
     void find_crossings();
+    bool find_crossings(bool only_new);
+    void sort_crossings();
     void build_chains();
     void plan_partial();
     glm::vec3 emitted_position(int id) const
@@ -333,6 +416,9 @@ private:
     Stereo stereo_{glm::dvec3(0, 0, 1)};
 
     std::vector<Crossing> crossings_;
+    std::shared_ptr<LobeBuildMemo> memo_ = std::make_shared<LobeBuildMemo>(); ///< this build's
+    const LobeBuildMemo* old_memo_ = nullptr;
+    Index old_strokes_ = 0;
     std::vector<int> crossing_count_;              ///< per stroke
     std::vector<Node> nodes_;
     std::vector<std::vector<int>> chains_;         ///< per stroke: node ids in order
@@ -354,10 +440,14 @@ private:
     const LobeSurface* previous_ = nullptr;
     const SurfaceRegions* previous_regions_ = nullptr;
     ChangedRegions changed_;
+    bool changed_only_ = true;
     bool partial_ = false;
     std::vector<char> region_inside_;              ///< per region: to be emitted
     std::vector<std::array<int, 2>> border_;       ///< node pairs (u, v): changed side runs u → v outward
     std::vector<std::array<int, 2>> inserted_;     ///< constrained node pairs
+    /// Per changed region of the previous surface: a cap of directions holding it (centre,
+    /// cosine of its angular radius).
+    std::vector<std::pair<glm::dvec3, double>> caps_;
     double ring_angle_ = 0;
 };
 
@@ -400,70 +490,172 @@ void Builder::make_directions()
     }
 }
 
+const LobeBuildMemo* Builder::usable_memo()
+{
+    if (!previous_ || !previous_->memo) return nullptr;
+    const LobeBuildMemo& m = *previous_->memo;
+    if (m.centre != centre_ || m.dirs.size() > strokes_.size() || m.dirs.empty()) return nullptr;
+    for (Index s = 0; s < m.dirs.size(); ++s)
+        if (m.dirs[s] != dirs_[s] || (m.closed[s] != 0) != strokes_[s].closed) return nullptr;
+    old_strokes_ = m.dirs.size();
+    return &m;
+}
+
 void Builder::choose_pole()
 {
     // The direction farthest from every sample: a Fibonacci lattice of candidates, then a
     // few rounds of pushing the best one away from its nearest sample.
+    //
+    // After one more stroke (old_memo_), the previous build's search is followed wherever the
+    // new samples cannot change a step: a candidate whose bound was already no better than the
+    // best is passed over again; an exact one needs only the new samples; a round whose nearest
+    // sample and outcome stay keeps them. The result is the whole search's, bit for bit: the
+    // first candidate with the smallest largest dot product, then the same rounds.
     constexpr int kCandidates = 512;
-    const double golden = M_PI * (3.0 - std::sqrt(5.0));
+    static const std::vector<glm::dvec3> lattice = [] {
+        std::vector<glm::dvec3> out;
+        const double golden = M_PI * (3.0 - std::sqrt(5.0));
+        for (int i = 0; i < kCandidates; ++i) {
+            const double z = 1.0 - (2.0 * i + 1.0) / kCandidates;
+            const double rr = std::sqrt(std::max(0.0, 1.0 - z * z));
+            out.emplace_back(rr * std::cos(golden * i), rr * std::sin(golden * i), z);
+        }
+        return out;
+    }();
     double best_dot = 2.0;
     glm::dvec3 best(0, 0, 1);
     std::vector<glm::dvec3> all;
     for (const auto& stroke : dirs_) all.insert(all.end(), stroke.begin(), stroke.end());
-    auto max_dot = [&](const glm::dvec3& d, glm::dvec3* nearest) {
+    const LobeBuildMemo* memo = old_memo_;
+    Index old_count = 0;
+    if (memo)
+        for (Index s = 0; s < old_strokes_; ++s) old_count += dirs_[s].size();
+    // Largest dot product with the samples [from, all.size()), and the first sample giving it.
+    auto max_dot = [&](const glm::dvec3& d, Index from, int* nearest) {
         double m = -2.0;
-        for (const glm::dvec3& u : all) {
-            const double c = glm::dot(u, d);
+        for (Index k = from; k < all.size(); ++k) {
+            const double c = glm::dot(all[k], d);
             if (c > m) {
                 m = c;
-                if (nearest) *nearest = u;
+                if (nearest) *nearest = static_cast<int>(k);
             }
         }
         return m;
     };
-    // A candidate is only of interest when its nearest sample is farther than the best
-    // one's: the scan stops at the first sample at least as near (`witness`), and the
-    // witnesses of the candidate's lattice neighbours (Fibonacci index steps) are tried first.
-    std::vector<int> witness(kCandidates, 0);
-    auto beaten = [&](const glm::dvec3& d, int& w) {
-        for (Index k = 0; k < all.size(); ++k)
-            if (glm::dot(all[k], d) >= best_dot) {
-                w = static_cast<int>(k);
-                return true;
+    // The first sample at least as near as the best (a lower bound ≥ best_dot), or −1.
+    auto beaten = [&](const glm::dvec3& d, double& bound) {
+        for (Index k = 0; k < all.size(); ++k) {
+            const double c = glm::dot(all[k], d);
+            if (c >= best_dot) {
+                bound = c;
+                return static_cast<int>(k);
             }
-        return false;
+        }
+        return -1;
     };
-    for (int i = 0; i < kCandidates; ++i) {
-        const double z = 1.0 - (2.0 * i + 1.0) / kCandidates;
-        const double rr = std::sqrt(std::max(0.0, 1.0 - z * z));
-        const glm::dvec3 d(rr * std::cos(golden * i), rr * std::sin(golden * i), z);
-        bool out = false;
-        for (int step : {1, 2, 3, 5, 8, 13, 21, 34, 55, 89})
-            if (i >= step && glm::dot(all[static_cast<Index>(witness[static_cast<Index>(i - step)])], d) >= best_dot) {
-                witness[static_cast<Index>(i)] = witness[static_cast<Index>(i - step)];
-                out = true;
-                break;
+    LobeBuildMemo& out = *memo_;
+    out.candidate_bound.assign(kCandidates, 0.0);
+    out.candidate_exact.assign(kCandidates, 0);
+    if (memo) {
+        for (Index i = 0; i < static_cast<Index>(kCandidates); ++i) {
+            const glm::dvec3& d = lattice[i];
+            double bound = memo->candidate_bound[i];
+            bool exact = memo->candidate_exact[i] != 0;
+            if (bound >= best_dot) {
+                exact = false; // the new samples may raise it: a lower bound now
+            } else {
+                const double added = max_dot(d, old_count, nullptr);
+                bound = exact ? std::max(bound, added) : max_dot(d, 0, nullptr);
+                exact = true;
+                if (bound < best_dot) {
+                    best_dot = bound;
+                    best = d;
+                }
             }
-        if (out || beaten(d, witness[static_cast<Index>(i)])) continue;
-        const double m = max_dot(d, nullptr);
-        if (m < best_dot) {
-            best_dot = m;
-            best = d;
+            out.candidate_bound[i] = bound;
+            out.candidate_exact[i] = exact ? 1 : 0;
+        }
+    } else {
+        // A candidate is only of interest when its nearest sample is farther than the best
+        // one's: the scan stops at the first sample at least as near (`witness`), and the
+        // witnesses of the candidate's lattice neighbours (Fibonacci index steps) are tried first.
+        std::vector<int> witness(kCandidates, 0);
+        for (int i = 0; i < kCandidates; ++i) {
+            const Index ii = static_cast<Index>(i);
+            const glm::dvec3& d = lattice[ii];
+            bool out_of_it = false;
+            for (int step : {1, 2, 3, 5, 8, 13, 21, 34, 55, 89}) {
+                if (i < step) break;
+                const int w = witness[static_cast<Index>(i - step)];
+                const double c = glm::dot(all[static_cast<Index>(w)], d);
+                if (c >= best_dot) {
+                    witness[ii] = w;
+                    out.candidate_bound[ii] = c;
+                    out_of_it = true;
+                    break;
+                }
+            }
+            if (out_of_it) continue;
+            double bound = 0;
+            const int w = beaten(d, bound);
+            if (w >= 0) {
+                witness[ii] = w;
+                out.candidate_bound[ii] = bound;
+                continue;
+            }
+            const double m = max_dot(d, 0, nullptr);
+            out.candidate_bound[ii] = m;
+            out.candidate_exact[ii] = 1;
+            if (m < best_dot) {
+                best_dot = m;
+                best = d;
+            }
         }
     }
+    out.start = best;
+    out.start_dot = best_dot;
+    out.steps.clear();
+    // Following the previous search while every step is the same.
+    bool follow = memo && memo->start == best && memo->start_dot == best_dot && memo->steps.size() == 40;
     double step = 0.1;
     for (int it = 0; it < 40; ++it) {
-        glm::dvec3 nearest(0.0);
-        max_dot(best, &nearest);
+        LobeBuildMemo::Step rec;
+        if (follow) {
+            int added_nearest = -1;
+            if (max_dot(best, old_count, &added_nearest) > best_dot) {
+                follow = false;
+                rec.nearest = added_nearest; // a new sample is nearer than every old one
+            } else {
+                rec.nearest = memo->steps[static_cast<Index>(it)].nearest;
+            }
+        } else {
+            max_dot(best, 0, &rec.nearest);
+        }
+        const glm::dvec3& nearest = all[static_cast<Index>(rec.nearest)];
         const glm::dvec3 trial = glm::normalize(best - step * (nearest - glm::dot(nearest, best) * best));
-        int w = 0;
-        const double m = beaten(trial, w) ? best_dot : max_dot(trial, nullptr);
-        if (m < best_dot) {
+        // m: the trial's largest dot product, or a lower bound of it when that is ≥ best_dot.
+        double m = 0;
+        if (follow) {
+            const LobeBuildMemo::Step& was = memo->steps[static_cast<Index>(it)];
+            if (!was.accepted) {
+                m = was.value; // ≥ best_dot: still refused, and still a lower bound
+            } else {
+                m = std::max(was.value, max_dot(trial, old_count, nullptr));
+                if (m != was.value) follow = false; // from here on the pole differs
+            }
+        } else {
+            double bound = 0;
+            m = beaten(trial, bound) >= 0 ? bound : max_dot(trial, 0, nullptr);
+        }
+        rec.accepted = m < best_dot;
+        rec.value = m;
+        if (rec.accepted) {
             best_dot = m;
             best = trial;
         } else {
             step *= 0.5;
         }
+        out.steps.push_back(rec);
     }
     empty_angle_ = std::acos(std::clamp(best_dot, -1.0, 1.0));
     if (empty_angle_ < 3.0 * M_PI / 180.0)
@@ -476,19 +668,61 @@ void Builder::choose_pole()
 
 void Builder::find_crossings()
 {
+    // After one more stroke, the old strokes' crossings are the previous build's: only pairs
+    // with a new segment are tested. Anything refused is refused by the whole search, so
+    // that the message is the same.
+    if (old_memo_) {
+        if (find_crossings(true)) return;
+        crossings_.clear();
+    }
+    find_crossings(false);
+}
+
+bool Builder::find_crossings(bool only_new)
+{
     std::vector<SegmentGrid::Seg> segs;
+    int first_new = 0;
     for (Index s = 0; s < strokes_.size(); ++s) {
-        const Index n = plane_[s].size();
+        if (s == old_strokes_) first_new = static_cast<int>(segs.size());
+        const Index n = dirs_[s].size();
         const Index count = strokes_[s].closed ? n : n - 1;
         for (Index i = 0; i < count; ++i)
-            segs.push_back({static_cast<int>(s), static_cast<int>(i), plane_[s][i], plane_[s][(i + 1) % n]});
+            segs.push_back({static_cast<int>(s), static_cast<int>(i), dirs_[s][i], dirs_[s][(i + 1) % n]});
     }
+    if (only_new && old_strokes_ >= strokes_.size()) first_new = static_cast<int>(segs.size());
     SegmentGrid grid(std::move(segs));
     crossing_count_.assign(strokes_.size(), 0);
     std::map<std::pair<int, int>, std::size_t> pair_count; // (lower, higher stroke) → crossings
+    if (only_new) {
+        crossings_ = old_memo_->crossings;
+        for (const Crossing& c : crossings_) {
+            ++crossing_count_[static_cast<Index>(c.a)];
+            ++crossing_count_[static_cast<Index>(c.b)];
+        }
+        bool refused = false;
+        grid.for_each_candidate_from(first_new, [&](const SegmentGrid::Seg& a, const SegmentGrid::Seg& b) {
+            double s = 0, t = 0;
+            if (refused || !arc_crossing(a.p0, a.p1, b.p0, b.p1, s, t)) return;
+            if (a.stroke == b.stroke || crossings_.size() >= 100000) {
+                refused = true;
+                return;
+            }
+            crossings_.push_back({a.stroke, a.index, b.stroke, b.index, s, t});
+            ++crossing_count_[static_cast<Index>(a.stroke)];
+            ++crossing_count_[static_cast<Index>(b.stroke)];
+            ++pair_count[{std::min(a.stroke, b.stroke), std::max(a.stroke, b.stroke)}];
+        });
+        for (const auto& [pair, c] : pair_count) {
+            const Index a = static_cast<Index>(pair.first), b = static_cast<Index>(pair.second);
+            if (c > std::max<std::size_t>(16, std::min(plane_[a].size(), plane_[b].size()) / 2)) refused = true;
+        }
+        if (refused) return false;
+        sort_crossings();
+        return true;
+    }
     grid.for_each_candidate([&](const SegmentGrid::Seg& a, const SegmentGrid::Seg& b) {
         double s = 0, t = 0;
-        if (!segment_crossing(a.p0, a.p1, b.p0, b.p1, s, t)) return;
+        if (!arc_crossing(a.p0, a.p1, b.p0, b.p1, s, t)) return;
         if (a.stroke == b.stroke)
             throw InvalidInput(stroke_name(a.stroke) + " folds back over itself as seen from the lobe's centre");
         if (crossings_.size() >= 100000) throw InvalidInput("the lobe's strokes cross each other too often to mesh");
@@ -506,9 +740,16 @@ void Builder::find_crossings()
                                " times; is one inside the lobe?)");
     }
     if (crossings_.size() > 100000) throw InvalidInput("the lobe's strokes cross each other too often to mesh");
+    sort_crossings();
+    return true;
+}
+
+void Builder::sort_crossings()
+{
     std::sort(crossings_.begin(), crossings_.end(), [](const Crossing& x, const Crossing& y) {
         return std::tie(x.a, x.seg, x.s, x.b, x.other_seg) < std::tie(y.a, y.seg, y.s, y.b, y.other_seg);
     });
+    memo_->crossings = crossings_;
 }
 
 void Builder::build_chains()
@@ -680,6 +921,45 @@ void Builder::plan_partial()
     }
     changed_ = find_changed_regions(*previous_, *previous_regions_, chains);
     partial_ = !changed_.everything;
+    if (!partial_) return;
+    // A cap of directions around each changed region of the previous surface. The changed
+    // regions of this build cover what those did (the same border edges bound both), so a
+    // lattice point outside every cap cannot fall into one: seed_fill neither tests it nor
+    // the stroke edges that only such points could be near.
+    const TriangleMesh& mesh = previous_->mesh;
+    const auto& face_region = previous_regions_->regions.face_region;
+    std::vector<int> cap_of(changed_.keep.size(), -1);
+    std::vector<glm::dvec3> dir(mesh.positions.size(), glm::dvec3(0.0));
+    std::vector<char> have(mesh.positions.size(), 0);
+    std::vector<glm::dvec3> sum;
+    for (Index f = 0; f < mesh.triangles.size(); ++f) {
+        const Index r = static_cast<Index>(face_region[f]);
+        if (changed_.keep[r]) continue;
+        if (cap_of[r] < 0) {
+            cap_of[r] = static_cast<int>(sum.size());
+            sum.emplace_back(0.0);
+        }
+        for (int v : mesh.triangles[f]) {
+            const Index i = static_cast<Index>(v);
+            if (!have[i]) {
+                have[i] = 1;
+                dir[i] = glm::normalize(glm::dvec3(mesh.positions[i]) - centre_);
+            }
+            sum[static_cast<Index>(cap_of[r])] += dir[i];
+        }
+    }
+    caps_.assign(sum.size(), {glm::dvec3(0.0), 1.0});
+    for (Index c = 0; c < sum.size(); ++c) {
+        const double len = glm::length(sum[c]);
+        caps_[c].first = len > 1e-12 ? sum[c] / len : glm::dvec3(0, 0, 1);
+        if (!(len > 1e-12)) caps_[c].second = -1.0; // a region round the whole sphere: everything
+    }
+    for (Index f = 0; f < mesh.triangles.size(); ++f) {
+        const Index r = static_cast<Index>(face_region[f]);
+        if (changed_.keep[r]) continue;
+        auto& cap = caps_[static_cast<Index>(cap_of[r])];
+        for (int v : mesh.triangles[f]) cap.second = std::min(cap.second, glm::dot(dir[static_cast<Index>(v)], cap.first));
+    }
 }
 
 VH Builder::insert_node(int id, VH hint)
@@ -899,6 +1179,42 @@ void Builder::seed_fill(double max_edge, int& added)
     // Directions along every stroke, binned in a uniform grid over [-1, 1]³ whose cells are
     // at least `clearance` wide: every direction within `clearance` of a lattice point lies
     // in the point's cell or in a neighbouring one.
+    //
+    // A build of the changed regions only tests the lattice points in the caps around them
+    // (plan_partial), and only against the stroke edges that can come within `clearance` of
+    // such a point (an edge's directions lie within its length of its first end): a point's
+    // verdict is the whole build's, for no direction left out could be near it.
+    const double cap_margin = 0.05; // the caps bound the regions' flat triangles; this covers the planar constraints' bulge
+    std::vector<double> cap_cos(caps_.size()), reach_angle(caps_.size());
+    for (Index c = 0; c < caps_.size(); ++c) {
+        // A cap wider than a hemisphere is not convex: the triangles between its vertices
+        // may leave it, so it holds every direction.
+        const double radius = caps_[c].second <= -1.0 ? M_PI : std::acos(std::clamp(caps_[c].second, -1.0, 1.0));
+        cap_cos[c] = radius + cap_margin < 0.5 * M_PI ? std::cos(radius + cap_margin) : -2.0;
+        reach_angle[c] = cap_cos[c] < -1.0 ? 2.0 * M_PI : radius + cap_margin + clearance + 1e-6;
+    }
+    auto in_caps = [&](const glm::dvec3& d) {
+        if (!partial_) return true;
+        for (Index c = 0; c < caps_.size(); ++c)
+            if (glm::dot(d, caps_[c].first) >= cap_cos[c]) return true;
+        return false;
+    };
+    std::vector<double> reach_cos(caps_.size()), reach_sin(caps_.size());
+    for (Index c = 0; c < caps_.size(); ++c) {
+        reach_cos[c] = std::cos(std::min(M_PI, reach_angle[c]));
+        reach_sin[c] = std::sin(std::min(M_PI, reach_angle[c]));
+    }
+    auto reaches_caps = [&](const glm::dvec3& a, const glm::dvec3& b) {
+        if (!partial_) return true;
+        // angle(a, centre) ≤ reach + |ab|, as cosines: cos(reach + |ab|) by the sum formula.
+        const double cl = glm::dot(a, b), sl = glm::length(glm::cross(a, b));
+        const double length = std::atan2(sl, cl);
+        for (Index c = 0; c < caps_.size(); ++c)
+            if (reach_angle[c] + length >= M_PI - 1e-9 ||
+                glm::dot(a, caps_[c].first) >= reach_cos[c] * cl - reach_sin[c] * sl - 1e-9)
+                return true;
+        return false;
+    };
     std::vector<glm::dvec3> along;
     for (Index s = 0; s < chains_.size(); ++s) {
         const auto& chain = chains_[s];
@@ -908,6 +1224,7 @@ void Builder::seed_fill(double max_edge, int& added)
         for (Index i = 0; i < count; ++i) {
             const glm::dvec3 a = nodes_[static_cast<Index>(chain[i])].dir;
             const glm::dvec3 b = nodes_[static_cast<Index>(chain[(i + 1) % n])].dir;
+            if (!reaches_caps(a, b)) continue;
             const int steps = std::max(1, static_cast<int>(std::ceil(angle_between(a, b) / (0.25 * clearance))));
             for (int k = 1; k <= steps; ++k) along.push_back(glm::normalize(a + (b - a) * (static_cast<double>(k) / steps)));
         }
@@ -934,7 +1251,7 @@ void Builder::seed_fill(double max_edge, int& added)
         const double z = 1.0 - (2.0 * i + 1.0) / count;
         const double rr = std::sqrt(std::max(0.0, 1.0 - z * z));
         const glm::dvec3 d(rr * std::cos(golden * i), rr * std::sin(golden * i), z);
-        if (glm::dot(d, stereo_.pole) > ring_keep) continue;
+        if (glm::dot(d, stereo_.pole) > ring_keep || !in_caps(d)) continue;
         bool near = false;
         const int cx = coord(d.x), cy = coord(d.y), cz = coord(d.z);
         for (int z2 = std::max(0, cz - 1); z2 <= std::min(dim - 1, cz + 1) && !near; ++z2)
@@ -1476,11 +1793,17 @@ LobeSurface Builder::run()
     if (!std::isfinite(centre_.x) || !std::isfinite(centre_.y) || !std::isfinite(centre_.z))
         throw InvalidInput("the lobe's centre is not finite");
     make_directions();
+    old_memo_ = usable_memo();
+    memo_->centre = centre_;
+    memo_->dirs = dirs_;
+    memo_->closed.resize(strokes_.size());
+    for (Index s = 0; s < strokes_.size(); ++s) memo_->closed[s] = strokes_[s].closed ? 1 : 0;
     choose_pole();
     find_crossings();
     build_chains();
-    if (previous_) plan_partial();
+    if (previous_ && changed_only_) plan_partial();
     LobeSurface out;
+    out.memo = memo_;
     out.centre = centre_;
     out.reference_radius = options_.reference_radius_m > 0 ? options_.reference_radius_m : mean_radius_;
     try {
@@ -1536,16 +1859,21 @@ LobeSurface continue_lobe_surface(const LobeSurface& previous, const SurfaceRegi
         LobeSurface surface = b.run();
         if (!b.partial()) {
             kept = keep_unchanged_regions(previous, previous_regions, surface, regions);
+            kept.followed_previous_build = b.followed_previous();
             return surface;
         }
         if (complete_with_kept_regions(previous, previous_regions, b.kept_previous_regions(), surface, regions, kept)) {
             kept.built_changed_only = true;
+            kept.followed_previous_build = b.followed_previous();
             return surface;
         }
     } catch (const PartialFailed&) {
     }
-    LobeSurface surface = build_lobe_surface(strokes, centre, options);
+    Builder b(strokes, centre, options);
+    b.set_previous(previous, previous_regions, false);
+    LobeSurface surface = b.run();
     kept = keep_unchanged_regions(previous, previous_regions, surface, regions);
+    kept.followed_previous_build = b.followed_previous();
     return surface;
 }
 

@@ -161,6 +161,19 @@ std::vector<glm::vec3> sphere_ring(const glm::dvec3& c, double r, double h, int 
     return loop(c + glm::dvec3(0, h, 0), {1, 0, 0}, {0, 0, 1}, rr, rr, n);
 }
 
+/// A triangle by the positions of its corners, starting at the least: the same triangle in
+/// two meshes, whatever its vertices' indices.
+std::array<std::array<float, 3>, 3> corners(const TriangleMesh& m, const std::array<int, 3>& t)
+{
+    std::array<std::array<float, 3>, 3> k{};
+    for (std::size_t i = 0; i < 3; ++i) {
+        const glm::vec3& p = m.positions[static_cast<std::size_t>(t[i])];
+        k[i] = {p.x, p.y, p.z};
+    }
+    std::rotate(k.begin(), std::min_element(k.begin(), k.end()), k.end());
+    return k;
+}
+
 // ---------------------------------------------------------------------------------------
 // The shipped recordings, through the whole pipeline.
 
@@ -478,15 +491,6 @@ TEST(Lobes, AStrokeInsertedBetweenTwoOthersOnlyChangesThatRegion)
     const TriangleMesh r1 = remesh_lobe_surface(s1, remesh, &cache, &stats);
     EXPECT_EQ(stats.remeshed, 2) << "the strip, now two strips";
     EXPECT_EQ(stats.reused, stats.regions - 2);
-    auto corners = [](const TriangleMesh& m, const std::array<int, 3>& t) {
-        std::array<std::array<float, 3>, 3> k{};
-        for (std::size_t i = 0; i < 3; ++i) {
-            const glm::vec3& p = m.positions[static_cast<std::size_t>(t[i])];
-            k[i] = {p.x, p.y, p.z};
-        }
-        std::rotate(k.begin(), std::min_element(k.begin(), k.end()), k.end());
-        return k;
-    };
     std::set<std::array<std::array<float, 3>, 3>> after_remesh;
     for (const auto& t : r1.triangles) after_remesh.insert(corners(r1, t));
     std::size_t away = 0;
@@ -501,6 +505,47 @@ TEST(Lobes, AStrokeInsertedBetweenTwoOthersOnlyChangesThatRegion)
         EXPECT_TRUE(after_remesh.count(corners(r0, t))) << "a remeshed triangle away from the new stroke changed";
     }
     EXPECT_GT(away, 100u);
+}
+
+TEST(Lobes, ARingDrawnBetweenTwoRingsAcrossSixLoopsChangesOnlyTheCellsBetweenThem)
+{
+    // Fig. 5 on a lobe whose strokes cross: six loops through both poles at 30° steps and four
+    // rings. Where the six loops meet, which of them are found to cross where must not depend
+    // on the projection the new ring moves, or the cells round the poles change too.
+    const glm::dvec3 c(0, 1.4, -0.45);
+    const double r = 0.2;
+    Lobe lobe;
+    std::int64_t id = 0;
+    for (int k = 0; k < 6; ++k) {
+        const double a = k * kPi / 6;
+        lobe.add_stroke(++id, loop(c, {0, 1, 0}, {std::cos(a), 0, std::sin(a)}, r, r, 160, 0.005, 0.1 * k));
+    }
+    for (double h : {-0.15, -0.08, 0.08, 0.15}) lobe.add_stroke(++id, sphere_ring(c, r, h));
+    const LobeSurface before = lobe.surface();
+    const int regions_before = lobe.last_kept().regions;
+    // Round the equator, between the two middle rings: it splits each of the 12 cells between
+    // them in two.
+    lobe.add_stroke(++id, sphere_ring(c, r, 0.0));
+    const LobeSurface& after = lobe.surface();
+    expect_valid_lobe(after.mesh, "after the ring");
+    ASSERT_EQ(after.centre, before.centre);
+    EXPECT_TRUE(lobe.last_kept().built_changed_only);
+    EXPECT_EQ(lobe.last_kept().regions, regions_before + 12);
+    EXPECT_EQ(lobe.last_kept().kept, regions_before - 12) << "every region but the 12 cells between the middle rings";
+    std::set<std::array<std::array<float, 3>, 3>> now;
+    for (const auto& t : after.mesh.triangles) now.insert(corners(after.mesh, t));
+    std::size_t kept = 0;
+    for (const auto& t : before.mesh.triangles) {
+        if (now.count(corners(before.mesh, t))) {
+            ++kept;
+            continue;
+        }
+        for (int v : t) {
+            const double h = before.mesh.positions[static_cast<std::size_t>(v)].y - c.y;
+            EXPECT_LE(std::abs(h), 0.081) << "a triangle outside the band between the middle rings changed";
+        }
+    }
+    EXPECT_GT(kept, before.mesh.triangles.size() / 2);
 }
 
 TEST(Lobes, BadStrokesAreRefusedWithOneLineAndTheLobeUnchanged)
