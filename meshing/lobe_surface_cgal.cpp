@@ -617,6 +617,40 @@ void Builder::choose_pole()
     out.steps.clear();
     // Following the previous search while every step is the same.
     bool follow = memo && memo->start == best && memo->start_dot == best_dot && memo->steps.size() == 40;
+    // Otherwise the rounds look only at the samples near the start: the nearest sample to a
+    // point within `reach` of the start lies within θ0 + 2·reach of the start (θ0: the start's
+    // distance to its nearest sample), and so does every sample at least as near to a trial
+    // within reach as the nearest one is to the pole. Farther out every sample is looked at.
+    constexpr double reach = 0.15;
+    const glm::dvec3 start = best;
+    const double cos_reach = std::cos(reach);
+    const double near_cos = std::cos(std::min(M_PI, std::acos(std::clamp(best_dot, -1.0, 1.0)) + 2.0 * reach + 1e-6));
+    std::vector<Index> near;
+    for (Index k = 0; k < all.size(); ++k)
+        if (glm::dot(all[k], start) >= near_cos) near.push_back(k);
+    auto max_dot_near = [&](const glm::dvec3& d, int* nearest) {
+        if (glm::dot(d, start) < cos_reach) return max_dot(d, 0, nearest);
+        double m = -2.0;
+        for (Index k : near) {
+            const double c = glm::dot(all[k], d);
+            if (c > m) {
+                m = c;
+                if (nearest) *nearest = static_cast<int>(k);
+            }
+        }
+        return m;
+    };
+    auto beaten_near = [&](const glm::dvec3& d, double& bound) {
+        if (glm::dot(d, start) < cos_reach || glm::dot(best, start) < cos_reach) return beaten(d, bound);
+        for (Index k : near) {
+            const double c = glm::dot(all[k], d);
+            if (c >= best_dot) {
+                bound = c;
+                return static_cast<int>(k);
+            }
+        }
+        return -1;
+    };
     double step = 0.1;
     for (int it = 0; it < 40; ++it) {
         LobeBuildMemo::Step rec;
@@ -629,7 +663,7 @@ void Builder::choose_pole()
                 rec.nearest = memo->steps[static_cast<Index>(it)].nearest;
             }
         } else {
-            max_dot(best, 0, &rec.nearest);
+            max_dot_near(best, &rec.nearest);
         }
         const glm::dvec3& nearest = all[static_cast<Index>(rec.nearest)];
         const glm::dvec3 trial = glm::normalize(best - step * (nearest - glm::dot(nearest, best) * best));
@@ -645,7 +679,7 @@ void Builder::choose_pole()
             }
         } else {
             double bound = 0;
-            m = beaten(trial, bound) >= 0 ? bound : max_dot(trial, 0, nullptr);
+            m = beaten_near(trial, bound) >= 0 ? bound : max_dot_near(trial, nullptr);
         }
         rec.accepted = m < best_dot;
         rec.value = m;
