@@ -322,8 +322,9 @@ struct Adjacency {
         list.reserve(raw.size());
         for (Index i = 0; i < n; ++i) {
             const auto b = raw.begin() + start[i], e = raw.begin() + start[i + 1];
-            std::sort(b, e);
             start[i] = static_cast<int>(list.size());
+            if (b == e) continue;
+            std::sort(b, e);
             list.insert(list.end(), b, std::unique(b, e));
         }
         start[n] = static_cast<int>(list.size());
