@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <limits>
 #include <map>
+#include <numeric>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -410,7 +411,6 @@ private:
 
     std::vector<std::vector<glm::dvec3>> dirs_;    ///< per stroke, per sample
     std::vector<std::vector<double>> radii_;       ///< per stroke, per sample
-    std::vector<std::vector<glm::dvec2>> plane_;   ///< per stroke, per sample
     std::vector<double> spacing_;                  ///< per stroke: median 3D spacing
     double mean_radius_ = 0;
     double empty_angle_ = 0;                       ///< angular radius of the empty cap at the pole
@@ -531,29 +531,38 @@ void Builder::choose_pole()
     Index old_count = 0;
     if (memo)
         for (Index s = 0; s < old_strokes_; ++s) old_count += dirs_[s].size();
-    // Largest dot product with the samples [from, all.size()), and the first sample giving it.
-    auto max_dot = [&](const glm::dvec3& d, Index from, int* nearest) {
+    // Scans over the samples listed in [first, last) (indices into `all`, in order).
+    std::vector<Index> every(all.size());
+    std::iota(every.begin(), every.end(), Index{0});
+    // The largest dot product with `d`, and the first sample giving it.
+    auto max_over = [&](const glm::dvec3& d, const Index* first, const Index* last, int* nearest) {
         double m = -2.0;
-        for (Index k = from; k < all.size(); ++k) {
-            const double c = glm::dot(all[k], d);
+        for (const Index* k = first; k != last; ++k) {
+            const double c = glm::dot(all[*k], d);
             if (c > m) {
                 m = c;
-                if (nearest) *nearest = static_cast<int>(k);
+                if (nearest) *nearest = static_cast<int>(*k);
             }
         }
         return m;
     };
-    // The first sample at least as near as the best (a lower bound ≥ best_dot), or −1.
-    auto beaten = [&](const glm::dvec3& d, double& bound) {
-        for (Index k = 0; k < all.size(); ++k) {
-            const double c = glm::dot(all[k], d);
+    // The first sample at least as near as the best (`bound`, its dot product ≥ best_dot), or −1.
+    auto beaten_over = [&](const glm::dvec3& d, const Index* first, const Index* last, double& bound) {
+        for (const Index* k = first; k != last; ++k) {
+            const double c = glm::dot(all[*k], d);
             if (c >= best_dot) {
                 bound = c;
-                return static_cast<int>(k);
+                return static_cast<int>(*k);
             }
         }
         return -1;
     };
+    const Index* every_end = every.data() + every.size();
+    // Over the samples from `from` on (the new strokes' from old_count).
+    auto max_dot = [&](const glm::dvec3& d, Index from, int* nearest) {
+        return max_over(d, every.data() + from, every_end, nearest);
+    };
+    auto beaten = [&](const glm::dvec3& d, double& bound) { return beaten_over(d, every.data(), every_end, bound); };
     LobeBuildMemo& out = *memo_;
     out.candidate_bound.assign(kCandidates, 0.0);
     out.candidate_exact.assign(kCandidates, 0);
@@ -629,28 +638,14 @@ void Builder::choose_pole()
     std::vector<Index> near;
     for (Index k = 0; k < all.size(); ++k)
         if (glm::dot(all[k], start) >= near_cos) near.push_back(k);
+    const Index* near_end = near.data() + near.size();
     auto max_dot_near = [&](const glm::dvec3& d, int* nearest) {
         if (glm::dot(d, start) < cos_reach) return max_dot(d, 0, nearest);
-        double m = -2.0;
-        for (Index k : near) {
-            const double c = glm::dot(all[k], d);
-            if (c > m) {
-                m = c;
-                if (nearest) *nearest = static_cast<int>(k);
-            }
-        }
-        return m;
+        return max_over(d, near.data(), near_end, nearest);
     };
     auto beaten_near = [&](const glm::dvec3& d, double& bound) {
         if (glm::dot(d, start) < cos_reach || glm::dot(best, start) < cos_reach) return beaten(d, bound);
-        for (Index k : near) {
-            const double c = glm::dot(all[k], d);
-            if (c >= best_dot) {
-                bound = c;
-                return static_cast<int>(k);
-            }
-        }
-        return -1;
+        return beaten_over(d, near.data(), near_end, bound);
     };
     double step = 0.1;
     for (int it = 0; it < 40; ++it) {
@@ -696,9 +691,6 @@ void Builder::choose_pole()
     if (empty_angle_ < 3.0 * M_PI / 180.0)
         throw InvalidInput("the lobe's strokes leave no open direction around its centre (they cover it densely)");
     stereo_ = Stereo(best);
-    plane_.resize(strokes_.size());
-    for (Index s = 0; s < strokes_.size(); ++s)
-        for (const glm::dvec3& d : dirs_[s]) plane_[s].push_back(stereo_.to_plane(d));
 }
 
 void Builder::find_crossings()
@@ -734,47 +726,36 @@ bool Builder::find_crossings(bool only_new)
             ++crossing_count_[static_cast<Index>(c.a)];
             ++crossing_count_[static_cast<Index>(c.b)];
         }
-        bool refused = false;
-        grid.for_each_candidate_from(first_new, [&](const SegmentGrid::Seg& a, const SegmentGrid::Seg& b) {
-            double s = 0, t = 0;
-            if (refused || !arc_crossing(a.p0, a.p1, b.p0, b.p1, s, t)) return;
-            if (a.stroke == b.stroke || crossings_.size() >= 100000) {
-                refused = true;
-                return;
-            }
-            crossings_.push_back({a.stroke, a.index, b.stroke, b.index, s, t});
-            ++crossing_count_[static_cast<Index>(a.stroke)];
-            ++crossing_count_[static_cast<Index>(b.stroke)];
-            ++pair_count[{std::min(a.stroke, b.stroke), std::max(a.stroke, b.stroke)}];
-        });
-        for (const auto& [pair, c] : pair_count) {
-            const Index a = static_cast<Index>(pair.first), b = static_cast<Index>(pair.second);
-            if (c > std::max<std::size_t>(16, std::min(plane_[a].size(), plane_[b].size()) / 2)) refused = true;
-        }
-        if (refused) return false;
-        sort_crossings();
-        return true;
     }
-    grid.for_each_candidate([&](const SegmentGrid::Seg& a, const SegmentGrid::Seg& b) {
+    // Looking only at the new segments, a refusal hands over to the whole search (false).
+    struct Refused {};
+    auto refuse = [&](const std::string& why) {
+        if (only_new) throw Refused{};
+        throw InvalidInput(why);
+    };
+    auto test = [&](const SegmentGrid::Seg& a, const SegmentGrid::Seg& b) {
         double s = 0, t = 0;
         if (!arc_crossing(a.p0, a.p1, b.p0, b.p1, s, t)) return;
-        if (a.stroke == b.stroke)
-            throw InvalidInput(stroke_name(a.stroke) + " folds back over itself as seen from the lobe's centre");
-        if (crossings_.size() >= 100000) throw InvalidInput("the lobe's strokes cross each other too often to mesh");
+        if (a.stroke == b.stroke) refuse(stroke_name(a.stroke) + " folds back over itself as seen from the lobe's centre");
+        if (crossings_.size() >= 100000) refuse("the lobe's strokes cross each other too often to mesh");
         crossings_.push_back({a.stroke, a.index, b.stroke, b.index, s, t});
         ++crossing_count_[static_cast<Index>(a.stroke)];
         ++crossing_count_[static_cast<Index>(b.stroke)];
         ++pair_count[{std::min(a.stroke, b.stroke), std::max(a.stroke, b.stroke)}];
-    });
-    // Two strokes that run along each other (seen from the centre) cross again and again.
-    for (const auto& [pair, c] : pair_count) {
-        const Index a = static_cast<Index>(pair.first), b = static_cast<Index>(pair.second);
-        if (c > std::max<std::size_t>(16, std::min(plane_[a].size(), plane_[b].size()) / 2))
-            throw InvalidInput(stroke_name(pair.second) + " runs along " + stroke_name(pair.first) +
-                               " as seen from the lobe's centre (they cross " + std::to_string(c) +
-                               " times; is one inside the lobe?)");
+    };
+    try {
+        if (only_new) grid.for_each_candidate_from(first_new, test);
+        else grid.for_each_candidate(test);
+        // Two strokes that run along each other (seen from the centre) cross again and again.
+        for (const auto& [pair, c] : pair_count) {
+            const Index a = static_cast<Index>(pair.first), b = static_cast<Index>(pair.second);
+            if (c > std::max<std::size_t>(16, std::min(dirs_[a].size(), dirs_[b].size()) / 2))
+                refuse(stroke_name(pair.second) + " runs along " + stroke_name(pair.first) +
+                       " as seen from the lobe's centre (they cross " + std::to_string(c) + " times; is one inside the lobe?)");
+        }
+    } catch (const Refused&) {
+        return false;
     }
-    if (crossings_.size() > 100000) throw InvalidInput("the lobe's strokes cross each other too often to mesh");
     sort_crossings();
     return true;
 }
