@@ -310,6 +310,7 @@ bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_re
             tri_region.push_back(next_regions.face_region[f]);
             tri_strip.push_back(next_strips ? next.paper_strip_faces[f] : 0);
         }
+    const Index tris_from_next = tris.size();
     // The kept triangles' vertices: stroke vertices are `next`'s at the same place; inner ones
     // are added in `previous`'s order (canonical there, so the order below is a merge).
     constexpr int kNeeded = -2;
@@ -414,15 +415,22 @@ bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_re
             const Index first = static_cast<Index>(std::min_element(o.begin(), o.end()) - o.begin());
             tagged.push_back({{o[first], o[(first + 1) % 3], o[(first + 2) % 3]}, tri_region[i], tri_strip[i]});
         }
-        std::vector<int> start(out.mesh.positions.size() + 1, 0);
-        for (const auto& x : tagged) ++start[static_cast<Index>(x.t[0]) + 1];
-        for (Index i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+        const auto by_corners = [](const Tagged& x, const Tagged& y) { return x.t < y.t; };
         std::vector<Tagged> sorted(tagged.size());
-        std::vector<int> next_slot(start.begin(), start.end() - 1);
-        for (const auto& x : tagged) sorted[static_cast<Index>(next_slot[static_cast<Index>(x.t[0])]++)] = x;
-        for (Index i = 0; i + 1 < start.size(); ++i)
-            std::sort(sorted.begin() + start[i], sorted.begin() + start[i + 1],
-                      [](const Tagged& x, const Tagged& y) { return x.t < y.t; });
+        // `next`'s triangles and the kept ones are each in order already where the vertices
+        // kept their relative order (the usual case): then a merge; else a bucket sort.
+        const auto middle = tagged.begin() + static_cast<std::ptrdiff_t>(tris_from_next);
+        if (std::is_sorted(tagged.begin(), middle, by_corners) && std::is_sorted(middle, tagged.end(), by_corners)) {
+            std::merge(tagged.begin(), middle, middle, tagged.end(), sorted.begin(), by_corners);
+        } else {
+            std::vector<int> start(out.mesh.positions.size() + 1, 0);
+            for (const auto& x : tagged) ++start[static_cast<Index>(x.t[0]) + 1];
+            for (Index i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+            std::vector<int> next_slot(start.begin(), start.end() - 1);
+            for (const auto& x : tagged) sorted[static_cast<Index>(next_slot[static_cast<Index>(x.t[0])]++)] = x;
+            for (Index i = 0; i + 1 < start.size(); ++i)
+                std::sort(sorted.begin() + start[i], sorted.begin() + start[i + 1], by_corners);
+        }
         // The result's regions, numbered again by their first triangle.
         std::vector<int> renumber(static_cast<Index>(region_count), -1);
         MeshRegions regions;
