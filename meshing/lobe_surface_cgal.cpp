@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <limits>
 #include <map>
 #include <numeric>
@@ -90,7 +91,7 @@ struct LobeBuildMemo {
         int node = -1;
     };
     glm::dvec3 centre{0.0};
-    std::vector<std::vector<glm::dvec3>> dirs; ///< per stroke, per sample: its direction
+    std::vector<std::vector<glm::vec3>> points; ///< per stroke, its samples (the directions follow from them)
     std::vector<char> closed;                  ///< per stroke
     /// The pole search (Builder::choose_pole): per lattice candidate, the largest dot product
     /// of its direction with any sample, exact or (when it was pruned) a lower bound of it.
@@ -495,10 +496,15 @@ const LobeBuildMemo* Builder::usable_memo()
 {
     if (!previous_ || !previous_->memo) return nullptr;
     const LobeBuildMemo& m = *previous_->memo;
-    if (m.centre != centre_ || m.dirs.size() > strokes_.size() || m.dirs.empty()) return nullptr;
-    for (Index s = 0; s < m.dirs.size(); ++s)
-        if (m.dirs[s] != dirs_[s] || (m.closed[s] != 0) != strokes_[s].closed) return nullptr;
-    old_strokes_ = m.dirs.size();
+    if (m.centre != centre_ || m.points.size() > strokes_.size() || m.points.empty()) return nullptr;
+    for (Index s = 0; s < m.points.size(); ++s) {
+        const auto& was = m.points[s];
+        const auto& now = strokes_[s].points;
+        if (was.size() != now.size() || (m.closed[s] != 0) != strokes_[s].closed ||
+            std::memcmp(was.data(), now.data(), was.size() * sizeof(glm::vec3)) != 0)
+            return nullptr;
+    }
+    old_strokes_ = m.points.size();
     return &m;
 }
 
@@ -1223,10 +1229,10 @@ void Builder::seed_fill(double max_edge, int& added)
     auto reaches_caps = [&](const glm::dvec3& a, const glm::dvec3& b) {
         if (!partial_) return true;
         // angle(a, centre) ≤ reach + |ab|, as cosines: cos(reach + |ab|) by the sum formula.
+        // reach + |ab| ≥ π (every direction is within it) ⇔ cos |ab| ≤ cos(π − reach) = −cos reach.
         const double cl = glm::dot(a, b), sl = glm::length(glm::cross(a, b));
-        const double length = std::atan2(sl, cl);
         for (Index c = 0; c < caps_.size(); ++c)
-            if (reach_angle[c] + length >= M_PI - 1e-9 ||
+            if (reach_angle[c] >= M_PI || cl <= -reach_cos[c] + 1e-9 ||
                 glm::dot(a, caps_[c].first) >= reach_cos[c] * cl - reach_sin[c] * sl - 1e-9)
                 return true;
         return false;
@@ -1811,7 +1817,8 @@ LobeSurface Builder::run()
     make_directions();
     old_memo_ = usable_memo();
     memo_->centre = centre_;
-    memo_->dirs = dirs_;
+    memo_->points.resize(strokes_.size());
+    for (Index s = 0; s < strokes_.size(); ++s) memo_->points[s] = strokes_[s].points;
     memo_->closed.resize(strokes_.size());
     for (Index s = 0; s < strokes_.size(); ++s) memo_->closed[s] = strokes_[s].closed ? 1 : 0;
     choose_pole();
