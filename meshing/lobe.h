@@ -62,6 +62,8 @@ public:
     bool empty() const { return strokes_.empty(); }
     /// What the last add_stroke / add_prepared kept of the surface before it.
     const KeptRegions& last_kept() const { return last_kept_; }
+    /// The regions of surface() (surface_regions of its mesh), kept for the next stroke.
+    const SurfaceRegions& regions() const { return regions_; }
     const std::vector<LobeStrokeSamples>& strokes() const { return strokes_; }
     /// The closed surface through every stroke, before remeshing.
     /// \pre !empty()

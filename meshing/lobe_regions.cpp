@@ -232,12 +232,14 @@ namespace {
 /// regions of `previous` that `next` lacks and that complete it. False when a stroke vertex of
 /// a kept region is not one of `next`'s (nothing is changed then).
 bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_regions, const std::vector<char>* also_keep,
-                  LobeSurface& next, SurfaceRegions& next_regions_out, KeptRegions& result)
+                  LobeSurface& next, SurfaceRegions& next_regions_out, bool next_regions_known, KeptRegions& result)
 {
     result = {};
     const Features next_features(next.mesh);
-    next_regions_out.regions = regions_of(next.mesh, next_features);
-    next_regions_out.edges = region_keys(next.mesh, next_features, next_regions_out.regions);
+    if (!next_regions_known) {
+        next_regions_out.regions = regions_of(next.mesh, next_features);
+        next_regions_out.edges = region_keys(next.mesh, next_features, next_regions_out.regions);
+    }
     const MeshRegions& next_regions = next_regions_out.regions;
     const auto& next_keys = next_regions_out.edges;
     result.regions = next_regions.count;
@@ -496,18 +498,18 @@ int region_at(const LobeSurface& surface, const MeshRegions& regions, const glm:
 } // namespace
 
 KeptRegions keep_unchanged_regions(const LobeSurface& previous, const SurfaceRegions& previous_regions,
-                                   LobeSurface& next, SurfaceRegions& next_regions)
+                                   LobeSurface& next, SurfaceRegions& next_regions, bool next_regions_known)
 {
     KeptRegions result;
-    keep_regions(previous, previous_regions, nullptr, next, next_regions, result);
+    keep_regions(previous, previous_regions, nullptr, next, next_regions, next_regions_known, result);
     return result;
 }
 
 bool complete_with_kept_regions(const LobeSurface& previous, const SurfaceRegions& previous_regions,
                                 const std::vector<char>& keep, LobeSurface& next, SurfaceRegions& next_regions,
-                                KeptRegions& kept)
+                                KeptRegions& kept, bool next_regions_known)
 {
-    return keep_regions(previous, previous_regions, &keep, next, next_regions, kept);
+    return keep_regions(previous, previous_regions, &keep, next, next_regions, next_regions_known, kept);
 }
 
 ChangedRegions find_changed_regions(const LobeSurface& previous, const SurfaceRegions& previous_regions,

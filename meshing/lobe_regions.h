@@ -65,9 +65,11 @@ struct KeptRegions {
 /// canonical as build_lobe_surface's: stroke vertices in their order, interpolated vertices
 /// sorted by direction, triangles sorted, each starting at its lowest index.
 /// `previous_regions` are surface_regions(previous.mesh); `next_regions` is set to the
-/// regions of the result (kept, so that the next stroke need not find them again).
+/// regions of the result (kept, so that the next stroke need not find them again). With
+/// `next_regions_known`, `next_regions` holds surface_regions(next.mesh) on entry (the
+/// builder knows them), and they are not found again.
 KeptRegions keep_unchanged_regions(const LobeSurface& previous, const SurfaceRegions& previous_regions,
-                                   LobeSurface& next, SurfaceRegions& next_regions);
+                                   LobeSurface& next, SurfaceRegions& next_regions, bool next_regions_known = false);
 
 /// A stroke of the next surface as its vertices will lie: the stroke's samples, crossings and
 /// subdivisions in order (the nodes the surface joins), at the positions the surface gives them.
@@ -106,7 +108,7 @@ ChangedRegions find_changed_regions(const LobeSurface& previous, const SurfaceRe
 /// region's stroke vertex is not one of `next`'s: then the whole surface must be built.
 bool complete_with_kept_regions(const LobeSurface& previous, const SurfaceRegions& previous_regions,
                                 const std::vector<char>& keep, LobeSurface& next, SurfaceRegions& next_regions,
-                                KeptRegions& kept);
+                                KeptRegions& kept, bool next_regions_known = false);
 
 /// The surface of `strokes` around `centre` after a stroke was added to (or changed in) the
 /// lobe whose surface was `previous`: the same, bit for bit, as build_lobe_surface followed by

@@ -363,7 +363,8 @@ public:
     bool followed_previous() const { return old_memo_ != nullptr; }
     const std::vector<char>& kept_previous_regions() const { return changed_.keep; }
 
-    LobeSurface run();
+    /// `regions` (may be null): set to surface_regions of the result, which the build knows.
+    LobeSurface run(SurfaceRegions* regions = nullptr);
 
 private:
     std::string stroke_name(int s) const
@@ -395,7 +396,7 @@ private:
     void seed_fill(double max_edge, int& added);
     void insert_fill(const glm::dvec2& x, int region, VH& hint, int& added);
     void insert_fill(const Node& n, const glm::dvec2& x, int region, VH& hint, int& added);
-    void emit(LobeSurface& out);
+    void emit(LobeSurface& out, SurfaceRegions* regions);
     void solve_fill_radii(const std::vector<std::array<int, 3>>& triangles, const std::vector<char>& on_chain);
     bool fit_radius_model(const std::vector<char>& fit, const std::vector<char>& used, std::vector<double>& model) const;
 
@@ -1610,7 +1611,7 @@ bool Builder::fit_radius_model(const std::vector<char>& fit, const std::vector<c
     return true;
 }
 
-void Builder::emit(LobeSurface& out)
+void Builder::emit(LobeSurface& out, SurfaceRegions* regions_out)
 {
     // CGAL vertices without a node (residual crossings it split itself) become fill nodes.
     for (auto v = cdt_.finite_vertices_begin(); v != cdt_.finite_vertices_end(); ++v) {
@@ -1634,6 +1635,10 @@ void Builder::emit(LobeSurface& out)
     // The paper's strips for the regions between two uncrossed loops; a strip that would
     // fold seen from the centre leaves its region to the Delaunay triangles.
     std::vector<std::array<int, 3>> tris; // node ids, outward
+    // Per triangle: its region of the triangulation, and which of its sides (side k: corner k
+    // to corner k + 1) are stroke edges, so that the output's regions need not be found again.
+    std::vector<int> tri_region;
+    std::vector<std::uint8_t> tri_mask;
     for (Index r = 0; r < paper_region_.size(); ++r) {
         if (!paper_region_[r]) continue;
         const auto [a, b] = region_strokes_[r];
@@ -1666,6 +1671,20 @@ void Builder::emit(LobeSurface& out)
         }
         out.paper_strip_triangles += region.size();
         tris.insert(tris.end(), region.begin(), region.end());
+        for (const auto& t : region) {
+            // A strip's stroke edges are its chains' edges: constrained edges of the triangulation.
+            std::uint8_t mask = 0;
+            for (int k = 0; k < 3; ++k) {
+                const VH x = node_vertex_[static_cast<Index>(t[static_cast<Index>(k)])];
+                const VH y = node_vertex_[static_cast<Index>(t[static_cast<Index>((k + 1) % 3)])];
+                FH f;
+                int i = 0;
+                if (x != y && cdt_.is_edge(x, y, f, i) && cdt_.is_constrained(CDT::Edge(f, i)))
+                    mask = static_cast<std::uint8_t>(mask | (1u << k));
+            }
+            tri_region.push_back(static_cast<int>(r));
+            tri_mask.push_back(mask);
+        }
     }
     const std::size_t strip_count = tris.size();
     if (partial_)
@@ -1687,6 +1706,11 @@ void Builder::emit(LobeSurface& out)
             continue;
         // Planar counter-clockwise is clockwise seen from outside the sphere.
         tris.push_back({node_of(f->vertex(0)), node_of(f->vertex(2)), node_of(f->vertex(1))});
+        // Sides v0 v2, v2 v1, v1 v0: the edges opposite v1, v0 and v2.
+        tri_region.push_back(f->info().region);
+        tri_mask.push_back(static_cast<std::uint8_t>((cdt_.is_constrained(CDT::Edge(f, 1)) ? 1u : 0u) |
+                                                     (cdt_.is_constrained(CDT::Edge(f, 0)) ? 2u : 0u) |
+                                                     (cdt_.is_constrained(CDT::Edge(f, 2)) ? 4u : 0u)));
     }
     // The pole fans the ring (the triangulation's outer boundary).
     for (FH f : cdt_.all_face_handles()) {
@@ -1698,6 +1722,8 @@ void Builder::emit(LobeSurface& out)
                     nodes_[static_cast<Index>(t[2])].dir) < 0)
             std::swap(t[1], t[2]);
         tris.push_back(t);
+        tri_region.push_back(f->neighbor(i)->info().region);
+        tri_mask.push_back(0); // the pole and the ring: no stroke edges
     }
     // Canonical order: the stroke nodes keep theirs (it follows the strokes alone), the
     // interpolated nodes are sorted by direction, and below the triangles are sorted too, so
@@ -1761,9 +1787,12 @@ void Builder::emit(LobeSurface& out)
         const glm::dvec3 mid = (p0 + p1 + p2) / 3.0 - centre_;
         if (!(orient3(d0, d1, d2) > 0.0) || !(glm::dot(normal, mid) > 0.0))
             throw InvalidInput("the lobe's strokes fold over each other as seen from its centre (draw around the lobe)");
-        // Each triangle starts at its lowest index (same orientation).
+        // Each triangle starts at its lowest index (same orientation), its sides' flags turned with it.
         const Index first = static_cast<Index>(std::min_element(o.begin(), o.end()) - o.begin());
         out.mesh.triangles.push_back({o[first], o[(first + 1) % 3], o[(first + 2) % 3]});
+        const unsigned m = tri_mask[static_cast<Index>(&t - tris.data())];
+        tri_mask[static_cast<Index>(&t - tris.data())] =
+            static_cast<std::uint8_t>(((m >> first) | (m << (3 - first))) & 7u);
     }
     // Sorted: bucketed by first (lowest) index, each bucket (a vertex's few triangles) sorted;
     // the paper strips' triangles (the first strip_count) flagged.
@@ -1772,15 +1801,48 @@ void Builder::emit(LobeSurface& out)
         std::vector<int> start(out.mesh.positions.size() + 1, 0);
         for (const auto& t : tris_out) ++start[static_cast<Index>(t[0]) + 1];
         for (Index i = 1; i < start.size(); ++i) start[i] += start[i - 1];
-        std::vector<std::pair<std::array<int, 3>, std::uint8_t>> sorted(tris_out.size());
+        struct Sorted {
+            std::array<int, 3> t;
+            std::uint8_t strip, mask;
+            int region;
+        };
+        std::vector<Sorted> sorted(tris_out.size());
         std::vector<int> next(start.begin(), start.end() - 1);
         for (Index k = 0; k < tris_out.size(); ++k)
-            sorted[static_cast<Index>(next[static_cast<Index>(tris_out[k][0])]++)] = {tris_out[k], k < strip_count ? 1 : 0};
-        for (Index i = 0; i + 1 < start.size(); ++i) std::sort(sorted.begin() + start[i], sorted.begin() + start[i + 1]);
+            sorted[static_cast<Index>(next[static_cast<Index>(tris_out[k][0])]++)] = {
+                tris_out[k], static_cast<std::uint8_t>(k < strip_count ? 1 : 0), tri_mask[k], tri_region[k]};
+        for (Index i = 0; i + 1 < start.size(); ++i)
+            std::sort(sorted.begin() + start[i], sorted.begin() + start[i + 1],
+                      [](const Sorted& x, const Sorted& y) { return x.t < y.t; });
         out.paper_strip_faces.resize(sorted.size());
         for (Index k = 0; k < sorted.size(); ++k) {
-            tris_out[k] = sorted[k].first;
-            out.paper_strip_faces[k] = sorted[k].second;
+            tris_out[k] = sorted[k].t;
+            out.paper_strip_faces[k] = sorted[k].strip;
+        }
+        if (regions_out) {
+            // As surface_regions finds them: numbered by their first triangle, each with its
+            // stroke edges directed as its triangles run round them, sorted.
+            std::vector<int> number(static_cast<Index>(region_count_), -1);
+            MeshRegions& mr = regions_out->regions;
+            mr = MeshRegions{};
+            mr.face_region.reserve(sorted.size());
+            auto& keys = regions_out->edges;
+            keys.clear();
+            for (const Sorted& x : sorted) {
+                int& n = number[static_cast<Index>(x.region)];
+                if (n < 0) {
+                    n = mr.count++;
+                    keys.emplace_back();
+                }
+                mr.face_region.push_back(n);
+                for (Index k = 0; k < 3; ++k) {
+                    if (!(x.mask & (1u << k))) continue;
+                    const glm::vec3& p = out.mesh.positions[static_cast<Index>(x.t[k])];
+                    const glm::vec3& q = out.mesh.positions[static_cast<Index>(x.t[(k + 1) % 3])];
+                    keys[static_cast<Index>(n)].push_back({p.x, p.y, p.z, q.x, q.y, q.z});
+                }
+            }
+            for (auto& k : keys) std::sort(k.begin(), k.end());
         }
     }
     // Stroke segments (split at crossings) are the constraints of remeshing.
@@ -1797,7 +1859,7 @@ void Builder::emit(LobeSurface& out)
     out.crossings = static_cast<std::size_t>(std::unique(crossing_nodes.begin(), crossing_nodes.end()) - crossing_nodes.begin());
 }
 
-LobeSurface Builder::run()
+LobeSurface Builder::run(SurfaceRegions* regions)
 {
     if (strokes_.empty()) throw InvalidInput("a lobe needs at least one stroke");
     std::size_t total = 0;
@@ -1832,7 +1894,7 @@ LobeSurface Builder::run()
     try {
         triangulate();
         refine();
-        emit(out);
+        emit(out, regions);
     } catch (const CGAL::Failure_exception& e) {
         throw InvalidInput(std::string("the lobe's strokes could not be triangulated: ") + e.message());
     }
@@ -1876,16 +1938,20 @@ LobeSurface continue_lobe_surface(const LobeSurface& previous, const SurfaceRegi
                                   const std::vector<LobeStrokeSamples>& strokes, const glm::dvec3& centre,
                                   const LobeSurfaceOptions& options, SurfaceRegions& regions, KeptRegions& kept)
 {
+    // The builder hands on the regions of what it built, so they are not found again.
     try {
         Builder b(strokes, centre, options);
         b.set_previous(previous, previous_regions);
-        LobeSurface surface = b.run();
+        SurfaceRegions built;
+        LobeSurface surface = b.run(&built);
         if (!b.partial()) {
-            kept = keep_unchanged_regions(previous, previous_regions, surface, regions);
+            regions = std::move(built);
+            kept = keep_unchanged_regions(previous, previous_regions, surface, regions, true);
             kept.followed_previous_build = b.followed_previous();
             return surface;
         }
-        if (complete_with_kept_regions(previous, previous_regions, b.kept_previous_regions(), surface, regions, kept)) {
+        if (complete_with_kept_regions(previous, previous_regions, b.kept_previous_regions(), surface, built, kept, true)) {
+            regions = std::move(built);
             kept.built_changed_only = true;
             kept.followed_previous_build = b.followed_previous();
             return surface;
@@ -1894,8 +1960,8 @@ LobeSurface continue_lobe_surface(const LobeSurface& previous, const SurfaceRegi
     }
     Builder b(strokes, centre, options);
     b.set_previous(previous, previous_regions, false);
-    LobeSurface surface = b.run();
-    kept = keep_unchanged_regions(previous, previous_regions, surface, regions);
+    LobeSurface surface = b.run(&regions);
+    kept = keep_unchanged_regions(previous, previous_regions, surface, regions, true);
     kept.followed_previous_build = b.followed_previous();
     return surface;
 }

@@ -180,10 +180,16 @@ std::map<std::vector<RegionStrokeEdge>, PositionTriangles> regions_by_stroke_edg
 /// The lobe's surface after a stroke was added, against build_lobe_surface on the same
 /// strokes around the same centre: the same stroke vertices, stroke edges and regions, and
 /// every region either the from-scratch build's or, bit for bit, the one with the same stroke
-/// edges in `before` (the surface before the stroke). Returns how many were kept from `before`.
+/// edges in `before` (the surface before the stroke). The regions the lobe keeps for the next
+/// stroke (handed on by the builder and the kept regions) are those of its surface. Returns
+/// how many were kept from `before`.
 int expect_scratch_or_kept_regions(const Lobe& lobe, const LobeSurface& before, const std::string& what)
 {
     const LobeSurface& kept = lobe.surface();
+    const SurfaceRegions found = surface_regions(kept.mesh);
+    EXPECT_EQ(lobe.regions().regions.count, found.regions.count) << what;
+    EXPECT_TRUE(lobe.regions().regions.face_region == found.regions.face_region) << what << ": regions handed on differ";
+    EXPECT_TRUE(lobe.regions().edges == found.edges) << what << ": regions' stroke edges handed on differ";
     LobeSurfaceOptions options;
     options.reference_radius_m = kept.reference_radius;
     const LobeSurface scratch = build_lobe_surface(lobe.strokes(), lobe.centre(), options);
