@@ -108,6 +108,13 @@ struct LobeBuildMemo {
     std::vector<Step> steps;
     /// The crossings of the strokes, as find_crossings found them.
     std::vector<Crossing> crossings;
+    /// The radius model's normal equations, per stroke (fit_radius_model).
+    struct FitPart {
+        std::vector<double> key; ///< per row: its direction and radius
+        Eigen::Matrix<double, 20, 20> ata = Eigen::Matrix<double, 20, 20>::Zero(); ///< lower triangle
+        Eigen::Matrix<double, 20, 1> atb = Eigen::Matrix<double, 20, 1>::Zero();
+    };
+    std::vector<FitPart> fit;
 };
 
 namespace {
@@ -1576,24 +1583,48 @@ bool Builder::fit_radius_model(const std::vector<char>& fit, const std::vector<c
         for (Index j = 0; j < static_cast<Index>(kTerms); ++j)
             out(static_cast<Eigen::Index>(j)) = px[monos[j].a] * py[monos[j].b] * pz[monos[j].c];
     };
-    // The basis at every sample (stroke, crossing and segment vertices in the surface), then
-    // the normal equations as one matrix product.
+    // The basis at every sample (stroke, crossing and segment vertices in the surface), and
+    // the normal equations summed stroke by stroke (a crossing counts with its first stroke),
+    // each stroke's part one matrix product over its rows in node order. A stroke whose rows
+    // are the previous build's, bit for bit, takes its part from the memo: the sum is the same.
     Index samples = 0;
-    for (Index i = 0; i < nodes_.size(); ++i)
-        if (fit[i]) ++samples;
-    if (samples < static_cast<Index>(kTerms)) return false;
-    Basis phi(static_cast<Eigen::Index>(samples), kTerms);
-    Eigen::VectorXd radius(static_cast<Eigen::Index>(samples));
-    Eigen::Index row = 0;
+    const Index stroke_count = strokes_.size();
+    std::vector<std::vector<Index>> rows_of(stroke_count);
     for (Index i = 0; i < nodes_.size(); ++i) {
         if (!fit[i]) continue;
-        basis(nodes_[i].dir, phi.row(row));
-        radius[row++] = nodes_[i].radius;
+        ++samples;
+        rows_of[static_cast<Index>(std::clamp(nodes_[i].origin.stroke, 0, static_cast<int>(stroke_count) - 1))].push_back(i);
     }
+    if (samples < static_cast<Index>(kTerms)) return false;
     // Only the lower triangle of the normal matrix is formed: all the LDLT below reads.
     Eigen::Matrix<double, kTerms, kTerms> ata = Eigen::Matrix<double, kTerms, kTerms>::Zero();
-    ata.selfadjointView<Eigen::Lower>().rankUpdate(phi.transpose());
-    const Eigen::Matrix<double, kTerms, 1> atb = phi.transpose() * radius;
+    Eigen::Matrix<double, kTerms, 1> atb = Eigen::Matrix<double, kTerms, 1>::Zero();
+    memo_->fit.assign(stroke_count, {});
+    for (Index s = 0; s < stroke_count; ++s) {
+        LobeBuildMemo::FitPart& part = memo_->fit[s];
+        const auto& rows = rows_of[s];
+        part.key.reserve(4 * rows.size());
+        for (Index i : rows) part.key.insert(part.key.end(), {nodes_[i].dir.x, nodes_[i].dir.y, nodes_[i].dir.z, nodes_[i].radius});
+        const LobeBuildMemo::FitPart* was =
+            old_memo_ && s < old_memo_->fit.size() ? &old_memo_->fit[s] : nullptr;
+        if (was && was->key.size() == part.key.size() &&
+            std::memcmp(was->key.data(), part.key.data(), part.key.size() * sizeof(double)) == 0) {
+            part.ata = was->ata;
+            part.atb = was->atb;
+        } else if (!rows.empty()) {
+            Basis phi(static_cast<Eigen::Index>(rows.size()), kTerms);
+            Eigen::VectorXd radius(static_cast<Eigen::Index>(rows.size()));
+            Eigen::Index row = 0;
+            for (Index i : rows) {
+                basis(nodes_[i].dir, phi.row(row));
+                radius[row++] = nodes_[i].radius;
+            }
+            part.ata.selfadjointView<Eigen::Lower>().rankUpdate(phi.transpose());
+            part.atb = phi.transpose() * radius;
+        }
+        ata += part.ata;
+        atb += part.atb;
+    }
     // Penalty growing with degree (d(d+1))², scaled to the number of samples.
     for (Index j = 0; j < static_cast<Index>(kTerms); ++j) {
         const int d = monos[j].a + monos[j].b + monos[j].c;
