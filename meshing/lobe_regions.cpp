@@ -294,7 +294,7 @@ bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_re
         LobeVertexOrigin origin;
     };
     std::vector<Vertex> all;
-    all.reserve(next.mesh.positions.size());
+    all.reserve(next.mesh.positions.size() + previous.mesh.positions.size());
     for (Index v = 0; v < next.mesh.positions.size(); ++v) all.push_back({next.mesh.positions[v], next.origins[v]});
     std::vector<int> from_previous(previous.mesh.positions.size(), -1);
     std::vector<std::array<int, 3>> tris;
@@ -302,7 +302,10 @@ bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_re
     std::vector<std::uint8_t> tri_strip;
     const bool next_strips = next.paper_strip_faces.size() == next.mesh.triangles.size();
     const bool prev_strips = previous.paper_strip_faces.size() == previous.mesh.triangles.size();
-    tris.reserve(next.mesh.triangles.size());
+    const Index at_most = next.mesh.triangles.size() + previous.mesh.triangles.size();
+    tris.reserve(at_most);
+    tri_region.reserve(at_most);
+    tri_strip.reserve(at_most);
     std::vector<char> next_kept(static_cast<Index>(next_regions.count), 0);
     for (int as : kept_as)
         if (as >= 0 && as < next_regions.count) next_kept[static_cast<Index>(as)] = 1;
@@ -363,7 +366,9 @@ bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_re
     for (const auto& t : tris)
         for (int v : t) used[static_cast<Index>(v)] = 1;
     std::vector<int> order;
+    order.reserve(all.size());
     std::vector<std::tuple<double, double, double, float, float, float, int>> fill;
+    fill.reserve(all.size());
     for (Index v = 0; v < all.size(); ++v) {
         if (!used[v]) continue;
         if (all[v].origin.kind != LobeVertexKind::Fill) {

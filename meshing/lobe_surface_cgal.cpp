@@ -1670,6 +1670,9 @@ void Builder::emit(LobeSurface& out, SurfaceRegions* regions_out)
     // to corner k + 1) are stroke edges, so that the output's regions need not be found again.
     std::vector<int> tri_region;
     std::vector<std::uint8_t> tri_mask;
+    tris.reserve(cdt_.number_of_faces() + 8);
+    tri_region.reserve(cdt_.number_of_faces() + 8);
+    tri_mask.reserve(cdt_.number_of_faces() + 8);
     for (Index r = 0; r < paper_region_.size(); ++r) {
         if (!paper_region_[r]) continue;
         const auto [a, b] = region_strokes_[r];
