@@ -52,7 +52,7 @@ struct KeptRegions {
     /// Only the regions that changed were built (continue_lobe_surface); false when the
     /// whole surface was built and the unchanged regions then swapped back.
     bool built_changed_only = false;
-    /// The search for the pole and the crossings of the strokes took the previous build's
+    /// The search for the pole, the crossings and the radius model took the previous build's
     /// over (the strokes before the new one unchanged, the same centre) and looked only at the
     /// new stroke where the answer could change (continue_lobe_surface).
     bool followed_previous_build = false;

@@ -75,9 +75,10 @@ struct LobeVertexOrigin {
     int other_stroke = -1;
 };
 
-/// What a build found over all of its strokes (the pole and its search, the crossings), kept
-/// so that the build after one more stroke looks only at that stroke where the answer
-/// cannot differ (lobe_surface_cgal.cpp). Never changes the result.
+/// What a build found over all of its strokes (the pole and its search, the crossings, the
+/// radius model's normal equations per stroke), kept so that the build after one more stroke
+/// looks only at that stroke where the answer cannot differ (lobe_surface_cgal.cpp). Never
+/// changes the result.
 struct LobeBuildMemo;
 
 /// The surface and how it was made.
