@@ -297,25 +297,25 @@ bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_re
     all.reserve(next.mesh.positions.size() + previous.mesh.positions.size());
     for (Index v = 0; v < next.mesh.positions.size(); ++v) all.push_back({next.mesh.positions[v], next.origins[v]});
     std::vector<int> from_previous(previous.mesh.positions.size(), -1);
-    std::vector<std::array<int, 3>> tris;
-    std::vector<int> tri_region; // region of the result each triangle belongs to
-    std::vector<std::uint8_t> tri_strip;
+    // The result's triangles before sorting, written in place (sized for all of both; this
+    // and the loops below run on every triangle of the lobe for every stroke).
     const bool next_strips = next.paper_strip_faces.size() == next.mesh.triangles.size();
     const bool prev_strips = previous.paper_strip_faces.size() == previous.mesh.triangles.size();
     const Index at_most = next.mesh.triangles.size() + previous.mesh.triangles.size();
-    tris.reserve(at_most);
-    tri_region.reserve(at_most);
-    tri_strip.reserve(at_most);
+    std::vector<std::array<int, 3>> tris(at_most);
+    std::vector<int> tri_region(at_most); // region of the result each triangle belongs to
+    std::vector<std::uint8_t> tri_strip(at_most);
+    Index tri_count = 0;
     std::vector<char> next_kept(static_cast<Index>(next_regions.count), 0);
     for (int as : kept_as)
         if (as >= 0 && as < next_regions.count) next_kept[static_cast<Index>(as)] = 1;
     for (Index f = 0; f < next.mesh.triangles.size(); ++f)
         if (!next_kept[static_cast<Index>(next_regions.face_region[f])]) {
-            tris.push_back(next.mesh.triangles[f]);
-            tri_region.push_back(next_regions.face_region[f]);
-            tri_strip.push_back(next_strips ? next.paper_strip_faces[f] : 0);
+            tris[tri_count] = next.mesh.triangles[f];
+            tri_region[tri_count] = next_regions.face_region[f];
+            tri_strip[tri_count++] = next_strips ? next.paper_strip_faces[f] : 0;
         }
-    const Index tris_from_next = tris.size();
+    const Index tris_from_next = tri_count;
     // The kept triangles' vertices: stroke vertices are `next`'s at the same place; inner ones
     // are added in `previous`'s order (canonical there, so the order below is a merge).
     constexpr int kNeeded = -2;
@@ -346,8 +346,8 @@ bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_re
     for (Index f = 0; f < previous.mesh.triangles.size(); ++f) {
         const int as = kept_as[static_cast<Index>(prev_regions.face_region[f])];
         if (as < 0) continue;
-        tri_region.push_back(as);
-        tri_strip.push_back(prev_strips ? previous.paper_strip_faces[f] : 0);
+        tri_region[tri_count] = as;
+        tri_strip[tri_count] = prev_strips ? previous.paper_strip_faces[f] : 0;
         const auto& pt = previous.mesh.triangles[f];
         const std::array<int, 3> t{from_previous[static_cast<Index>(pt[0])], from_previous[static_cast<Index>(pt[1])],
                                    from_previous[static_cast<Index>(pt[2])]};
@@ -356,9 +356,12 @@ bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_re
                 const int a = pt[k], b = pt[(k + 1) % 3];
                 if (a < b && prev_features.has(a, b)) kept_features.push_back({t[k], t[(k + 1) % 3]});
             }
-        tris.push_back(t);
+        tris[tri_count++] = t;
         ++result.kept_triangles;
     }
+    tris.resize(tri_count);
+    tri_region.resize(tri_count);
+    tri_strip.resize(tri_count);
 
     // Canonical order, as build_lobe_surface emits it: stroke vertices in their order, then
     // interpolated vertices by direction from the centre; only vertices some triangle uses.
@@ -380,8 +383,8 @@ bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_re
         fill.emplace_back(d.x, d.y, d.z, p.x, p.y, p.z, static_cast<int>(v));
     }
     // `next`'s interpolated vertices, then `previous`'s: each list is sorted already when it
-    // came from a surface made by this function (a whole build orders them by the direction
-    // of its nodes, which rounding to positions may swap).
+    // came from a build or from this function (both order them so); a surface made otherwise
+    // is sorted.
     {
         const auto middle = std::partition_point(fill.begin(), fill.end(), [&](const auto& f) {
             return static_cast<Index>(std::get<6>(f)) < from_next;
@@ -413,14 +416,13 @@ bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_re
             int region;
             std::uint8_t strip;
         };
-        std::vector<Tagged> tagged;
-        tagged.reserve(tris.size());
+        std::vector<Tagged> tagged(tris.size());
         for (Index i = 0; i < tris.size(); ++i) {
             const auto& t = tris[i];
             const std::array<int, 3> o{new_index[static_cast<Index>(t[0])], new_index[static_cast<Index>(t[1])],
                                        new_index[static_cast<Index>(t[2])]};
             const Index first = static_cast<Index>(std::min_element(o.begin(), o.end()) - o.begin());
-            tagged.push_back({{o[first], o[(first + 1) % 3], o[(first + 2) % 3]}, tri_region[i], tri_strip[i]});
+            tagged[i] = {{o[first], o[(first + 1) % 3], o[(first + 2) % 3]}, tri_region[i], tri_strip[i]};
         }
         const auto by_corners = [](const Tagged& x, const Tagged& y) { return x.t < y.t; };
         std::vector<Tagged> sorted(tagged.size());
@@ -441,15 +443,16 @@ bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_re
         // The result's regions, numbered again by their first triangle.
         std::vector<int> renumber(static_cast<Index>(region_count), -1);
         MeshRegions regions;
-        regions.face_region.reserve(sorted.size());
-        out.mesh.triangles.reserve(sorted.size());
-        out.paper_strip_faces.reserve(sorted.size());
-        for (const auto& x : sorted) {
+        regions.face_region.resize(sorted.size());
+        out.mesh.triangles.resize(sorted.size());
+        out.paper_strip_faces.resize(sorted.size());
+        for (Index i = 0; i < sorted.size(); ++i) {
+            const Tagged& x = sorted[i];
             int& n = renumber[static_cast<Index>(x.region)];
             if (n < 0) n = regions.count++;
-            regions.face_region.push_back(n);
-            out.mesh.triangles.push_back(x.t);
-            out.paper_strip_faces.push_back(x.strip);
+            regions.face_region[i] = n;
+            out.mesh.triangles[i] = x.t;
+            out.paper_strip_faces[i] = x.strip;
             out.paper_strip_triangles += x.strip;
         }
         std::vector<std::vector<RegionStrokeEdge>> edges(static_cast<Index>(regions.count));

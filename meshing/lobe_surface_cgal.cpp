@@ -405,7 +405,7 @@ private:
     void insert_fill(const Node& n, const glm::dvec2& x, int region, VH& hint, int& added);
     void emit(LobeSurface& out, SurfaceRegions* regions);
     void solve_fill_radii(const std::vector<std::array<int, 3>>& triangles, const std::vector<char>& on_chain);
-    bool fit_radius_model(const std::vector<char>& fit, const std::vector<char>& used, std::vector<double>& model) const;
+    bool fit_radius_model(const std::vector<char>& fit, const std::vector<char>& at, std::vector<double>& model) const;
 
     int add_node(const Node& n)
     {
@@ -581,17 +581,39 @@ void Builder::choose_pole()
     out.candidate_bound.assign(kCandidates, 0.0);
     out.candidate_exact.assign(kCandidates, 0);
     if (memo) {
+        // New samples only raise a candidate's largest dot product, so the previous bounds stay
+        // lower bounds. The previous winner's new value `ceiling` is one the answer cannot
+        // exceed: a candidate whose bound is above it cannot be the answer and is passed over.
+        // The others are scanned in order as the whole search does, so ties go the same way.
+        Index leader = 0;
+        for (Index i = 1; i < static_cast<Index>(kCandidates); ++i)
+            if (memo->candidate_exact[i] &&
+                (!memo->candidate_exact[leader] || memo->candidate_bound[i] < memo->candidate_bound[leader]))
+                leader = i;
+        double ceiling = 2.0;
+        if (memo->candidate_exact[leader])
+            ceiling = std::max(memo->candidate_bound[leader], max_dot(lattice[leader], old_count, nullptr));
         for (Index i = 0; i < static_cast<Index>(kCandidates); ++i) {
             const glm::dvec3& d = lattice[i];
             double bound = memo->candidate_bound[i];
             bool exact = memo->candidate_exact[i] != 0;
-            if (bound >= best_dot) {
+            if (bound >= best_dot || bound > ceiling) {
                 exact = false; // the new samples may raise it: a lower bound now
             } else {
                 const double added = max_dot(d, old_count, nullptr);
-                bound = exact ? std::max(bound, added) : max_dot(d, 0, nullptr);
-                exact = true;
-                if (bound < best_dot) {
+                if (exact) {
+                    bound = std::max(bound, added);
+                } else if (added >= best_dot) {
+                    bound = std::max(bound, added); // cannot win: a lower bound
+                } else {
+                    // The old samples until one is at least as near as the best (then it
+                    // cannot win either), else all of them: the exact value.
+                    double old_max = -2.0;
+                    for (Index k = 0; k < old_count && old_max < best_dot; ++k) old_max = std::max(old_max, glm::dot(all[k], d));
+                    bound = std::max(old_max, added);
+                    exact = old_max < best_dot;
+                }
+                if (exact && bound < best_dot) {
                     best_dot = bound;
                     best = d;
                 }
@@ -641,25 +663,40 @@ void Builder::choose_pole()
     out.steps.clear();
     // Following the previous search while every step is the same.
     bool follow = memo && memo->start == best && memo->start_dot == best_dot && memo->steps.size() == 40;
-    // Otherwise the rounds look only at the samples near the start: the nearest sample to a
-    // point within `reach` of the start lies within θ0 + 2·reach of the start (θ0: the start's
-    // distance to its nearest sample), and so does every sample at least as near to a trial
-    // within reach as the nearest one is to the pole. Farther out every sample is looked at.
+    // Otherwise the rounds look only at the samples near a centre (first the start): the
+    // nearest sample to a point within `reach` of the centre lies within θ0 + 2·reach of it
+    // (θ0: the centre's distance to its nearest sample), and so does every sample at least as
+    // near to a trial within reach as the nearest one is to the pole, while the pole is within
+    // reach too. When the search walks out of reach, the current pole becomes the centre (a
+    // step moves less than reach). Either way the answers are the full scan's, bit for bit:
+    // the samples left out cannot be the first nearest or the first at least as near.
     constexpr double reach = 0.15;
-    const glm::dvec3 start = best;
     const double cos_reach = std::cos(reach);
-    const double near_cos = std::cos(std::min(M_PI, std::acos(std::clamp(best_dot, -1.0, 1.0)) + 2.0 * reach + 1e-6));
+    glm::dvec3 centre = best;
     std::vector<Index> near;
-    for (Index k = 0; k < all.size(); ++k)
-        if (glm::dot(all[k], start) >= near_cos) near.push_back(k);
-    const Index* near_end = near.data() + near.size();
+    auto recentre = [&] {
+        centre = best;
+        const double near_cos = std::cos(std::min(M_PI, std::acos(std::clamp(best_dot, -1.0, 1.0)) + 2.0 * reach + 1e-6));
+        near.clear();
+        for (Index k = 0; k < all.size(); ++k)
+            if (glm::dot(all[k], centre) >= near_cos) near.push_back(k);
+    };
+    bool near_ready = false;
+    // Whether the near samples serve `d` (and the pole), moving the centre if they did not.
+    auto near_serves = [&](const glm::dvec3& d) {
+        auto covers = [&](const glm::dvec3& x) { return glm::dot(x, centre) >= cos_reach; };
+        if (near_ready && covers(d) && covers(best)) return true;
+        recentre();
+        near_ready = true;
+        return covers(d);
+    };
     auto max_dot_near = [&](const glm::dvec3& d, int* nearest) {
-        if (glm::dot(d, start) < cos_reach) return max_dot(d, 0, nearest);
-        return max_over(d, near.data(), near_end, nearest);
+        if (!near_serves(d)) return max_dot(d, 0, nearest);
+        return max_over(d, near.data(), near.data() + near.size(), nearest);
     };
     auto beaten_near = [&](const glm::dvec3& d, double& bound) {
-        if (glm::dot(d, start) < cos_reach || glm::dot(best, start) < cos_reach) return beaten(d, bound);
-        return beaten_over(d, near.data(), near_end, bound);
+        if (!near_serves(d)) return beaten(d, bound);
+        return beaten_over(d, near.data(), near.data() + near.size(), bound);
     };
     double step = 0.1;
     for (int it = 0; it < 40; ++it) {
@@ -1261,7 +1298,11 @@ void Builder::seed_fill(double max_edge, int& added)
     }
     const double cell = std::max(clearance, 2.0 / 48.0);
     const int dim = static_cast<int>(std::floor(2.0 / cell)) + 1;
-    auto coord = [&](double c) { return std::clamp(static_cast<int>(std::floor((c + 1.0) / cell)), 0, dim - 1); };
+    // c + 1 ≥ 0, so truncation is the floor; a multiplication by the reciprocal is monotone
+    // too, and two directions within `clearance` differ by less than a cell in every coordinate
+    // (by their chord, shorter than the angle) with a margin far above its rounding.
+    const double per_cell = 1.0 / cell;
+    auto coord = [&](double c) { return std::min(static_cast<int>(std::max(0.0, c + 1.0) * per_cell), dim - 1); };
     auto cell_index = [&](int x, int y, int z) { return (static_cast<Index>(z) * static_cast<Index>(dim) + static_cast<Index>(y)) * static_cast<Index>(dim) + static_cast<Index>(x); };
     std::vector<int> start(static_cast<Index>(dim) * static_cast<Index>(dim) * static_cast<Index>(dim) + 1, 0);
     for (const glm::dvec3& d : along) ++start[cell_index(coord(d.x), coord(d.y), coord(d.z)) + 1];
@@ -1466,8 +1507,15 @@ void Builder::solve_fill_radii(const std::vector<std::array<int, 3>>& triangles,
             lo = std::min(lo, nodes_[i].radius);
             hi = std::max(hi, nodes_[i].radius);
         }
+    // The model is read at the interpolated vertices and their neighbours only.
+    std::vector<char> needed(n, 0);
+    for (Index i = 0; i < n; ++i) {
+        if (unknown[i] < 0) continue;
+        needed[i] = 1;
+        for (int j : adj[i]) needed[static_cast<Index>(j)] = 1;
+    }
     std::vector<double> model(n, 0.0);
-    const bool have_model = fit_radius_model(fit, used, model);
+    const bool have_model = fit_radius_model(fit, needed, model);
     // Groups: connected interpolated vertices (union–find over their rows).
     std::vector<int> parent(static_cast<Index>(count));
     for (Index r = 0; r < parent.size(); ++r) parent[r] = static_cast<int>(r);
@@ -1558,7 +1606,7 @@ void Builder::solve_fill_radii(const std::vector<std::array<int, 3>>& triangles,
     }
 }
 
-bool Builder::fit_radius_model(const std::vector<char>& fit, const std::vector<char>& used, std::vector<double>& model) const
+bool Builder::fit_radius_model(const std::vector<char>& fit, const std::vector<char>& at, std::vector<double>& model) const
 {
     // Monomials x^a y^b z^c of the direction, a + b + c ≤ 3: 20 functions spanning the
     // spherical harmonics up to degree 3 on the sphere.
@@ -1576,12 +1624,16 @@ bool Builder::fit_radius_model(const std::vector<char>& fit, const std::vector<c
     }();
     using Row = Eigen::Matrix<double, 1, kTerms>;
     using Basis = Eigen::Matrix<double, Eigen::Dynamic, kTerms, Eigen::RowMajor>;
+    // The monomials in the order of `monos`, written out (a loop over the table's exponents
+    // cost a third of the fit); each is x^a·y^b·z^c multiplied in that order, as the table
+    // reads, factors of 1 left out (exact).
     auto basis = [&](const glm::dvec3& u, auto&& out) {
-        const double px[4] = {1, u.x, u.x * u.x, u.x * u.x * u.x};
-        const double py[4] = {1, u.y, u.y * u.y, u.y * u.y * u.y};
-        const double pz[4] = {1, u.z, u.z * u.z, u.z * u.z * u.z};
-        for (Index j = 0; j < static_cast<Index>(kTerms); ++j)
-            out(static_cast<Eigen::Index>(j)) = px[monos[j].a] * py[monos[j].b] * pz[monos[j].c];
+        const double x = u.x, y = u.y, z = u.z;
+        const double x2 = x * x, y2 = y * y, z2 = z * z;
+        const double t[kTerms] = {1.0,    x,          y,      z,          x2,         x * y,  x * z,
+                                  y2,     y * z,      z2,     x2 * x,     x2 * y,     x2 * z, x * y2,
+                                  x * y * z, x * z2, y2 * y, y2 * z, y * z2, z2 * z};
+        for (Index j = 0; j < static_cast<Index>(kTerms); ++j) out(static_cast<Eigen::Index>(j)) = t[j];
     };
     // The basis at every sample (stroke, crossing and segment vertices in the surface), and
     // the normal equations summed stroke by stroke (a crossing counts with its first stroke),
@@ -1633,11 +1685,11 @@ bool Builder::fit_radius_model(const std::vector<char>& fit, const std::vector<c
     }
     const Eigen::Matrix<double, kTerms, 1> coef = ata.ldlt().solve(atb);
     if (!coef.allFinite()) return false;
-    Row at;
+    Row row;
     for (Index i = 0; i < nodes_.size(); ++i) {
-        if (!used[i]) continue;
-        basis(nodes_[i].dir, at);
-        model[i] = at.dot(coef.transpose());
+        if (!at[i]) continue;
+        basis(nodes_[i].dir, row);
+        model[i] = row.dot(coef.transpose());
     }
     return true;
 }
@@ -1790,24 +1842,46 @@ void Builder::emit(LobeSurface& out, SurfaceRegions* regions_out)
         for (int id : chain) on_chain[static_cast<Index>(new_id[static_cast<Index>(id)])] = 1;
     solve_fill_radii(tris, on_chain);
 
-    // Output: only nodes used by triangles, in node order (samples first, by stroke); a
-    // build of the changed regions has every stroke node (the kept regions use them).
+    // Output: only nodes used by triangles; a build of the changed regions has every stroke
+    // node (the kept regions use them). The stroke nodes come first in node order (samples
+    // first, by stroke), then the interpolated ones by the direction of their rounded position
+    // from the centre: the order complete_with_kept_regions gives its result, so that it merges
+    // a build's vertices with the kept ones instead of sorting them all.
     std::vector<int> out_index(nodes_.size(), -1);
     for (const auto& t : tris)
         for (int id : t) out_index[static_cast<Index>(id)] = 0;
     if (partial_)
         for (Index i = 0; i < nodes_.size(); ++i)
             if (on_chain[i]) out_index[i] = 0;
+    std::vector<std::tuple<double, double, double, float, float, float, int>> fill_out;
     for (Index i = 0; i < nodes_.size(); ++i) {
         if (out_index[i] < 0) continue;
-        out_index[i] = static_cast<int>(out.mesh.positions.size());
         const Node& n = nodes_[i];
-        const glm::dvec3 p = n.origin.kind == LobeVertexKind::Sample
-                                 ? glm::dvec3(strokes_[static_cast<Index>(n.origin.stroke)]
-                                                  .points[static_cast<Index>(n.origin.sample)])
-                                 : centre_ + n.radius * n.dir;
-        out.mesh.positions.emplace_back(p);
+        const glm::vec3 p(n.origin.kind == LobeVertexKind::Sample
+                              ? glm::dvec3(strokes_[static_cast<Index>(n.origin.stroke)]
+                                               .points[static_cast<Index>(n.origin.sample)])
+                              : centre_ + n.radius * n.dir);
+        if (n.origin.kind == LobeVertexKind::Fill) {
+            const glm::dvec3 d = glm::normalize(glm::dvec3(p) - centre_);
+            fill_out.emplace_back(d.x, d.y, d.z, p.x, p.y, p.z, static_cast<int>(i));
+            continue;
+        }
+        out_index[i] = static_cast<int>(out.mesh.positions.size());
+        out.mesh.positions.push_back(p);
         out.origins.push_back(n.origin);
+    }
+    // The nodes are in order of their directions already, which rounding swaps only here and
+    // there: an insertion sort, handing over to a full sort should it move much.
+    {
+        std::size_t moves = 0;
+        for (Index k = 1; k < fill_out.size() && moves <= 4 * fill_out.size(); ++k)
+            for (Index j = k; j > 0 && fill_out[j] < fill_out[j - 1]; --j, ++moves) std::swap(fill_out[j], fill_out[j - 1]);
+        if (moves > 4 * fill_out.size()) std::sort(fill_out.begin(), fill_out.end());
+    }
+    for (const auto& [dx, dy, dz, px, py, pz, i] : fill_out) {
+        out_index[static_cast<Index>(i)] = static_cast<int>(out.mesh.positions.size());
+        out.mesh.positions.emplace_back(px, py, pz);
+        out.origins.push_back(nodes_[static_cast<Index>(i)].origin);
     }
     for (const auto& t : tris) {
         const glm::dvec3 d0 = nodes_[static_cast<Index>(t[0])].dir, d1 = nodes_[static_cast<Index>(t[1])].dir,
