@@ -590,6 +590,7 @@ void Builder::choose_pole()
             if (memo->candidate_exact[i] &&
                 (!memo->candidate_exact[leader] || memo->candidate_bound[i] < memo->candidate_bound[leader]))
                 leader = i;
+        std::vector<int> stopped_at(kCandidates, -1); // per candidate scanned: its nearest old sample so far
         double ceiling = 2.0;
         if (memo->candidate_exact[leader])
             ceiling = std::max(memo->candidate_bound[leader], max_dot(lattice[leader], old_count, nullptr));
@@ -607,9 +608,28 @@ void Builder::choose_pole()
                     bound = std::max(bound, added); // cannot win: a lower bound
                 } else {
                     // The old samples until one is at least as near as the best (then it
-                    // cannot win either), else all of them: the exact value.
+                    // cannot win either), else all of them: the exact value. The samples that
+                    // ended the scans of the lattice neighbours (Fibonacci index steps) are
+                    // tried first, as in the whole search.
                     double old_max = -2.0;
-                    for (Index k = 0; k < old_count && old_max < best_dot; ++k) old_max = std::max(old_max, glm::dot(all[k], d));
+                    for (int step : {1, 2, 3, 5, 8, 13, 21, 34, 55, 89}) {
+                        if (i < static_cast<Index>(step)) break;
+                        const int w = stopped_at[i - static_cast<Index>(step)];
+                        if (w < 0) continue;
+                        const double c = glm::dot(all[static_cast<Index>(w)], d);
+                        if (c >= best_dot) {
+                            old_max = c;
+                            stopped_at[i] = w;
+                            break;
+                        }
+                    }
+                    for (Index k = 0; k < old_count && old_max < best_dot; ++k) {
+                        const double c = glm::dot(all[k], d);
+                        if (c > old_max) {
+                            old_max = c;
+                            stopped_at[i] = static_cast<int>(k);
+                        }
+                    }
                     bound = std::max(old_max, added);
                     exact = old_max < best_dot;
                 }
