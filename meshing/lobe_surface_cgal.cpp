@@ -1415,6 +1415,13 @@ void Builder::refine()
     mark_regions();
     find_paper_regions();
     regions_stale_ = false;
+    // Where every region built is a paper strip (a ring drawn between two others, Fig. 5),
+    // there is nothing to fill: fill vertices go into the other regions only, and those are
+    // the kept ones.
+    bool to_fill = false;
+    for (Index k = 0; k < static_cast<Index>(region_count_); ++k)
+        to_fill = to_fill || (region_inside_[k] && !paper_region_[k]);
+    if (!to_fill) return;
     seed_fill(max_edge, added);
     for (int pass = 0; pass < 4; ++pass) {
         if (regions_stale_) {
