@@ -1,6 +1,7 @@
 #include "meshing/stitch.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <queue>
@@ -141,21 +142,26 @@ struct StripBuilder {
     enum class Diagonal { Shorter, V0V2, V1V3 };
     void add_quad(int v0, int v1, int v2, int v3, Diagonal forced = Diagonal::Shorter)
     {
-        std::vector<int> q{v0, v1, v2, v3};
-        for (bool changed = true; changed && q.size() > 1;) {
+        // The corners with repeats next to each other dropped (a fixed array: this runs for
+        // every quad of every strip).
+        std::array<int, 4> q{v0, v1, v2, v3};
+        std::size_t size = 4;
+        for (bool changed = true; changed && size > 1;) {
             changed = false;
-            for (std::size_t i = 0; i < q.size(); ++i)
-                if (q[i] == q[(i + 1) % q.size()]) {
-                    q.erase(q.begin() + static_cast<std::ptrdiff_t>(i));
+            for (std::size_t i = 0; i < size; ++i)
+                if (q[i] == q[(i + 1) % size]) {
+                    std::copy(q.begin() + static_cast<std::ptrdiff_t>(i) + 1, q.begin() + static_cast<std::ptrdiff_t>(size),
+                              q.begin() + static_cast<std::ptrdiff_t>(i));
+                    --size;
                     changed = true;
                     break;
                 }
         }
-        if (q.size() == 3) {
+        if (size == 3) {
             strip.triangles.push_back({q[0], q[1], q[2]});
             return;
         }
-        if (q.size() != 4 || q[0] == q[2] || q[1] == q[3]) return;
+        if (size != 4 || q[0] == q[2] || q[1] == q[3]) return;
         auto P = [&](int v) { return pos[static_cast<Index>(v)]; };
         const double d02 = glm::distance(P(q[0]), P(q[2]));
         const double d13 = glm::distance(P(q[1]), P(q[3]));
@@ -239,15 +245,34 @@ StrokeStrip stitch_closed_closed(const std::vector<glm::vec3>& a, const std::vec
     };
     int best_shift[2] = {0, 0};
     double distance_sum[2] = {0.0, 0.0};
+    // The scores of all shifts at once, a probe at a time: b's directions in partner order,
+    // written out twice so that shift i + shift needs no wrapping, so the inner loop runs over
+    // consecutive shifts (and vectorises). Every score still sums its probes in their order,
+    // each term as glm::dot forms it: the same numbers as a loop over shifts.
+    std::vector<double> bx(2 * static_cast<Index>(N)), by(bx.size()), bz(bx.size()), score(static_cast<Index>(N));
     for (int r = 0; r < 2; ++r) {
         const bool reversed = r == 1;
-        double best = -std::numeric_limits<double>::infinity();
-        for (int shift = 0; shift < N; ++shift) {
-            double score = 0.0;
-            for (int i : probe)
-                score += glm::dot(da[static_cast<Index>(i)], db[static_cast<Index>(partner(reversed, shift, i))]);
-            if (score > best + 1e-12) { best = score; best_shift[r] = shift; }
+        for (int k = 0; k < 2 * N; ++k) {
+            const glm::dvec3& d = db[static_cast<Index>(partner(reversed, 0, k % N))];
+            bx[static_cast<Index>(k)] = d.x;
+            by[static_cast<Index>(k)] = d.y;
+            bz[static_cast<Index>(k)] = d.z;
         }
+        std::fill(score.begin(), score.end(), 0.0);
+        for (int i : probe) {
+            const glm::dvec3& d = da[static_cast<Index>(i)];
+            const double* x = bx.data() + i;
+            const double* y = by.data() + i;
+            const double* z = bz.data() + i;
+            for (Index shift = 0; shift < static_cast<Index>(N); ++shift)
+                score[shift] += d.x * x[shift] + d.y * y[shift] + d.z * z[shift];
+        }
+        double best = -std::numeric_limits<double>::infinity();
+        for (int shift = 0; shift < N; ++shift)
+            if (score[static_cast<Index>(shift)] > best + 1e-12) {
+                best = score[static_cast<Index>(shift)];
+                best_shift[r] = shift;
+            }
         for (int i : probe)
             distance_sum[r] += glm::distance(ea.positions[static_cast<Index>(i)],
                                              eb.positions[static_cast<Index>(partner(reversed, best_shift[r], i))]);
