@@ -105,6 +105,37 @@ void BM_AddStrokeToTenStrokeLobe(benchmark::State& state)
 }
 BENCHMARK(BM_AddStrokeToTenStrokeLobe)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 
+/// The paper's progressive lobe without crossings (Fig. 5): ten rings stacked round a 20 cm
+/// sphere, from 70° south to 70° north, each joined to the next by a strip and the ends capped
+/// automatically; an 11th ring drawn between the two middle ones replaces the strip between
+/// them with two. The lobe is copied back outside the timed region each round.
+void BM_AddRingBetweenTwoOfTenStackedRings(benchmark::State& state)
+{
+    auto ring_at = [](double latitude_deg, int seed) {
+        const double lat = latitude_deg * kPi / 180.0;
+        return raw_loop(kCentre + glm::dvec3(0, kRadius * std::sin(lat), 0), {1, 0, 0}, {0, 0, 1},
+                        kRadius * std::cos(lat), seed);
+    };
+    Lobe base;
+    for (int k = 0; k < 10; ++k) base.add_stroke(k + 1, ring_at(-70.0 + k * 140.0 / 9.0, k));
+    const LobeStrokeSamples prepared = prepare_lobe_stroke(11, ring_at(0.0, 10));
+    Lobe after = base;
+    after.add_prepared(prepared);
+    for (auto _ : state) {
+        state.PauseTiming();
+        Lobe lobe = base;
+        state.ResumeTiming();
+        lobe.add_prepared(prepared);
+        benchmark::DoNotOptimize(lobe.surface().mesh.positions.data());
+    }
+    state.counters["vertices"] = static_cast<double>(after.surface().mesh.positions.size());
+    state.counters["strip_triangles"] = static_cast<double>(after.surface().paper_strip_triangles);
+    state.counters["regions"] = static_cast<double>(after.last_kept().regions);
+    state.counters["kept"] = static_cast<double>(after.last_kept().kept);
+    state.counters["built_changed_only"] = after.last_kept().built_changed_only ? 1.0 : 0.0;
+}
+BENCHMARK(BM_AddRingBetweenTwoOfTenStackedRings)->Unit(benchmark::kMillisecond);
+
 /// What a regrowth does with the lobes after the person drew one more lobe stroke: every lobe
 /// of table1-4lobes-22strokes (4 lobes, 22 strokes) built from its strokes and remeshed.
 /// Arg 0: from scratch (replay, the CLI); arg 1: with the regrowth worker's kept build
