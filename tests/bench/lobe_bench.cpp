@@ -65,6 +65,25 @@ std::vector<std::vector<glm::vec3>> ten_strokes()
     return s;
 }
 
+/// Times adding `prepared` to copies of `base` (copied outside the timed region) and
+/// reports which regions the stroke kept; returns the lobe with the stroke added.
+Lobe time_adding_stroke(benchmark::State& state, const Lobe& base, const LobeStrokeSamples& prepared)
+{
+    Lobe after = base;
+    after.add_prepared(prepared);
+    for (auto _ : state) {
+        state.PauseTiming();
+        Lobe lobe = base;
+        state.ResumeTiming();
+        lobe.add_prepared(prepared);
+        benchmark::DoNotOptimize(lobe.surface().mesh.positions.data());
+    }
+    state.counters["regions"] = static_cast<double>(after.last_kept().regions);
+    state.counters["kept"] = static_cast<double>(after.last_kept().kept);
+    state.counters["built_changed_only"] = after.last_kept().built_changed_only ? 1.0 : 0.0;
+    return after;
+}
+
 /// Adds an 11th stroke to a lobe of ten; the lobe is copied back outside the timed region
 /// each round. Arg 0: a loop tilted by 45°, which crosses every stroke (twice) and changes
 /// about half of the lobe; arg 1: a ring round the equator, between the two middle rings,
@@ -86,22 +105,9 @@ void BM_AddStrokeToTenStrokeLobe(benchmark::State& state)
         const double a = 0.04;
         extra = raw_loop(kCentre + std::sqrt(kRadius * kRadius - a * a) * axis, u, v, a, 2);
     }
-    const LobeStrokeSamples prepared = prepare_lobe_stroke(11, extra);
-    Lobe after = base;
-    after.add_prepared(prepared);
-    for (auto _ : state) {
-        state.PauseTiming();
-        Lobe lobe = base;
-        state.ResumeTiming();
-        lobe.add_prepared(prepared);
-        benchmark::DoNotOptimize(lobe.surface().mesh.positions.data());
-    }
-    const LobeSurface& s = base.surface();
-    state.counters["vertices"] = static_cast<double>(s.mesh.positions.size());
-    state.counters["crossings"] = static_cast<double>(s.crossings);
-    state.counters["regions"] = static_cast<double>(after.last_kept().regions);
-    state.counters["kept"] = static_cast<double>(after.last_kept().kept);
-    state.counters["built_changed_only"] = after.last_kept().built_changed_only ? 1.0 : 0.0;
+    time_adding_stroke(state, base, prepare_lobe_stroke(11, extra));
+    state.counters["vertices"] = static_cast<double>(base.surface().mesh.positions.size());
+    state.counters["crossings"] = static_cast<double>(base.surface().crossings);
 }
 BENCHMARK(BM_AddStrokeToTenStrokeLobe)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 
@@ -118,21 +124,9 @@ void BM_AddRingBetweenTwoOfTenStackedRings(benchmark::State& state)
     };
     Lobe base;
     for (int k = 0; k < 10; ++k) base.add_stroke(k + 1, ring_at(-70.0 + k * 140.0 / 9.0, k));
-    const LobeStrokeSamples prepared = prepare_lobe_stroke(11, ring_at(0.0, 10));
-    Lobe after = base;
-    after.add_prepared(prepared);
-    for (auto _ : state) {
-        state.PauseTiming();
-        Lobe lobe = base;
-        state.ResumeTiming();
-        lobe.add_prepared(prepared);
-        benchmark::DoNotOptimize(lobe.surface().mesh.positions.data());
-    }
+    const Lobe after = time_adding_stroke(state, base, prepare_lobe_stroke(11, ring_at(0.0, 10)));
     state.counters["vertices"] = static_cast<double>(after.surface().mesh.positions.size());
     state.counters["strip_triangles"] = static_cast<double>(after.surface().paper_strip_triangles);
-    state.counters["regions"] = static_cast<double>(after.last_kept().regions);
-    state.counters["kept"] = static_cast<double>(after.last_kept().kept);
-    state.counters["built_changed_only"] = after.last_kept().built_changed_only ? 1.0 : 0.0;
 }
 BENCHMARK(BM_AddRingBetweenTwoOfTenStackedRings)->Unit(benchmark::kMillisecond);
 
