@@ -217,28 +217,8 @@ public:
             for_cells(i, [&](Index c) { cells_[static_cast<Index>(next[c]++)] = static_cast<int>(i); });
     }
 
-    /// Calls f(seg_i, seg_j) once for each pair of segments whose boxes share a cell, in
-    /// increasing (i, j) order, i < j.
-    template <typename F>
-    void for_each_candidate(F&& f) const
-    {
-        check_density();
-        std::vector<int> others;
-        for (int i = 0; i < static_cast<int>(segs_.size()); ++i) {
-            others.clear();
-            for_cells(static_cast<Index>(i), [&](Index c) {
-                // Cells list their segments in increasing order.
-                for (int k = start_[c + 1] - 1; k >= start_[c] && cells_[static_cast<Index>(k)] > i; --k)
-                    others.push_back(cells_[static_cast<Index>(k)]);
-            });
-            std::sort(others.begin(), others.end());
-            others.erase(std::unique(others.begin(), others.end()), others.end());
-            for (int j : others) f(segs_[static_cast<Index>(i)], segs_[static_cast<Index>(j)]);
-        }
-    }
-
-    /// As for_each_candidate, but only the pairs with a segment at or after `first` (each
-    /// still as f(seg_i, seg_j), i < j).
+    /// Calls f(seg_i, seg_j), i < j, once for each pair of segments whose boxes share a cell
+    /// and of which one is at or after `first` (0: every pair, in increasing (i, j) order).
     template <typename F>
     void for_each_candidate_from(int first, F&& f) const
     {
@@ -247,10 +227,12 @@ public:
         for (int i = first; i < static_cast<int>(segs_.size()); ++i) {
             others.clear();
             for_cells(static_cast<Index>(i), [&](Index c) {
-                for (int k = start_[c]; k < start_[c + 1]; ++k) {
-                    const int j = cells_[static_cast<Index>(k)];
-                    if (j < first || j > i) others.push_back(j);
-                }
+                // Cells list their segments in increasing order: those after i from the end,
+                // those before `first` from the start.
+                for (int k = start_[c + 1] - 1; k >= start_[c] && cells_[static_cast<Index>(k)] > i; --k)
+                    others.push_back(cells_[static_cast<Index>(k)]);
+                for (int k = start_[c]; k < start_[c + 1] && cells_[static_cast<Index>(k)] < first; ++k)
+                    others.push_back(cells_[static_cast<Index>(k)]);
             });
             std::sort(others.begin(), others.end());
             others.erase(std::unique(others.begin(), others.end()), others.end());
@@ -815,8 +797,7 @@ bool Builder::find_crossings(bool only_new)
         ++pair_count[{std::min(a.stroke, b.stroke), std::max(a.stroke, b.stroke)}];
     };
     try {
-        if (only_new) grid.for_each_candidate_from(first_new, test);
-        else grid.for_each_candidate(test);
+        grid.for_each_candidate_from(only_new ? first_new : 0, test);
         // Two strokes that run along each other (seen from the centre) cross again and again.
         for (const auto& [pair, c] : pair_count) {
             const Index a = static_cast<Index>(pair.first), b = static_cast<Index>(pair.second);
