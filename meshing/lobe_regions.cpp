@@ -226,6 +226,13 @@ SurfaceRegions surface_regions(const TriangleMesh& mesh)
     return out;
 }
 
+// Not inlined (see lobe_regions.h): its callers must see the float position as stored.
+[[gnu::noinline]] FillOrderKey fill_order_key(const glm::vec3& position, const glm::dvec3& centre, int vertex)
+{
+    const glm::dvec3 d = glm::normalize(glm::dvec3(position) - centre);
+    return {d.x, d.y, d.z, position.x, position.y, position.z, vertex};
+}
+
 namespace {
 
 /// keep_unchanged_regions and complete_with_kept_regions: `also_keep` (may be null) flags the
@@ -370,7 +377,7 @@ bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_re
         for (int v : t) used[static_cast<Index>(v)] = 1;
     std::vector<int> order;
     order.reserve(all.size());
-    std::vector<std::tuple<double, double, double, float, float, float, int>> fill;
+    std::vector<FillOrderKey> fill;
     fill.reserve(all.size());
     for (Index v = 0; v < all.size(); ++v) {
         if (!used[v]) continue;
@@ -378,9 +385,7 @@ bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_re
             order.push_back(static_cast<int>(v));
             continue;
         }
-        const glm::vec3& p = all[v].position;
-        const glm::dvec3 d = glm::normalize(glm::dvec3(p) - next.centre);
-        fill.emplace_back(d.x, d.y, d.z, p.x, p.y, p.z, static_cast<int>(v));
+        fill.push_back(fill_order_key(all[v].position, next.centre, static_cast<int>(v)));
     }
     // `next`'s interpolated vertices, then `previous`'s: each list is sorted already when it
     // came from a build or from this function (both order them so); a surface made otherwise

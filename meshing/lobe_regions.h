@@ -14,6 +14,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <tuple>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -22,6 +23,9 @@
 #include "meshing/lobe_surface.h"
 
 namespace lobe {
+
+/// (direction x, y, z, position x, y, z, vertex): see fill_order_key.
+using FillOrderKey = std::tuple<double, double, double, float, float, float, int>;
 
 /// The regions of `mesh`: faces connected across edges that are not feature edges. Regions
 /// are numbered in the order of their first triangle.
@@ -99,6 +103,14 @@ struct ChangedRegions {
 };
 ChangedRegions find_changed_regions(const LobeSurface& previous, const SurfaceRegions& previous_regions,
                                     const std::vector<RegionChain>& chains);
+
+/// The key interpolated vertices are ordered by (build_lobe_surface's output and
+/// complete_with_kept_regions'): the direction from `centre` of the stored (float) position,
+/// then the position, then `vertex` (ties keep vertex order).
+/// Defined out of line on purpose: GCC 12's SLP vectoriser, given the double position a float
+/// was just rounded from, used it unrounded in place of the float, so the two callers' keys
+/// differed in the last bits and their orders disagreed (GCC only; Clang rounds).
+FillOrderKey fill_order_key(const glm::vec3& position, const glm::dvec3& centre, int vertex);
 
 /// The second half of a build of only the changed regions: `next` has the triangles of the
 /// changed regions (and every stroke vertex), `keep` (ChangedRegions::keep) says which regions

@@ -1861,7 +1861,7 @@ void Builder::emit(LobeSurface& out, SurfaceRegions* regions_out)
     if (partial_)
         for (Index i = 0; i < nodes_.size(); ++i)
             if (on_chain[i]) out_index[i] = 0;
-    std::vector<std::tuple<double, double, double, float, float, float, int>> fill_out;
+    std::vector<FillOrderKey> fill_out;
     for (Index i = 0; i < nodes_.size(); ++i) {
         if (out_index[i] < 0) continue;
         const Node& n = nodes_[i];
@@ -1870,8 +1870,7 @@ void Builder::emit(LobeSurface& out, SurfaceRegions* regions_out)
                                                .points[static_cast<Index>(n.origin.sample)])
                               : centre_ + n.radius * n.dir);
         if (n.origin.kind == LobeVertexKind::Fill) {
-            const glm::dvec3 d = glm::normalize(glm::dvec3(p) - centre_);
-            fill_out.emplace_back(d.x, d.y, d.z, p.x, p.y, p.z, static_cast<int>(i));
+            fill_out.push_back(fill_order_key(p, centre_, static_cast<int>(i)));
             continue;
         }
         out_index[i] = static_cast<int>(out.mesh.positions.size());
