@@ -65,6 +65,9 @@ std::vector<std::vector<glm::vec3>> ten_strokes()
     return s;
 }
 
+/// The timed adding, apart so that scripts/count-instructions.sh can count it under callgrind.
+[[gnu::noinline]] void add_timed(Lobe& lobe, const LobeStrokeSamples& prepared) { lobe.add_prepared(prepared); }
+
 /// Times adding `prepared` to copies of `base` (copied outside the timed region) and
 /// reports which regions the stroke kept; returns the lobe with the stroke added.
 Lobe time_adding_stroke(benchmark::State& state, const Lobe& base, const LobeStrokeSamples& prepared)
@@ -75,7 +78,7 @@ Lobe time_adding_stroke(benchmark::State& state, const Lobe& base, const LobeStr
         state.PauseTiming();
         Lobe lobe = base;
         state.ResumeTiming();
-        lobe.add_prepared(prepared);
+        add_timed(lobe, prepared);
         benchmark::DoNotOptimize(lobe.surface().mesh.positions.data());
     }
     state.counters["regions"] = static_cast<double>(after.last_kept().regions);
