@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The README's test command: set up, build, and run the whole test suite, first optimised,
 # then under AddressSanitizer + UndefinedBehaviorSanitizer, then every fuzz target of that
-# build for 15 seconds (docs/fuzzing.md).
+# build for 15 seconds (docs/fuzzing.md). In between, the two builds (GCC -O3 and Clang -O1)
+# must replay the shipped recordings to the same bytes.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 JOBS="$(nproc)"
@@ -12,4 +13,19 @@ ctest --preset release -j "$JOBS"
 cmake --preset asan >/dev/null
 cmake --build --preset asan
 ctest --preset asan -j "$JOBS"
+
+# The application is a function of the hand stream (DESIGN.md), whichever compiler built it:
+# lobes, their remeshing, the tree and the session, byte for byte.
+replays="$(mktemp -d)"
+trap 'rm -rf "$replays"' EXIT
+for rec in recordings/*.lrec; do
+  name="$(basename "$rec" .lrec)"
+  for build in release asan; do
+    "./build/$build/app/lobesketch" replay "$rec" --out "$replays/$build/$name" >/dev/null
+  done
+done
+diff -r "$replays/release" "$replays/asan" >/dev/null ||
+  { echo "the release and asan builds replay a recording to different bytes:" >&2; diff -rq "$replays/release" "$replays/asan" >&2; exit 1; }
+echo "release and asan builds: every recording replays to the same bytes"
+
 ./scripts/fuzz.sh 15
