@@ -559,6 +559,55 @@ void Builder::choose_pole()
         return max_over(d, every.data() + from, every_end, nearest);
     };
     auto beaten = [&](const glm::dvec3& d, double& bound) { return beaten_over(d, every.data(), every_end, bound); };
+    // Runs of up to 8 consecutive samples (along a stroke: close together), each with a cap
+    // of directions holding it, so that a scan for a largest dot product can pass over a run
+    // whose cap cannot beat the value it has: the same answer (and the same first sample
+    // giving it), with fewer products. The old samples' runs end at old_count.
+    struct Run {
+        Index first, last;
+        glm::dvec3 axis;
+        double cos_r, sin_r; ///< of the cap's angular radius
+    };
+    std::vector<Run> runs;
+    auto add_runs = [&](Index from, Index to) {
+        for (Index f = from; f < to; f += 8) {
+            Run run{f, std::min(to, f + 8), glm::dvec3(0.0), 1.0, 0.0};
+            for (Index k = run.first; k < run.last; ++k) run.axis += all[k];
+            const double len = glm::length(run.axis);
+            if (!(len > 1e-6)) {
+                run.cos_r = -1.0; // no useful cap: always scanned
+            } else {
+                run.axis /= len;
+                for (Index k = run.first; k < run.last; ++k) run.cos_r = std::min(run.cos_r, glm::dot(all[k], run.axis));
+                run.cos_r = std::clamp(run.cos_r, -1.0, 1.0);
+                run.sin_r = std::sqrt(1.0 - run.cos_r * run.cos_r);
+            }
+            runs.push_back(run);
+        }
+    };
+    add_runs(0, old_count);
+    const Index first_new_run = runs.size();
+    add_runs(old_count, all.size());
+    // An upper bound of dot(d, x) over a run's samples x: cos(θ − r) for the angle θ between d
+    // and the axis beyond the radius r (the products are of unit vectors, rounded far below
+    // the margin).
+    auto run_bound = [](const Run& run, const glm::dvec3& d) {
+        if (run.cos_r <= -1.0) return 2.0;
+        const double c = glm::dot(d, run.axis);
+        if (c >= run.cos_r) return 2.0;
+        return c * run.cos_r + std::sqrt(std::max(0.0, 1.0 - c * c)) * run.sin_r + 1e-9;
+    };
+    // max(floor, the largest dot product of `d` with a new sample): the runs that cannot
+    // exceed what is found so far are passed over.
+    auto new_max_above = [&](const glm::dvec3& d, double floor) {
+        double m = floor;
+        for (Index r = first_new_run; r < runs.size(); ++r) {
+            const Run& run = runs[r];
+            if (run_bound(run, d) <= m) continue;
+            for (Index k = run.first; k < run.last; ++k) m = std::max(m, glm::dot(all[k], d));
+        }
+        return m;
+    };
     LobeBuildMemo& out = *memo_;
     out.candidate_bound.assign(kCandidates, 0.0);
     out.candidate_exact.assign(kCandidates, 0);
@@ -575,7 +624,7 @@ void Builder::choose_pole()
         std::vector<int> stopped_at(kCandidates, -1); // per candidate scanned: its nearest old sample so far
         double ceiling = 2.0;
         if (memo->candidate_exact[leader])
-            ceiling = std::max(memo->candidate_bound[leader], max_dot(lattice[leader], old_count, nullptr));
+            ceiling = new_max_above(lattice[leader], memo->candidate_bound[leader]);
         for (Index i = 0; i < static_cast<Index>(kCandidates); ++i) {
             const glm::dvec3& d = lattice[i];
             double bound = memo->candidate_bound[i];
@@ -583,11 +632,14 @@ void Builder::choose_pole()
             if (bound >= best_dot || bound > ceiling) {
                 exact = false; // the new samples may raise it: a lower bound now
             } else {
-                const double added = max_dot(d, old_count, nullptr);
+                // max(bound, the new samples' largest): bound is the old samples' largest
+                // (exact) or a lower bound of it (< best_dot here), so `added` reaches
+                // best_dot exactly when the new samples' largest does.
+                const double added = new_max_above(d, bound);
                 if (exact) {
-                    bound = std::max(bound, added);
+                    bound = added;
                 } else if (added >= best_dot) {
-                    bound = std::max(bound, added); // cannot win: a lower bound
+                    bound = added; // cannot win: a lower bound
                 } else {
                     // The old samples until one is at least as near as the best (then it
                     // cannot win either), else all of them: the exact value. The samples that
@@ -605,13 +657,21 @@ void Builder::choose_pole()
                             break;
                         }
                     }
-                    for (Index k = 0; k < old_count && old_max < best_dot; ++k) {
-                        const double c = glm::dot(all[k], d);
-                        if (c > old_max) {
-                            old_max = c;
-                            stopped_at[i] = static_cast<int>(k);
+                    // In sample order; a run that cannot beat old_max changes nothing.
+                    for (Index r = 0; r < first_new_run && old_max < best_dot; ++r) {
+                        const Run& run = runs[r];
+                        if (run_bound(run, d) <= old_max) continue;
+                        for (Index k = run.first; k < run.last && old_max < best_dot; ++k) {
+                            const double c = glm::dot(all[k], d);
+                            if (c > old_max) {
+                                old_max = c;
+                                stopped_at[i] = static_cast<int>(k);
+                            }
                         }
                     }
+                    // old_max is the old samples' largest when the scan ran through (so at
+                    // least the lower bound folded into `added`), else a value ≥ best_dot:
+                    // either way this is max(old_max, the new samples' largest).
                     bound = std::max(old_max, added);
                     exact = old_max < best_dot;
                 }
