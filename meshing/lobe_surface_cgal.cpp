@@ -585,9 +585,13 @@ void Builder::choose_pole()
             runs.push_back(run);
         }
     };
-    add_runs(0, old_count);
-    const Index first_new_run = runs.size();
-    add_runs(old_count, all.size());
+    // Only the search after one more stroke (memo) scans by runs.
+    Index first_new_run = 0;
+    if (memo) {
+        add_runs(0, old_count);
+        first_new_run = runs.size();
+        add_runs(old_count, all.size());
+    }
     // An upper bound of dot(d, x) over a run's samples x: cos(θ − r) for the angle θ between d
     // and the axis beyond the radius r (the products are of unit vectors, rounded far below
     // the margin).
