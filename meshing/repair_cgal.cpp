@@ -232,8 +232,22 @@ TriangleMesh repair_mesh(const TriangleMesh& in, RepairReport* report)
 
     TriangleMesh out = to_triangle_mesh(mesh);
     const MeshQuality q = measure_quality(out);
-    if (!q.closed || !q.manifold || !q.outward)
-        throw InvalidInput("repair_mesh: the result is still not a closed, 2-manifold, outward-oriented surface");
+    if (!q.closed || !q.manifold || !q.outward) {
+        // Name the cause. A flat or single-sheet input (one triangle, a plane) gets its one
+        // boundary capped by a copy of itself: closed and manifold, but with no inside.
+        glm::dvec3 lo, hi;
+        bounding_box(out, lo, hi);
+        const double extent = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
+        if (q.closed && q.manifold && !(std::abs(q.signed_volume_m3) > 1e-9 * extent * extent * extent))
+            throw InvalidInput("repair_mesh: the mesh encloses no volume (it is flat or a single open sheet), so it "
+                               "cannot become a closed lobe");
+        throw InvalidInput(std::string("repair_mesh: the result is still not ") +
+                           (!q.closed ? "closed (" + std::to_string(q.boundary_edges) + " boundary edges left)"
+                            : !q.manifold ? "2-manifold (" + std::to_string(q.non_manifold_edges) + " non-manifold edges, " +
+                                                std::to_string(q.non_manifold_vertices) + " non-manifold vertices, " +
+                                                std::to_string(q.inconsistent_edges) + " inconsistently oriented edges)"
+                                          : std::string("oriented outward (its signed volume is not positive)")));
+    }
     r.output_vertices = out.positions.size();
     r.output_triangles = out.triangles.size();
     if (report) *report = std::move(r);

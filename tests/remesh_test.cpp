@@ -297,6 +297,34 @@ TEST(Repair, RejectsUnusableInput)
     EXPECT_THROW(repair_mesh(nan), InvalidInput);
 }
 
+TEST(Repair, AFlatSheetIsRefusedAsEnclosingNoVolume)
+{
+    // One triangle, and a flat 4 × 4 grid: their border can only be capped by a copy of the
+    // sheet, which leaves nothing inside; the message says so rather than naming a property.
+    TriangleMesh triangle;
+    triangle.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    triangle.triangles = {{0, 1, 2}};
+    TriangleMesh grid;
+    for (int j = 0; j < 5; ++j)
+        for (int i = 0; i < 5; ++i) grid.positions.push_back({static_cast<float>(i), static_cast<float>(j), 0.0f});
+    for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 4; ++i) {
+            const int a = 5 * j + i;
+            grid.triangles.push_back({a, a + 1, a + 6});
+            grid.triangles.push_back({a, a + 6, a + 5});
+        }
+    for (const TriangleMesh* m : {&triangle, &grid}) {
+        try {
+            repair_mesh(*m);
+            ADD_FAILURE() << "a flat sheet was accepted";
+        } catch (const InvalidInput& e) {
+            const std::string what = e.what();
+            EXPECT_NE(what.find("encloses no volume"), std::string::npos) << what;
+            EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+        }
+    }
+}
+
 TEST(Repair, NormalizeToBoxScalesAndCentresTheBase)
 {
     TriangleMesh m = icosphere(1, 250.0, glm::dvec3(100.0, 40.0, -7.0));
