@@ -183,6 +183,23 @@ TriangleMesh repair_mesh(const TriangleMesh& in, RepairReport* report)
     r.merged_vertices = in.positions.size() - points.size();
     r.removed_triangles = in.triangles.size() - polygons.size();
     if (polygons.empty()) throw InvalidInput("repair_mesh: no valid triangle left after removing degenerate ones");
+    {
+        // Triangles whose corners are collinear pass the clean-up but bound nothing, and hole
+        // filling would then report an open hole: say what is wrong instead.
+        double lo[3] = {points[0].x(), points[0].y(), points[0].z()}, hi[3] = {lo[0], lo[1], lo[2]};
+        for (const Point& p : points)
+            for (int k = 0; k < 3; ++k) {
+                lo[k] = std::min(lo[k], p[k]);
+                hi[k] = std::max(hi[k], p[k]);
+            }
+        const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+        double area = 0.0;
+        for (const Polygon& t : polygons)
+            for (std::size_t k = 2; k < t.size(); ++k) // a fan, should the clean-up leave a polygon
+                area += std::sqrt(CGAL::to_double(CGAL::squared_area(points[t[0]], points[t[k - 1]], points[t[k]])));
+        if (!(area > 1e-12 * extent * extent))
+            throw InvalidInput("repair_mesh: the mesh has no area (the corners of every triangle are collinear)");
+    }
     if (r.merged_vertices) r.notes.push_back("merged or dropped " + std::to_string(r.merged_vertices) + " duplicate or unused vertices");
     if (r.removed_triangles) r.notes.push_back("removed " + std::to_string(r.removed_triangles) + " degenerate or duplicate triangles");
 

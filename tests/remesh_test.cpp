@@ -314,6 +314,7 @@ TEST(Repair, AFlatSheetIsRefusedAsEnclosingNoVolume)
             grid.triangles.push_back({a, a + 6, a + 5});
         }
     for (const TriangleMesh* m : {&triangle, &grid}) {
+        SCOPED_TRACE(m->triangles.size());
         try {
             repair_mesh(*m);
             ADD_FAILURE() << "a flat sheet was accepted";
@@ -322,6 +323,19 @@ TEST(Repair, AFlatSheetIsRefusedAsEnclosingNoVolume)
             EXPECT_NE(what.find("encloses no volume"), std::string::npos) << what;
             EXPECT_EQ(what.find('\n'), std::string::npos) << what;
         }
+    }
+}
+
+TEST(Repair, TrianglesWithCollinearCornersAreRefusedAsHavingNoArea)
+{
+    TriangleMesh line;
+    line.positions = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, 0, 0}};
+    line.triangles = {{0, 1, 2}, {1, 3, 2}};
+    try {
+        repair_mesh(line);
+        ADD_FAILURE() << "collinear triangles were accepted";
+    } catch (const InvalidInput& e) {
+        EXPECT_NE(std::string(e.what()).find("no area"), std::string::npos) << e.what();
     }
 }
 
