@@ -252,17 +252,44 @@ def scenario_seeds():
         indent=1))
 
 
+def repair_seeds():
+    """Small meshes for mesh_repair, one per repair step: a closed one, a hole, a
+    non-manifold vertex, duplicate and degenerate faces, faces the wrong way round, two
+    components, a self-intersection, and the refusals (a flat sheet, collinear corners)."""
+    def obj(vs, fs):
+        return "".join("v %g %g %g\n" % v for v in vs) + "".join("f %d %d %d\n" % tuple(i + 1 for i in f) for f in fs)
+    cube_v = [(x, y, z) for x in (0, 1) for y in (0, 1) for z in (0, 1)]
+    cube_f = [(0, 1, 3), (0, 3, 2), (4, 6, 7), (4, 7, 5), (0, 4, 5), (0, 5, 1),
+              (2, 3, 7), (2, 7, 6), (0, 2, 6), (0, 6, 4), (1, 5, 7), (1, 7, 3)]
+    tet_v = [(0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1)]
+    tet_f = [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3)]
+    put("mesh_repair", "cube.obj", obj(cube_v, cube_f))
+    put("mesh_repair", "cube-hole.obj", obj(cube_v, cube_f[2:]))
+    put("mesh_repair", "cube-inside-out.obj", obj(cube_v, [(a, c, b) for a, b, c in cube_f]))
+    put("mesh_repair", "cube-duplicate-degenerate.obj", obj(cube_v, cube_f + [cube_f[0], (0, 0, 1), (1, 0, 3)]))
+    two_tets_v = tet_v + [(x, y, z + 1) for x, y, z in tet_v[1:]]  # sharing vertex 3
+    two_tets_f = tet_f + [(3, 5, 4), (3, 4, 6), (3, 6, 5), (4, 5, 6)]
+    put("mesh_repair", "tets-sharing-a-vertex.obj", obj(two_tets_v, two_tets_f))
+    put("mesh_repair", "two-components.obj", obj(tet_v + [(x + 3, y, z) for x, y, z in cube_v],
+                                                  tet_f + [(a + 4, b + 4, c + 4) for a, b, c in cube_f]))
+    put("mesh_repair", "self-intersecting.obj", obj(cube_v + [(x + 0.5, y + 0.3, z + 0.2) for x, y, z in cube_v],
+                                                    cube_f + [(a + 8, b + 8, c + 8) for a, b, c in cube_f]))
+    put("mesh_repair", "flat-triangle.obj", obj(tet_v[:3], [(0, 1, 2)]))
+    put("mesh_repair", "collinear.obj", obj([(0, 0, 0), (1, 0, 0), (2, 0, 0)], [(0, 1, 2)]))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--lobesketch", help="a built lobesketch, to remake the text-recording and session seeds")
     a = ap.parse_args()
-    for t in ["import_leap", "import_webxr", "recording_binary", "mesh_obj", "mesh_ply", "mesh_off", "species",
-              "desktop_script", "scenario"]:
+    for t in ["import_leap", "import_webxr", "recording_binary", "mesh_obj", "mesh_ply", "mesh_off", "mesh_repair",
+              "species", "desktop_script", "scenario"]:
         shutil.rmtree(OUT / t, ignore_errors=True)
     leap_seeds()
     webxr_seeds()
     recording_binary_seeds()
     mesh_seeds()
+    repair_seeds()
     species_seeds()
     desktop_script_seeds()
     scenario_seeds()
