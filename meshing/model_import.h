@@ -23,8 +23,14 @@ struct LobeFromModelOptions {
     unsigned iterations = 3;             ///< remeshing rounds (RemeshOptions)
 };
 
-/// read_mesh → repair_mesh → normalize_to_box → remesh_isotropic. `report` (optional)
-/// receives what repair did.
+/// repair_mesh → normalize_to_box → remesh_isotropic, and the result checked: closed,
+/// 2-manifold, enclosing a volume (check_encloses_volume). `report` (optional) receives what
+/// repair did.
+/// \throw InvalidInput for a mesh beyond repair, or one that remeshing flattened (one line).
+TriangleMesh lobe_from_mesh(const TriangleMesh& mesh, const LobeFromModelOptions& options = {},
+                            RepairReport* report = nullptr);
+
+/// read_mesh → lobe_from_mesh, errors naming the file.
 /// \throw FileError for an unreadable or malformed file; InvalidInput for a mesh beyond
 /// repair.
 TriangleMesh lobe_from_model(const std::string& path, const LobeFromModelOptions& options = {},

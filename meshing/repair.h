@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/mesh.h"
+#include "meshing/mesh_quality.h"
 
 namespace lobe {
 
@@ -49,6 +50,11 @@ struct RepairReport {
 /// is left after step 1, or the result is still not closed and 2-manifold (a hole that
 /// cannot be triangulated), with a one-line message.
 TriangleMesh repair_mesh(const TriangleMesh& mesh, RepairReport* report = nullptr);
+
+/// Throws InvalidInput, "<what> encloses no volume …" or "<what> is not closed / 2-manifold /
+/// oriented outward (…)", unless `mesh` (measured as `q`) is closed, 2-manifold and encloses
+/// a positive volume of at least a millionth of its bounding cube (its largest side cubed).
+void check_encloses_volume(const TriangleMesh& mesh, const MeshQuality& q, const std::string& what);
 
 /// Removes self-intersections where it can: CGAL's experimental remove_self_intersections
 /// (preserve_genus(false)) takes out the faces involved and fills the gaps by smoothing or

@@ -29,6 +29,7 @@
 #include "input/truth_surface.h"
 #include "meshing/lobe_document.h"
 #include "meshing/mesh_io.h"
+#include "meshing/model_import.h"
 #include "meshing/remesh.h"
 #include "tests/cli_run.h"
 #include "tests/test_paths.h"
@@ -142,7 +143,7 @@ TEST(DegenerateInput, CorpusCoversEveryKindAndEveryFileIsListed)
         EXPECT_TRUE(fs::is_regular_file(c.path())) << c.file;
         EXPECT_FALSE(c.expect.empty()) << c.file;
     }
-    for (const char* kind : {"session", "lobes", "stroke", "settings", "species", "recording", "mesh"})
+    for (const char* kind : {"session", "lobes", "stroke", "settings", "species", "recording", "mesh", "model"})
         EXPECT_GE(count[kind], 5) << kind;
     // Every file of the kind folders has its case (a file without one would never be read).
     for (const auto& [kind, n] : count)
@@ -259,6 +260,14 @@ TEST(DegenerateInput, MeshesAreRefusedInOneLine)
     for (const Case& c : cases_of("mesh")) {
         SCOPED_TRACE(c.file + " (" + c.note + ")");
         expect_refused(c, [](const std::string& p) { read_mesh(p); });
+    }
+}
+
+TEST(DegenerateInput, MeshesThatReadButCannotBecomeALobeAreRefusedInOneLine)
+{
+    for (const Case& c : cases_of("model")) {
+        SCOPED_TRACE(c.file + " (" + c.note + ")");
+        expect_refused(c, [](const std::string& p) { lobe_from_model(p); });
     }
 }
 

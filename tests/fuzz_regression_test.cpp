@@ -21,6 +21,7 @@
 #include "input/recording.h"
 #include "input/synth.h"
 #include "meshing/mesh_io.h"
+#include "meshing/model_import.h"
 #include "tests/test_paths.h"
 
 using namespace lobe;
@@ -42,6 +43,11 @@ const std::map<std::string, std::function<void(const std::string&)>>& readers()
         {"mesh_obj", [](const std::string& p) { read_mesh(p); }},
         {"mesh_ply", [](const std::string& p) { read_mesh(p); }},
         {"mesh_off", [](const std::string& p) { read_mesh(p); }},
+        {"mesh_repair", [](const std::string& p) {
+             LobeFromModelOptions o;
+             o.target_edge_length_m = 0.15; // as the fuzz target
+             lobe_from_model(p, o);
+         }},
         {"desktop_script", [](const std::string& p) { parse_desktop_script(read_file_limited(p, 16u << 20), p); }},
         {"scenario", [](const std::string& p) { load_scenario(p); }},
     };

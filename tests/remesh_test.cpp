@@ -415,6 +415,26 @@ TEST(Remesh, RelaxedStrokeVerticesStayOnTheirStrokeAndEveryVertexLiesOnTheInputS
     EXPECT_FALSE(self_intersects(out));
 }
 
+TEST(Remesh, OurRoundsRemeshASmallRepairedModelThatCGALsRelaxationCannot)
+{
+    // fuzz/mesh_repair_fuzz.cpp found this OBJ: repaired, it is a closed 6-vertex solid with
+    // a thin wedge; remeshing it at 15 cm on a 1.5 m box leaves a vertex whose faces are all
+    // exactly degenerate, where CGAL 5.5's own tangential relaxation reads an edge property at
+    // index −1. Our rounds (as every stroke lobe is remeshed) give a closed, outward lobe.
+    const TriangleMesh raw = parse_mesh("v 0 0 0\nv 0 0 1\nv 1 1 0\nv 0 1 1\nv 1 0 0\nv 1 0 1\nv 1 1 0\nv 0 0 1\nv 1 1 0\n"
+                                        "f 5 8 7\nf 1 6 5\nf 3 8 4\nf 3 7 8\nf 1 5 7\nf 2 8 6\nf 2 4 8\n",
+                                        "fuzz-finding.obj");
+    const TriangleMesh repaired = repair_mesh(raw);
+    RemeshOptions o;
+    o.target_edge_length_m = 0.15;
+    o.own_rounds = true;
+    const TriangleMesh lobe = remesh_isotropic(normalize_to_box(repaired, 1.5), o);
+    const MeshQuality q = measure_quality(lobe);
+    EXPECT_TRUE(q.closed && q.manifold && q.outward);
+    EXPECT_GT(q.signed_volume_m3, 0.01);
+    EXPECT_GT(lobe.triangles.size(), 100u);
+}
+
 TEST(Remesh, FeatureEdgesCanBeIgnored)
 {
     std::vector<int> equator;

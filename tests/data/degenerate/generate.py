@@ -442,6 +442,28 @@ case(M, "truncated.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 3
                           "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n\x00\x00",
      "element 'vertex' declares 3 entries, more than the file's 2 bytes of data can hold", "a binary PLY cut inside its vertices")
 
+# ---------------------------------------------------------------- meshes made into lobes
+# Read fine, but nothing closed can be made of them (`lobesketch lobes MESH`, lobe_from_model).
+O = "model"
+
+
+def obj(vs, fs):
+    return "".join("v %g %g %g\n" % v for v in vs) + "".join("f %d %d %d\n" % tuple(i + 1 for i in f) for f in fs)
+
+
+grid_v = [(i, j, 0) for j in range(5) for i in range(5)]
+grid_f = [t for j in range(4) for i in range(4) for t in ((5 * j + i, 5 * j + i + 1, 5 * j + i + 6), (5 * j + i, 5 * j + i + 6, 5 * j + i + 5))]
+case(O, "flat-triangle.obj", obj([(0, 0, 0), (1, 0, 0), (0, 1, 0)], [(0, 1, 2)]), "encloses no volume", "a single triangle")
+case(O, "flat-grid.obj", obj(grid_v, grid_f), "encloses no volume", "a flat 4 × 4 grid: its border can only be capped by a copy of it")
+case(O, "collinear-corners.obj", obj([(0, 0, 0), (1, 0, 0), (2, 0, 0), (3, 0, 0)], [(0, 1, 2), (1, 3, 2)]),
+     "the mesh has no area", "triangles whose corners lie on one line")
+case(O, "repeated-vertices-only.obj", obj([(0, 0, 0), (1, 0, 0), (0, 1, 0)], [(0, 0, 1), (1, 2, 2)]),
+     "no valid triangle left", "every triangle names a vertex twice")
+case(O, "sliver-after-repair.obj",
+     obj([(0, 0, 0), (0, 0, 1), (0, 1, 0), (0, 1, 1), (1, 0, 0), (1, 0, 1), (1, 1, 1), (1, 0, 0)],
+         [(2, 7, 3), (2, 6, 7), (0, 6, 2), (0, 5, 4)]),
+     "encloses no volume", "four faces whose repair leaves a closed sliver of no volume (found by fuzz/mesh_repair_fuzz.cpp)")
+
 # A file left from a removed case would never be read: remove it.
 listed = {c["file"] for c in cases}
 for kind in sorted({c["kind"] for c in cases}):
