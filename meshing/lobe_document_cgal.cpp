@@ -20,6 +20,7 @@
 #include "meshing/lobe_transform.h"
 #include "meshing/mesh_quality.h"
 #include "meshing/remesh.h"
+#include "meshing/repair.h"
 
 namespace lobe {
 
@@ -137,6 +138,7 @@ BuiltLobe model_document_lobe(const LobeRecord& rec, const RemeshOptions& remesh
     const MeshQuality q = measure_quality(built.surface.mesh);
     if (!q.closed || !q.manifold || !q.outward)
         throw InvalidInput("its mesh is not a closed, outward-oriented 2-manifold");
+    check_encloses_volume(built.surface.mesh, q, "its mesh"); // a sliver passes "volume > 0" by rounding
     const double edge = mean_edge_length(built.surface.mesh);
     const double target = remesh.target_edge_length_m;
     if (remesh.iterations > 0 && (edge < 0.75 * target || edge > 1.25 * target)) {

@@ -169,6 +169,23 @@ TEST(ModelLobe, AStoredMeshThatIsNotClosedIsLeftOutWithAWarning)
     EXPECT_EQ(warnings[0], "lobe 1: its mesh is not a closed, outward-oriented 2-manifold; the lobe is left out");
 }
 
+TEST(ModelLobe, AStoredMeshOfNoVolumeIsLeftOutWithAWarning)
+{
+    // A tetrahedron a nanometre high: closed, 2-manifold and of positive volume, but flat.
+    Document d = imported().document();
+    LobeModel flat = *d.lobes[0].model;
+    flat.mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1e-9f}};
+    flat.mesh.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+    flat.mesh.feature_edges.clear();
+    ASSERT_TRUE(measure_quality(flat.mesh).outward);
+    d.lobes[0].model = std::make_shared<const LobeModel>(flat);
+    std::vector<std::string> warnings;
+    EXPECT_TRUE(build_document_lobes(d, &warnings).empty());
+    ASSERT_EQ(warnings.size(), 1u);
+    EXPECT_EQ(warnings[0].rfind("lobe 1: its mesh encloses no volume", 0), 0u) << warnings[0];
+    EXPECT_EQ(warnings[0].find('\n'), std::string::npos);
+}
+
 TEST(ModelLobe, AStrokeDrawnIntoAMeshLobeStartsALobeOfItsOwn)
 {
     SessionBuilder b = imported();
