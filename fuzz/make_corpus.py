@@ -278,18 +278,49 @@ def repair_seeds():
     put("mesh_repair", "collinear.obj", obj([(0, 0, 0), (1, 0, 0), (2, 0, 0)], [(0, 1, 2)]))
 
 
+def lobe_strokes_seeds():
+    """Byte strings for lobe_strokes (fuzz/lobe_strokes_fuzz.cpp reads them a byte at a time):
+    a stroke count, then per stroke its kind (bit 0 arc, bit 1 reversed, bit 2 shifted, bits
+    3-6 a special case: 0 folded back, 1 one point, 2 one line, 3 a stroke again, 4 a NaN,
+    5 an enormous coordinate, 6 too few points, others none), tilt, turn, size, height, point
+    count, [sweep], wobble, frequency, [shift x y z], [the special case's byte]."""
+    plain = 7 << 3  # no special case
+
+    def stroke(kind, tilt, turn, size, height, n, wobble=40, freq=5, sweep=None, shift=None, extra=None):
+        b = [kind, tilt, turn, size, height, n]
+        if kind & 1:
+            b.append(sweep if sweep is not None else 120)
+        b += [wobble, freq]
+        if kind & 4:
+            b += shift or [128, 128, 128]
+        if extra is not None:
+            b.append(extra)
+        return b
+
+    loops = [stroke(plain, t, u, 150, 128, 120) for t, u in [(0, 0), (128, 0), (128, 64), (64, 200)]]
+    put("lobe_strokes", "four-loops", bytes([4] + sum(loops, [])))
+    rings = [stroke(plain, 0, 0, 150, h, 140) for h in (60, 100, 160, 200)] + [stroke(plain | 2, 128, 32, 150, 128, 140)]
+    put("lobe_strokes", "stacked-rings-and-a-loop-drawn-backwards", bytes([5] + sum(rings, [])))
+    arcs = loops[:2] + [stroke(plain | 1, 64, 10, 150, 180, 60, sweep=110)]
+    put("lobe_strokes", "two-loops-and-an-arc", bytes([3] + sum(arcs, [])))
+    odd = loops[:2] + [stroke(3 << 3, 0, 0, 0, 0, 0, extra=1), stroke(plain | 4, 90, 90, 60, 128, 80, shift=[255, 0, 255]),
+                       stroke(0 << 3, 30, 30, 150, 128, 50), stroke(4 << 3, 128, 128, 150, 128, 100, extra=7)]
+    put("lobe_strokes", "a-loop-again-a-far-one-a-fold-and-a-nan", bytes([6] + sum(odd, [])))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--lobesketch", help="a built lobesketch, to remake the text-recording and session seeds")
     a = ap.parse_args()
     for t in ["import_leap", "import_webxr", "recording_binary", "mesh_obj", "mesh_ply", "mesh_off", "mesh_repair",
-              "species", "desktop_script", "scenario"]:
+              "lobe_strokes", "species", "desktop_script", "scenario"]:
         shutil.rmtree(OUT / t, ignore_errors=True)
     leap_seeds()
     webxr_seeds()
     recording_binary_seeds()
     mesh_seeds()
     repair_seeds()
+    lobe_strokes_seeds()
     species_seeds()
     desktop_script_seeds()
     scenario_seeds()

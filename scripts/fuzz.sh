@@ -24,10 +24,10 @@ declare -A MAX_LEN=(
   [recording_binary]=16384 [recording_text]=16384
   [import_leap]=16384 [import_webxr]=16384
   [document]=16384 [settings]=8192 [species]=4096
-  [mesh_obj]=8192 [mesh_ply]=8192 [mesh_off]=8192 [mesh_repair]=4096
+  [mesh_obj]=8192 [mesh_ply]=8192 [mesh_off]=8192 [mesh_repair]=4096 [lobe_strokes]=128
   [desktop_script]=4096 [scenario]=8192
 )
-ALL=(recording_binary recording_text import_leap import_webxr document settings species mesh_obj mesh_ply mesh_off mesh_repair desktop_script scenario)
+ALL=(recording_binary recording_text import_leap import_webxr document settings species mesh_obj mesh_ply mesh_off mesh_repair lobe_strokes desktop_script scenario)
 TARGETS=("$@")
 [ ${#TARGETS[@]} -eq 0 ] && TARGETS=("${ALL[@]}")
 
