@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -2106,11 +2107,47 @@ glm::dvec3 lobe_stroke_centroid(const std::vector<LobeStrokeSamples>& strokes)
     return n ? mean / static_cast<double>(n) : mean;
 }
 
+namespace {
+
+/// Whether a surface has no hole. Every triangle of a build faces away from the centre, but
+/// strokes that run over themselves (a loop whose ends met after it folded back, so that it
+/// encloses nothing) give the triangulation regions without area, and the surface an open
+/// border there. Each edge a → b adds ±hash(min, max) (+ when a < b), so a closed surface,
+/// where every edge is run once each way, sums to zero; an open border edge leaves its hash
+/// (a sum of such hashes is zero with a chance of 2⁻⁶⁴). One pass over the triangles, far
+/// cheaper than matching the edges up.
+bool closed_surface(const TriangleMesh& mesh)
+{
+    std::uint64_t sum = 0;
+    for (const auto& t : mesh.triangles)
+        for (std::size_t k = 0; k < 3; ++k) {
+            const auto a = static_cast<std::uint32_t>(t[k]), b = static_cast<std::uint32_t>(t[(k + 1) % 3]);
+            // A 64-bit mix of the undirected edge (two multiplications: nonlinear enough that
+            // the hashes of an open border do not cancel but by chance), negated when a > b.
+            std::uint64_t h = (std::uint64_t{std::min(a, b)} << 32 | std::max(a, b)) * 0x9E3779B97F4A7C15ull;
+            h = (h ^ (h >> 29)) * 0xBF58476D1CE4E5B9ull;
+            h ^= h >> 32;
+            const std::uint64_t negate = std::uint64_t{0} - static_cast<std::uint64_t>(a > b);
+            sum += (h ^ negate) - negate;
+        }
+    return sum == 0 && !mesh.triangles.empty();
+}
+
+void require_closed(const TriangleMesh& mesh)
+{
+    if (!closed_surface(mesh))
+        throw InvalidInput("the lobe's strokes leave its surface open (a stroke folds back or runs over itself)");
+}
+
+} // namespace
+
 LobeSurface build_lobe_surface(const std::vector<LobeStrokeSamples>& strokes, const glm::dvec3& centre,
                                const LobeSurfaceOptions& options)
 {
     Builder b(strokes, centre, options);
-    return b.run();
+    LobeSurface surface = b.run();
+    require_closed(surface.mesh);
+    return surface;
 }
 
 LobeSurface continue_lobe_surface(const LobeSurface& previous, const SurfaceRegions& previous_regions,
@@ -2127,9 +2164,13 @@ LobeSurface continue_lobe_surface(const LobeSurface& previous, const SurfaceRegi
             regions = std::move(built);
             kept = keep_unchanged_regions(previous, previous_regions, surface, regions, true);
             kept.followed_previous_build = b.followed_previous();
+            require_closed(surface.mesh);
             return surface;
         }
-        if (complete_with_kept_regions(previous, previous_regions, b.kept_previous_regions(), surface, built, kept, true)) {
+        // An open result of the changed regions falls back to the whole build, which refuses it
+        // if it is open too.
+        if (complete_with_kept_regions(previous, previous_regions, b.kept_previous_regions(), surface, built, kept, true) &&
+            closed_surface(surface.mesh)) {
             regions = std::move(built);
             kept.built_changed_only = true;
             kept.followed_previous_build = b.followed_previous();
@@ -2142,6 +2183,7 @@ LobeSurface continue_lobe_surface(const LobeSurface& previous, const SurfaceRegi
     LobeSurface surface = b.run(&regions);
     kept = keep_unchanged_regions(previous, previous_regions, surface, regions, true);
     kept.followed_previous_build = b.followed_previous();
+    require_closed(surface.mesh);
     return surface;
 }
 

@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
+#include <fstream>
 #include <map>
 #include <set>
 #include <string>
@@ -593,6 +595,50 @@ TEST(Lobes, BadStrokesAreRefusedWithOneLineAndTheLobeUnchanged)
     std::vector<glm::vec3> through;
     for (int i = 0; i < 60; ++i) through.emplace_back(c + glm::dvec3(-0.15 + 0.005 * i, 0.002 * std::sin(i * 0.3), 0.001 * (i - 30)));
     expect_refused(through, "through the centre");
+}
+
+TEST(Lobes, AnArcDrawnBackToItsStartIsRefusedRatherThanLeavingTheSurfaceOpen)
+{
+    // Two rings, then a 2 cm arc and back along it until its ends met: judged closed, a loop
+    // that encloses nothing, whose region of the triangulation has no area. The surface had an
+    // open border there (fuzz/lobe_strokes_fuzz.cpp found it); now the stroke is refused and
+    // the lobe stays as it was, and the whole build of the three strokes is refused too.
+    std::ifstream in(test::source_path("tests/data/lobe-strokes/arc-and-back-to-its-start.txt"));
+    ASSERT_TRUE(in.good());
+    std::vector<std::vector<glm::vec3>> strokes;
+    for (std::string line; std::getline(in, line);) {
+        if (line.empty() || line[0] == '#') continue;
+        std::istringstream words(line);
+        int id = 0;
+        words >> id;
+        std::vector<glm::vec3> raw;
+        for (float x, y, z; words >> x >> y >> z;) raw.emplace_back(x, y, z);
+        strokes.push_back(raw);
+    }
+    ASSERT_EQ(strokes.size(), 3u);
+    Lobe lobe;
+    lobe.add_stroke(1, strokes[0]);
+    lobe.add_stroke(2, strokes[1]);
+    const TriangleMesh before = lobe.surface().mesh;
+    try {
+        lobe.add_stroke(3, strokes[2]);
+        ADD_FAILURE() << "accepted";
+    } catch (const InvalidInput& e) {
+        // Built from the changed regions the surface is open, and the whole build that follows
+        // finds the stroke folding over itself.
+        EXPECT_NE(std::string(e.what()).find("lobe stroke 3 folds back over itself"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(lobe.strokes().size(), 2u);
+    EXPECT_EQ(lobe.surface().mesh.positions, before.positions);
+    EXPECT_EQ(lobe.surface().mesh.triangles, before.triangles);
+    std::vector<LobeStrokeSamples> all = lobe.strokes();
+    all.push_back(prepare_lobe_stroke(3, strokes[2]));
+    try {
+        build_lobe_surface(all, lobe.centre());
+        ADD_FAILURE() << "the whole build accepted it";
+    } catch (const InvalidInput& e) {
+        EXPECT_NE(std::string(e.what()).find("leave its surface open"), std::string::npos) << e.what();
+    }
 }
 
 TEST(Lobes, StrokesFarFromEveryLobeAndTheNewLobeKeyStartNewLobes)
