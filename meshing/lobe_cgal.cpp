@@ -97,6 +97,21 @@ LobeStrokeSamples prepare_lobe_stroke(std::int64_t id, const std::vector<glm::ve
             }
             retraced = best <= options.duplicate_distance_m;
         }
+        // A closed stroke that encloses (almost) nothing: its ends met after it went out and came
+        // back along itself, which the halves above miss when the turn falls between them. Its
+        // vector area is under a thousandth of its length squared (a real loop's is about
+        // 0.08; a loop 30 cm long would have to be under about 1 mm wide).
+        if (!retraced && out.closed) {
+            glm::dvec3 area(0.0);
+            double length = 0.0;
+            for (std::size_t i = 0; i < q.size(); ++i) {
+                const glm::dvec3& a = q[i];
+                const glm::dvec3& b = q[(i + 1) % q.size()];
+                area += 0.5 * glm::cross(a - q[0], b - q[0]);
+                length += glm::distance(a, b);
+            }
+            retraced = !(glm::length(area) >= 1e-3 * length * length);
+        }
         if (retraced) throw InvalidInput(who + " retraces itself (the same loop twice, or a path and back along it)");
     }
     // A stroke that reverses (turns by more than 160° from one Eq. 1 sample to the next)
