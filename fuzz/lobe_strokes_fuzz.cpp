@@ -1,6 +1,6 @@
 // libFuzzer target: lobes drawn stroke by stroke (meshing/lobe.h), the heart of the sketching.
 // The input bytes describe up to six strokes round one lobe: loops and arcs of any tilt, size,
-// height, wobble, direction and point count, a few of them far away, doubled, folded back,
+// height, wobble, direction and point count, some up to 30 cm off, doubled, folded back,
 // collapsed to a point or a line, or carrying a NaN or an enormous coordinate. Each is added
 // with Lobe::add_stroke, as a drawing session adds it. Promises checked (docs/lobes.md):
 // - a refused stroke gives one line (InvalidInput) and leaves the lobe exactly as it was;
@@ -53,7 +53,10 @@ std::vector<glm::vec3> make_stroke(Bytes& in, const std::vector<std::vector<glm:
     glm::dvec3 u = glm::cross(axis, glm::dvec3(0.3, 0.1, 0.9));
     u = glm::length(u) > 1e-9 ? glm::normalize(u) : glm::dvec3(1, 0, 0);
     const glm::dvec3 v = glm::cross(axis, u);
-    const glm::dvec3 shift = (kind & 4) ? glm::dvec3(in.unit() - 0.5, in.unit() - 0.5, in.unit() - 0.5) * 2.0 : glm::dvec3(0.0);
+    // Up to 30 cm off: a stroke farther from every lobe starts a lobe of its own (the session
+    // builder's choice, not the lobe's), and a lobe a metre or two across fills up to the cap
+    // of 20,000 interpolated vertices, seconds a build under ASan.
+    const glm::dvec3 shift = (kind & 4) ? glm::dvec3(in.unit() - 0.5, in.unit() - 0.5, in.unit() - 0.5) * 0.6 : glm::dvec3(0.0);
     const double rr = std::sqrt(std::max(0.0, r * r - h * h));
     std::vector<glm::vec3> raw;
     for (int i = 0; i < n; ++i) {

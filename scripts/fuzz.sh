@@ -3,8 +3,8 @@
 # the other, from the committed seeds (fuzz/corpus/<target>) into a scratch corpus that is
 # kept between runs (build/fuzz/<target>/corpus). Prints each target's statistics and exits
 # non-zero when any target found something: a crash, a sanitizer report, an uncaught
-# exception, a multi-line error, a timeout (10 s; LOBE_FUZZ_TIMEOUT=S sets another, for runs on
-# a loaded machine) or more than 2 GiB of memory. The inputs
+# exception, a multi-line error, a timeout (10 s, lobe_strokes 30 s; LOBE_FUZZ_TIMEOUT=S sets
+# another, for runs on a loaded machine) or more than 2 GiB of memory. The inputs
 # that did it are in build/fuzz/<target>/artifacts/.
 #
 #   scripts/fuzz.sh [SECONDS] [TARGET...]     targets: the names below, e.g. mesh_ply
@@ -27,6 +27,10 @@ declare -A MAX_LEN=(
   [mesh_obj]=8192 [mesh_ply]=8192 [mesh_off]=8192 [mesh_repair]=4096 [lobe_strokes]=128
   [desktop_script]=4096 [scenario]=8192
 )
+# target → seconds one input may take (LOBE_FUZZ_TIMEOUT sets every target's): a lobe of six
+# strokes, each built twice (continued and whole) and checked for self-intersections, takes
+# a few seconds under ASan.
+declare -A TIMEOUT=([lobe_strokes]=30)
 ALL=(recording_binary recording_text import_leap import_webxr document settings species mesh_obj mesh_ply mesh_off mesh_repair lobe_strokes desktop_script scenario)
 TARGETS=("$@")
 [ ${#TARGETS[@]} -eq 0 ] && TARGETS=("${ALL[@]}")
@@ -50,7 +54,7 @@ for t in "${TARGETS[@]}"; do
   mkdir -p "$work/corpus" "$work/artifacts"
   log="$work/last-run.log"
   rc=0
-  "$bin" -max_total_time="$DURATION" -max_len="${MAX_LEN[$t]}" -timeout="${LOBE_FUZZ_TIMEOUT:-10}" -rss_limit_mb=2048 \
+  "$bin" -max_total_time="$DURATION" -max_len="${MAX_LEN[$t]}" -timeout="${LOBE_FUZZ_TIMEOUT:-${TIMEOUT[$t]:-10}}" -rss_limit_mb=2048 \
     -malloc_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$work/artifacts/" \
     "$work/corpus" "fuzz/corpus/$t" >"$log" 2>&1 || rc=$?
   stat_of() { sed -n "s/^stat::$1: *//p" "$log" | tail -1; }
