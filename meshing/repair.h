@@ -22,6 +22,8 @@ struct RepairReport {
     std::size_t split_non_manifold_vertices = 0; ///< vertex copies made to split non-manifold vertices
     std::size_t holes_filled = 0;
     std::size_t holes_faired = 0;            ///< of those, filled with a smooth (faired) patch
+    std::size_t holes_not_faired = 0;        ///< of those, filled again without fairing: the faired
+                                             ///< patch crossed itself or the surface
     std::size_t components = 0;              ///< connected components before keeping the largest
     std::size_t removed_component_triangles = 0; ///< triangles of the smaller components, dropped
     bool self_intersections_left = false;    ///< the input self-intersected and not all could be removed
@@ -40,7 +42,8 @@ struct RepairReport {
 ///    hair apart (1% towards their own fan) so the surface does not touch itself there;
 /// 3. keeps the largest connected component (by triangle count), noting the others;
 /// 4. fills every hole (triangulate_refine_and_fair_hole; plain triangulate_hole when
-///    that gives nothing);
+///    that gives nothing); a faired patch that intersects itself or the surface (a long,
+///    wavy border) is replaced by the refined patch without fairing;
 /// 5. removes self-intersections where it can (CGAL's experimental
 ///    remove_self_intersections, preserve_genus(false)); what is left is reported in
 ///    RepairReport::self_intersections_left, not thrown;
@@ -68,5 +71,10 @@ bool remove_self_intersections(TriangleMesh& mesh);
 /// \pre mesh is 2-manifold (it is converted to a halfedge mesh).
 /// \throw InvalidInput when it is not.
 bool self_intersects(const TriangleMesh& mesh);
+
+/// Indices (into mesh.triangles, ascending, each once) of the triangles that intersect a
+/// non-adjacent triangle of `mesh` (CGAL::Polygon_mesh_processing::self_intersections).
+/// \pre mesh is 2-manifold. \throw InvalidInput when it is not.
+std::vector<std::size_t> self_intersecting_triangles(const TriangleMesh& mesh);
 
 } // namespace lobe

@@ -12,6 +12,7 @@
 #include <map>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #pragma GCC diagnostic push
@@ -140,27 +141,81 @@ void keep_largest_component(Mesh& mesh, RepairReport& r)
                       std::to_string(faces_before - mesh.number_of_faces()) + " triangles)");
 }
 
+/// Fills the holes whose boundary cycles start at `borders`, each with a refined, faired
+/// patch unless `unfaired` flags it (a refined patch then, not faired), or a plain
+/// minimal-area one when that gives nothing; `patch` receives, per face, 1 + the index of
+/// the hole it fills (0: not a patch face). Returns how many were filled and faired.
+std::pair<std::size_t, std::size_t> fill_holes_once(Mesh& mesh, const std::vector<Mesh::Halfedge_index>& borders,
+                                                    const std::vector<char>& unfaired,
+                                                    Mesh::Property_map<Mesh::Face_index, std::size_t> patch)
+{
+    std::size_t filled = 0, faired = 0;
+    for (std::size_t i = 0; i < borders.size(); ++i) {
+        const Mesh::Halfedge_index h = borders[i];
+        std::vector<Mesh::Face_index> new_faces;
+        std::vector<VertexIndex> new_vertices;
+        if (unfaired[i]) {
+            PMP::triangulate_and_refine_hole(mesh, h, std::back_inserter(new_faces), std::back_inserter(new_vertices));
+        } else if (std::get<0>(PMP::triangulate_refine_and_fair_hole(mesh, h, std::back_inserter(new_faces),
+                                                                      std::back_inserter(new_vertices)))) {
+            ++faired;
+        }
+        if (new_faces.empty()) PMP::triangulate_hole(mesh, h, std::back_inserter(new_faces));
+        if (!new_faces.empty()) ++filled;
+        for (Mesh::Face_index f : new_faces) patch[f] = i + 1;
+    }
+    return {filled, faired};
+}
+
 /// Fills every hole with a refined, faired patch (a plain minimal-area one when that fails).
+/// Fairing keeps the patch's interior smooth but not out of the surface's way: over a long,
+/// wavy border (the open base of a scan, say) the faired patch can fold through itself or
+/// the surface. Those holes are filled again with the refined patch alone, which lies on the
+/// border's triangulation. Left to remove_self_intersections, such a fold cost a minute on a
+/// 1,000-edge border and took most of the mesh with it.
 /// \throw InvalidInput when a hole stays open.
 void fill_holes(Mesh& mesh, RepairReport& r)
 {
     std::vector<Mesh::Halfedge_index> borders;
     PMP::extract_boundary_cycles(mesh, std::back_inserter(borders));
     if (borders.empty()) return;
-    std::size_t filled = 0, faired = 0;
-    for (Mesh::Halfedge_index h : borders) {
-        std::vector<Mesh::Face_index> new_faces;
-        std::vector<VertexIndex> new_vertices;
-        const auto result =
-            PMP::triangulate_refine_and_fair_hole(mesh, h, std::back_inserter(new_faces), std::back_inserter(new_vertices));
-        if (new_faces.empty()) PMP::triangulate_hole(mesh, h, std::back_inserter(new_faces));
-        else if (std::get<0>(result)) ++faired;
-        if (!new_faces.empty()) ++filled;
+    const Mesh before = mesh; // halfedge indices (the borders) stay valid in the copy
+    auto patch = mesh.add_property_map<Mesh::Face_index, std::size_t>("f:lobe_patch", 0).first;
+    std::vector<char> unfaired(borders.size(), 0);
+    auto [filled, faired] = fill_holes_once(mesh, borders, unfaired, patch);
+    std::size_t refilled = 0;
+    if (faired > 0 && CGAL::is_closed(mesh)) {
+        // Which faired patches take part in a self-intersection (patch and surface are
+        // listed in the order to_triangle_mesh writes the faces).
+        const TriangleMesh tm = to_triangle_mesh(mesh);
+        std::vector<std::size_t> patch_of;
+        patch_of.reserve(mesh.number_of_faces());
+        for (auto f : mesh.faces()) patch_of.push_back(patch[f]);
+        std::vector<std::size_t> crossing;
+        try {
+            crossing = self_intersecting_triangles(tm);
+        } catch (const InvalidInput&) {
+            crossing.clear(); // not 2-manifold as a soup: judged below, as before
+        }
+        for (std::size_t t : crossing)
+            if (t < patch_of.size() && patch_of[t] > 0 && !unfaired[patch_of[t] - 1]) {
+                unfaired[patch_of[t] - 1] = 1;
+                ++refilled;
+            }
+        if (refilled > 0) {
+            mesh = before;
+            patch = mesh.add_property_map<Mesh::Face_index, std::size_t>("f:lobe_patch", 0).first;
+            std::tie(filled, faired) = fill_holes_once(mesh, borders, unfaired, patch);
+        }
     }
+    mesh.remove_property_map(patch);
     r.holes_filled += filled;
     r.holes_faired += faired;
+    r.holes_not_faired += refilled;
     r.notes.push_back("filled " + std::to_string(filled) + " of " + std::to_string(borders.size()) + " holes (" +
-                      std::to_string(faired) + " faired)");
+                      std::to_string(faired) + " faired" +
+                      (refilled ? ", " + std::to_string(refilled) + " not faired: a faired patch crossed the surface" : "") +
+                      ")");
     if (!CGAL::is_closed(mesh))
         throw InvalidInput("repair_mesh: a hole could not be filled (" + std::to_string(borders.size() - filled) +
                            " of " + std::to_string(borders.size()) + " left open)");

@@ -3,7 +3,10 @@
 // compile as the rest of the repair code.
 #include "meshing/repair.h"
 
+#include <algorithm>
 #include <array>
+#include <iterator>
+#include <utility>
 #include <cmath>
 #include <cstddef>
 #include <string>
@@ -66,6 +69,23 @@ Mesh to_surface_mesh(const TriangleMesh& in, const char* who)
 bool self_intersects(const TriangleMesh& in)
 {
     return PMP::does_self_intersect(to_surface_mesh(in, "self_intersects"));
+}
+
+std::vector<std::size_t> self_intersecting_triangles(const TriangleMesh& in)
+{
+    const Mesh sm = to_surface_mesh(in, "self_intersecting_triangles");
+    std::vector<std::pair<Mesh::Face_index, Mesh::Face_index>> pairs;
+    PMP::self_intersections(faces(sm), sm, std::back_inserter(pairs));
+    // A mesh built from a soup numbers its faces as the soup's triangles.
+    std::vector<std::size_t> out;
+    out.reserve(2 * pairs.size());
+    for (const auto& [f, g] : pairs) {
+        out.push_back(static_cast<std::size_t>(f.idx()));
+        out.push_back(static_cast<std::size_t>(g.idx()));
+    }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
 }
 
 bool remove_self_intersections(TriangleMesh& mesh)

@@ -274,6 +274,70 @@ TEST(Repair, FillsHolesAndKeepsTheLargestComponent)
     EXPECT_TRUE(noted);
 }
 
+/// A dome (a unit sphere above latitude −40°) whose open base runs up and down by ±15° of
+/// latitude in `waves` waves over `segments` edges, as the cut-off base of a scan can.
+TriangleMesh dome_with_wavy_base(int segments, int waves)
+{
+    TriangleMesh m;
+    constexpr int kRings = 6;
+    for (int r = 0; r < kRings; ++r)
+        for (int i = 0; i < segments; ++i) {
+            const double lon = 2.0 * kPi * i / segments;
+            const double lat = (-40.0 + 130.0 * r / kRings + (r == 0 ? 15.0 * std::sin(waves * lon) : 0.0)) * kPi / 180.0;
+            m.positions.emplace_back(std::cos(lat) * std::cos(lon), std::sin(lat), std::cos(lat) * std::sin(lon));
+        }
+    m.positions.emplace_back(0.0f, 1.0f, 0.0f);
+    for (int r = 0; r + 1 < kRings; ++r)
+        for (int i = 0; i < segments; ++i) {
+            const int a = r * segments + i, b = r * segments + (i + 1) % segments;
+            const int c = (r + 1) * segments + (i + 1) % segments, d = (r + 1) * segments + i;
+            m.triangles.push_back({a, c, b});
+            m.triangles.push_back({a, d, c});
+        }
+    const int pole = kRings * segments;
+    for (int i = 0; i < segments; ++i)
+        m.triangles.push_back({(kRings - 1) * segments + i, pole, (kRings - 1) * segments + (i + 1) % segments});
+    return m;
+}
+
+TEST(Repair, AFairedPatchThatCrossesTheSurfaceIsReplacedByAnUnfairedOneAndTheMeshKept)
+{
+    // Fairing the patch over this 1,000-edge border folds it through itself; CGAL's
+    // self-intersection removal then took most of a minute (1,000 edges) and cut away much
+    // of the dome.
+    const TriangleMesh dome = dome_with_wavy_base(1000, 40);
+    ASSERT_FALSE(self_intersects(dome));
+    RepairReport r;
+    const TriangleMesh out = repair_mesh(dome, &r);
+    EXPECT_EQ(r.holes_filled, 1u);
+    EXPECT_EQ(r.holes_not_faired, 1u);
+    EXPECT_FALSE(r.self_intersections_left);
+    EXPECT_FALSE(self_intersects(out));
+    const MeshQuality q = measure_quality(out);
+    EXPECT_TRUE(q.closed && q.manifold && q.outward);
+    // Every triangle of the dome is still there, at the same place.
+    std::set<std::array<float, 9>> corners;
+    for (const auto& t : out.triangles)
+        for (int k = 0; k < 3; ++k) {
+            const glm::vec3 &a = out.positions[static_cast<std::size_t>(t[static_cast<std::size_t>(k)])],
+                            &b = out.positions[static_cast<std::size_t>(t[static_cast<std::size_t>((k + 1) % 3)])],
+                            &c = out.positions[static_cast<std::size_t>(t[static_cast<std::size_t>((k + 2) % 3)])];
+            corners.insert({a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z});
+        }
+    std::size_t found = 0;
+    for (const auto& t : dome.triangles) {
+        const glm::vec3 &a = dome.positions[static_cast<std::size_t>(t[0])], &b = dome.positions[static_cast<std::size_t>(t[1])],
+                        &c = dome.positions[static_cast<std::size_t>(t[2])];
+        // The repaired mesh may run the other way round (flipped outward).
+        found += corners.count({a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z}) +
+                 corners.count({a.x, a.y, a.z, c.x, c.y, c.z, b.x, b.y, b.z});
+    }
+    EXPECT_EQ(found, dome.triangles.size());
+    bool noted = false;
+    for (const auto& n : r.notes) noted = noted || n.find("1 not faired") != std::string::npos;
+    EXPECT_TRUE(noted);
+}
+
 TEST(Repair, SplitsTheCowsNonManifoldVertex)
 {
     RepairReport r;
