@@ -1,7 +1,9 @@
 // The tree as a user gets it: `replay`, `grow` and `export` from recordings, sessions and the
 // reference meshes, the .glb checked by the Khronos validator, levels of detail within their
 // triangle budgets, and bad options refused with one line.
+#include <algorithm>
 #include <array>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -194,8 +196,24 @@ TEST_P(TreeInModel, ReferenceMeshGrowsOneConnectedTreeFillingIt)
     }
     EXPECT_NEAR(g.nodes[0].position.y, 0.0f, 1e-6f); // rooted at the ground below the model
     ASSERT_EQ(t.growth.lobes.size(), 1u);
-    RecordProperty("coverage", std::to_string(t.growth.lobes[0].coverage()));
-    EXPECT_GE(t.growth.lobes[0].coverage(), 0.9) << t.growth.lobes[0].reached << " of " << t.growth.lobes[0].attractors;
+    // The tree fills the model whatever the seed: the share of attractors reached varies by a
+    // few points from seed to seed (cow 0.90–0.94 over seeds 1–8), so it is judged over eight
+    // seeds, not by one that happens to pass.
+    std::vector<double> coverage{t.growth.lobes[0].coverage()};
+    for (std::uint64_t seed = 2; seed <= 8; ++seed) {
+        Document other = doc;
+        other.seed = seed;
+        const BuiltTree u = grow_document_tree(other, {lobe});
+        ASSERT_EQ(u.growth.lobes.size(), 1u);
+        coverage.push_back(u.growth.lobes[0].coverage());
+    }
+    std::string shares;
+    for (double c : coverage) shares += std::to_string(c).substr(0, 5) + " ";
+    RecordProperty("coverage", shares);
+    std::vector<double> sorted = coverage;
+    std::sort(sorted.begin(), sorted.end());
+    EXPECT_GE(0.5 * (sorted[3] + sorted[4]), 0.9) << "shares reached, seeds 1–8: " << shares;
+    EXPECT_GE(sorted.front(), 0.85) << "shares reached, seeds 1–8: " << shares;
     const MeshRaycaster ray(lobe.mesh);
     double out = 0.0, total = 0.0;
     for (const TreeNode& n : g.nodes) {
