@@ -47,6 +47,11 @@ void add_lobes_command(CLI::App& app, int& exit_code)
             options.iterations = static_cast<unsigned>(doc.settings.lobes.remesh_iterations);
             RepairReport report;
             const TriangleMesh mesh = lobe_from_model(a->input, options, &report);
+            if (!report.notes.empty()) {
+                std::string done;
+                for (const std::string& n : report.notes) done += (done.empty() ? "" : "; ") + n;
+                progress(a->input + ": repaired: " + done);
+            }
             std::filesystem::create_directories(a->out + "/lobes", ec);
             if (ec) throw FileError(a->out + "/lobes", "cannot create folder: " + ec.message());
             write_ply(a->out + "/lobes/lobe_1.ply", mesh);

@@ -4,6 +4,7 @@
 /// closed, 2-manifold, one component, oriented outward. CGAL works behind this plain
 /// interface (repair_cgal.cpp). See docs/lobes-from-models.md.
 
+#include <array>
 #include <cstddef>
 #include <string>
 #include <vector>
@@ -24,6 +25,8 @@ struct RepairReport {
     std::size_t holes_faired = 0;            ///< of those, filled with a smooth (faired) patch
     std::size_t holes_not_faired = 0;        ///< of those, filled again without fairing: the faired
                                              ///< patch crossed itself or the surface
+    std::size_t hole_patch_crossings = 0;    ///< pairs of triangles where a hole's patch (unfaired
+                                             ///< too) crosses itself or the surface: left as they are
     std::size_t components = 0;              ///< connected components before keeping the largest
     std::size_t removed_component_triangles = 0; ///< triangles of the smaller components, dropped
     bool self_intersections_left = false;    ///< the input self-intersected and not all could be removed
@@ -44,6 +47,9 @@ struct RepairReport {
 /// 4. fills every hole (triangulate_refine_and_fair_hole; plain triangulate_hole when
 ///    that gives nothing); a faired patch that intersects itself or the surface (a long,
 ///    wavy border) is replaced by the refined patch without fairing;
+///    where a patch still crosses itself or the surface and the rest of the mesh does not
+///    self-intersect, the crossings are left (RepairReport::hole_patch_crossings) rather
+///    than handed to step 5, which can take minutes on them and cut away much of the mesh;
 /// 5. removes self-intersections where it can (CGAL's experimental
 ///    remove_self_intersections, preserve_genus(false)); what is left is reported in
 ///    RepairReport::self_intersections_left, not thrown;
@@ -72,9 +78,9 @@ bool remove_self_intersections(TriangleMesh& mesh);
 /// \throw InvalidInput when it is not.
 bool self_intersects(const TriangleMesh& mesh);
 
-/// Indices (into mesh.triangles, ascending, each once) of the triangles that intersect a
-/// non-adjacent triangle of `mesh` (CGAL::Polygon_mesh_processing::self_intersections).
+/// The pairs of non-adjacent triangles of `mesh` that intersect, as indices into
+/// mesh.triangles (CGAL::Polygon_mesh_processing::self_intersections).
 /// \pre mesh is 2-manifold. \throw InvalidInput when it is not.
-std::vector<std::size_t> self_intersecting_triangles(const TriangleMesh& mesh);
+std::vector<std::array<std::size_t, 2>> self_intersecting_pairs(const TriangleMesh& mesh);
 
 } // namespace lobe

@@ -167,12 +167,40 @@ std::pair<std::size_t, std::size_t> fill_holes_once(Mesh& mesh, const std::vecto
     return {filled, faired};
 }
 
+/// Which hole's patch each face of `mesh` belongs to (1 + its index; 0: none), kept from
+/// fill_holes to the self-intersection step; in the order to_triangle_mesh writes the faces.
+Mesh::Property_map<Mesh::Face_index, std::size_t> patch_map(Mesh& mesh)
+{
+    return mesh.add_property_map<Mesh::Face_index, std::size_t>("f:lobe_patch", 0).first;
+}
+
+std::vector<std::size_t> patch_of_faces(Mesh& mesh)
+{
+    const auto patch = patch_map(mesh);
+    std::vector<std::size_t> out;
+    out.reserve(mesh.number_of_faces());
+    for (auto f : mesh.faces()) out.push_back(patch[f]);
+    return out;
+}
+
+/// The pairs of intersecting triangles of `tm`; none when it is not 2-manifold as a soup
+/// (the checks after repair judge that).
+std::vector<std::array<std::size_t, 2>> crossing_pairs(const TriangleMesh& tm)
+{
+    try {
+        return self_intersecting_pairs(tm);
+    } catch (const InvalidInput&) {
+        return {};
+    }
+}
+
 /// Fills every hole with a refined, faired patch (a plain minimal-area one when that fails).
 /// Fairing keeps the patch's interior smooth but not out of the surface's way: over a long,
 /// wavy border (the open base of a scan, say) the faired patch can fold through itself or
 /// the surface. Those holes are filled again with the refined patch alone, which lies on the
 /// border's triangulation. Left to remove_self_intersections, such a fold cost a minute on a
-/// 1,000-edge border and took most of the mesh with it.
+/// 1,000-edge border and took most of the mesh with it. The patch faces stay marked
+/// (patch_map) for the self-intersection step.
 /// \throw InvalidInput when a hole stays open.
 void fill_holes(Mesh& mesh, RepairReport& r)
 {
@@ -180,35 +208,23 @@ void fill_holes(Mesh& mesh, RepairReport& r)
     PMP::extract_boundary_cycles(mesh, std::back_inserter(borders));
     if (borders.empty()) return;
     const Mesh before = mesh; // halfedge indices (the borders) stay valid in the copy
-    auto patch = mesh.add_property_map<Mesh::Face_index, std::size_t>("f:lobe_patch", 0).first;
     std::vector<char> unfaired(borders.size(), 0);
-    auto [filled, faired] = fill_holes_once(mesh, borders, unfaired, patch);
+    auto [filled, faired] = fill_holes_once(mesh, borders, unfaired, patch_map(mesh));
     std::size_t refilled = 0;
     if (faired > 0 && CGAL::is_closed(mesh)) {
-        // Which faired patches take part in a self-intersection (patch and surface are
-        // listed in the order to_triangle_mesh writes the faces).
         const TriangleMesh tm = to_triangle_mesh(mesh);
-        std::vector<std::size_t> patch_of;
-        patch_of.reserve(mesh.number_of_faces());
-        for (auto f : mesh.faces()) patch_of.push_back(patch[f]);
-        std::vector<std::size_t> crossing;
-        try {
-            crossing = self_intersecting_triangles(tm);
-        } catch (const InvalidInput&) {
-            crossing.clear(); // not 2-manifold as a soup: judged below, as before
-        }
-        for (std::size_t t : crossing)
-            if (t < patch_of.size() && patch_of[t] > 0 && !unfaired[patch_of[t] - 1]) {
-                unfaired[patch_of[t] - 1] = 1;
-                ++refilled;
-            }
+        const std::vector<std::size_t> patch_of = patch_of_faces(mesh);
+        for (const auto& pair : crossing_pairs(tm))
+            for (std::size_t t : pair)
+                if (t < patch_of.size() && patch_of[t] > 0 && !unfaired[patch_of[t] - 1]) {
+                    unfaired[patch_of[t] - 1] = 1;
+                    ++refilled;
+                }
         if (refilled > 0) {
             mesh = before;
-            patch = mesh.add_property_map<Mesh::Face_index, std::size_t>("f:lobe_patch", 0).first;
-            std::tie(filled, faired) = fill_holes_once(mesh, borders, unfaired, patch);
+            std::tie(filled, faired) = fill_holes_once(mesh, borders, unfaired, patch_map(mesh));
         }
     }
-    mesh.remove_property_map(patch);
     r.holes_filled += filled;
     r.holes_faired += faired;
     r.holes_not_faired += refilled;
@@ -301,9 +317,22 @@ TriangleMesh repair_mesh(const TriangleMesh& in, RepairReport* report)
     //    repair removes the faces involved and fills the gap, smoothing or re-triangulating;
     //    with preserve_genus(false) it may also cut through a handle, which a lobe (an
     //    envelope of foliage) does not mind.
+    //    Where only hole patches cross (their own triangles or the surface's), the crossings
+    //    are left: the removal can take minutes on a patch over a long zig-zag border and
+    //    cut away much of the mesh, and a lobe is an envelope of attractors, which a fold at
+    //    its filled base hardly changes.
     {
         TriangleMesh tm = to_triangle_mesh(mesh);
-        if (self_intersects(tm)) {
+        const std::vector<std::size_t> patch_of = patch_of_faces(mesh);
+        const auto pairs = self_intersecting_pairs(tm);
+        const bool patches_only = std::all_of(pairs.begin(), pairs.end(), [&](const std::array<std::size_t, 2>& p) {
+            return (p[0] < patch_of.size() && patch_of[p[0]] > 0) || (p[1] < patch_of.size() && patch_of[p[1]] > 0);
+        });
+        if (!pairs.empty() && patches_only) {
+            r.hole_patch_crossings = pairs.size();
+            r.notes.push_back("left " + std::to_string(pairs.size()) +
+                              " crossings of a filled hole's triangles with themselves or the surface");
+        } else if (!pairs.empty()) {
             r.self_intersections_left = !remove_self_intersections(tm);
             r.notes.push_back(r.self_intersections_left ? "some self-intersections could not be removed"
                                                         : "removed self-intersections");

@@ -3,7 +3,6 @@
 // compile as the rest of the repair code.
 #include "meshing/repair.h"
 
-#include <algorithm>
 #include <array>
 #include <iterator>
 #include <utility>
@@ -71,20 +70,15 @@ bool self_intersects(const TriangleMesh& in)
     return PMP::does_self_intersect(to_surface_mesh(in, "self_intersects"));
 }
 
-std::vector<std::size_t> self_intersecting_triangles(const TriangleMesh& in)
+std::vector<std::array<std::size_t, 2>> self_intersecting_pairs(const TriangleMesh& in)
 {
-    const Mesh sm = to_surface_mesh(in, "self_intersecting_triangles");
+    const Mesh sm = to_surface_mesh(in, "self_intersecting_pairs");
     std::vector<std::pair<Mesh::Face_index, Mesh::Face_index>> pairs;
     PMP::self_intersections(faces(sm), sm, std::back_inserter(pairs));
     // A mesh built from a soup numbers its faces as the soup's triangles.
-    std::vector<std::size_t> out;
-    out.reserve(2 * pairs.size());
-    for (const auto& [f, g] : pairs) {
-        out.push_back(static_cast<std::size_t>(f.idx()));
-        out.push_back(static_cast<std::size_t>(g.idx()));
-    }
-    std::sort(out.begin(), out.end());
-    out.erase(std::unique(out.begin(), out.end()), out.end());
+    std::vector<std::array<std::size_t, 2>> out;
+    out.reserve(pairs.size());
+    for (const auto& [f, g] : pairs) out.push_back({static_cast<std::size_t>(f.idx()), static_cast<std::size_t>(g.idx())});
     return out;
 }
 

@@ -274,16 +274,17 @@ TEST(Repair, FillsHolesAndKeepsTheLargestComponent)
     EXPECT_TRUE(noted);
 }
 
-/// A dome (a unit sphere above latitude −40°) whose open base runs up and down by ±15° of
-/// latitude in `waves` waves over `segments` edges, as the cut-off base of a scan can.
-TriangleMesh dome_with_wavy_base(int segments, int waves)
+/// A dome (a unit sphere above latitude −40°) whose open base runs up and down by
+/// ±`amplitude_deg` of latitude in `waves` waves over `segments` edges, as the cut-off base of
+/// a scan can.
+TriangleMesh dome_with_wavy_base(int segments, int waves, double amplitude_deg)
 {
     TriangleMesh m;
     constexpr int kRings = 6;
     for (int r = 0; r < kRings; ++r)
         for (int i = 0; i < segments; ++i) {
             const double lon = 2.0 * kPi * i / segments;
-            const double lat = (-40.0 + 130.0 * r / kRings + (r == 0 ? 15.0 * std::sin(waves * lon) : 0.0)) * kPi / 180.0;
+            const double lat = (-40.0 + 130.0 * r / kRings + (r == 0 ? amplitude_deg * std::sin(waves * lon) : 0.0)) * kPi / 180.0;
             m.positions.emplace_back(std::cos(lat) * std::cos(lon), std::sin(lat), std::cos(lat) * std::sin(lon));
         }
     m.positions.emplace_back(0.0f, 1.0f, 0.0f);
@@ -300,12 +301,33 @@ TriangleMesh dome_with_wavy_base(int segments, int waves)
     return m;
 }
 
+/// How many triangles of `in` are triangles of `out` too, at the same place (either way round).
+std::size_t triangles_kept(const TriangleMesh& in, const TriangleMesh& out)
+{
+    std::set<std::array<float, 9>> corners;
+    auto at = [](const TriangleMesh& m, const std::array<int, 3>& t, int k) {
+        return m.positions[static_cast<std::size_t>(t[static_cast<std::size_t>(k % 3)])];
+    };
+    for (const auto& t : out.triangles)
+        for (int k = 0; k < 3; ++k) {
+            const glm::vec3 a = at(out, t, k), b = at(out, t, k + 1), c = at(out, t, k + 2);
+            corners.insert({a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z});
+        }
+    std::size_t found = 0;
+    for (const auto& t : in.triangles) {
+        const glm::vec3 a = at(in, t, 0), b = at(in, t, 1), c = at(in, t, 2);
+        found += corners.count({a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z}) +
+                 corners.count({a.x, a.y, a.z, c.x, c.y, c.z, b.x, b.y, b.z});
+    }
+    return found;
+}
+
 TEST(Repair, AFairedPatchThatCrossesTheSurfaceIsReplacedByAnUnfairedOneAndTheMeshKept)
 {
     // Fairing the patch over this 1,000-edge border folds it through itself; CGAL's
     // self-intersection removal then took most of a minute (1,000 edges) and cut away much
     // of the dome.
-    const TriangleMesh dome = dome_with_wavy_base(1000, 40);
+    const TriangleMesh dome = dome_with_wavy_base(1000, 40, 15.0);
     ASSERT_FALSE(self_intersects(dome));
     RepairReport r;
     const TriangleMesh out = repair_mesh(dome, &r);
@@ -315,27 +337,29 @@ TEST(Repair, AFairedPatchThatCrossesTheSurfaceIsReplacedByAnUnfairedOneAndTheMes
     EXPECT_FALSE(self_intersects(out));
     const MeshQuality q = measure_quality(out);
     EXPECT_TRUE(q.closed && q.manifold && q.outward);
-    // Every triangle of the dome is still there, at the same place.
-    std::set<std::array<float, 9>> corners;
-    for (const auto& t : out.triangles)
-        for (int k = 0; k < 3; ++k) {
-            const glm::vec3 &a = out.positions[static_cast<std::size_t>(t[static_cast<std::size_t>(k)])],
-                            &b = out.positions[static_cast<std::size_t>(t[static_cast<std::size_t>((k + 1) % 3)])],
-                            &c = out.positions[static_cast<std::size_t>(t[static_cast<std::size_t>((k + 2) % 3)])];
-            corners.insert({a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z});
-        }
-    std::size_t found = 0;
-    for (const auto& t : dome.triangles) {
-        const glm::vec3 &a = dome.positions[static_cast<std::size_t>(t[0])], &b = dome.positions[static_cast<std::size_t>(t[1])],
-                        &c = dome.positions[static_cast<std::size_t>(t[2])];
-        // The repaired mesh may run the other way round (flipped outward).
-        found += corners.count({a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z}) +
-                 corners.count({a.x, a.y, a.z, c.x, c.y, c.z, b.x, b.y, b.z});
-    }
-    EXPECT_EQ(found, dome.triangles.size());
+    EXPECT_EQ(triangles_kept(dome, out), dome.triangles.size());
     bool noted = false;
     for (const auto& n : r.notes) noted = noted || n.find("1 not faired") != std::string::npos;
     EXPECT_TRUE(noted);
+}
+
+TEST(Repair, APatchThatStillCrossesTheSurfaceUnfairedIsLeftRatherThanCuttingTheMeshAway)
+{
+    // 120 waves over 600 edges: the border zig-zags so steeply that the unfaired patch crosses
+    // the surface too. The dome itself does not intersect itself, so the crossings are the
+    // patch's: they are left, counted, and the dome kept whole.
+    const TriangleMesh dome = dome_with_wavy_base(600, 120, 20.0);
+    ASSERT_FALSE(self_intersects(dome));
+    RepairReport r;
+    const TriangleMesh out = repair_mesh(dome, &r);
+    EXPECT_EQ(r.holes_filled, 1u);
+    EXPECT_EQ(r.holes_not_faired, 1u);
+    EXPECT_GT(r.hole_patch_crossings, 0u);
+    EXPECT_FALSE(r.self_intersections_left); // nothing was handed to the removal
+    const MeshQuality q = measure_quality(out);
+    EXPECT_TRUE(q.closed && q.manifold && q.outward);
+    EXPECT_EQ(triangles_kept(dome, out), dome.triangles.size());
+    EXPECT_EQ(self_intersecting_pairs(out).size(), r.hole_patch_crossings);
 }
 
 TEST(Repair, SplitsTheCowsNonManifoldVertex)
