@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <iterator>
 #include <map>
+#include <optional>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -200,9 +201,10 @@ std::vector<std::array<std::size_t, 2>> crossing_pairs(const TriangleMesh& tm)
 /// the surface. Those holes are filled again with the refined patch alone, which lies on the
 /// border's triangulation. Left to remove_self_intersections, such a fold cost a minute on a
 /// 1,000-edge border and took most of the mesh with it. The patch faces stay marked
-/// (patch_map) for the self-intersection step.
+/// (patch_map) for the self-intersection step, and `pairs` (when given) receives the
+/// intersecting pairs of the result when they were found on the way (one pass saved).
 /// \throw InvalidInput when a hole stays open.
-void fill_holes(Mesh& mesh, RepairReport& r)
+void fill_holes(Mesh& mesh, RepairReport& r, std::optional<std::vector<std::array<std::size_t, 2>>>* pairs = nullptr)
 {
     std::vector<Mesh::Halfedge_index> borders;
     PMP::extract_boundary_cycles(mesh, std::back_inserter(borders));
@@ -214,7 +216,8 @@ void fill_holes(Mesh& mesh, RepairReport& r)
     if (faired > 0 && CGAL::is_closed(mesh)) {
         const TriangleMesh tm = to_triangle_mesh(mesh);
         const std::vector<std::size_t> patch_of = patch_of_faces(mesh);
-        for (const auto& pair : crossing_pairs(tm))
+        const auto found = crossing_pairs(tm);
+        for (const auto& pair : found)
             for (std::size_t t : pair)
                 if (t < patch_of.size() && patch_of[t] > 0 && !unfaired[patch_of[t] - 1]) {
                     unfaired[patch_of[t] - 1] = 1;
@@ -223,6 +226,8 @@ void fill_holes(Mesh& mesh, RepairReport& r)
         if (refilled > 0) {
             mesh = before;
             std::tie(filled, faired) = fill_holes_once(mesh, borders, unfaired, patch_map(mesh));
+        } else if (pairs) {
+            *pairs = found;
         }
     }
     r.holes_filled += filled;
@@ -308,10 +313,11 @@ TriangleMesh repair_mesh(const TriangleMesh& in, RepairReport* report)
 
     // 3. One component, 4. no holes.
     keep_largest_component(mesh, r);
-    fill_holes(mesh, r);
+    std::optional<std::vector<std::array<std::size_t, 2>>> known_pairs;
+    fill_holes(mesh, r, &known_pairs);
 
     // Copies of split vertices would make the surface touch itself at a point.
-    separate_coincident_vertices(mesh);
+    if (separate_coincident_vertices(mesh) > 0) known_pairs.reset();
 
     // 5. Self-intersections (the cow's tail runs into its body): CGAL's experimental local
     //    repair removes the faces involved and fills the gap, smoothing or re-triangulating;
@@ -324,7 +330,7 @@ TriangleMesh repair_mesh(const TriangleMesh& in, RepairReport* report)
     {
         TriangleMesh tm = to_triangle_mesh(mesh);
         const std::vector<std::size_t> patch_of = patch_of_faces(mesh);
-        const auto pairs = self_intersecting_pairs(tm);
+        const auto pairs = known_pairs ? std::move(*known_pairs) : self_intersecting_pairs(tm);
         const bool patches_only = std::all_of(pairs.begin(), pairs.end(), [&](const std::array<std::size_t, 2>& p) {
             return (p[0] < patch_of.size() && patch_of[p[0]] > 0) || (p[1] < patch_of.size() && patch_of[p[1]] > 0);
         });
