@@ -325,8 +325,8 @@ std::size_t triangles_kept(const TriangleMesh& in, const TriangleMesh& out)
 TEST(Repair, AFairedPatchThatCrossesTheSurfaceIsReplacedByAnUnfairedOneAndTheMeshKept)
 {
     // Fairing the patch over this 1,000-edge border folds it through itself; CGAL's
-    // self-intersection removal then took most of a minute (1,000 edges) and cut away much
-    // of the dome.
+    // self-intersection removal then cut away 2,186 of the dome's 11,000 triangles (and on
+    // the same dome read from a 6-decimal OBJ, `lobesketch lobes` took 75 s over it).
     const TriangleMesh dome = dome_with_wavy_base(1000, 40, 15.0);
     ASSERT_FALSE(self_intersects(dome));
     RepairReport r;
