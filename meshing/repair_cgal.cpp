@@ -184,14 +184,14 @@ std::vector<std::size_t> patch_of_faces(Mesh& mesh)
     return out;
 }
 
-/// The pairs of intersecting triangles of `tm`; none when it is not 2-manifold as a soup
-/// (the checks after repair judge that).
-std::vector<std::array<std::size_t, 2>> crossing_pairs(const TriangleMesh& tm)
+/// The pairs of intersecting triangles of `tm`; nothing when it is not 2-manifold as a soup
+/// (the self-intersection step says so, as it always did).
+std::optional<std::vector<std::array<std::size_t, 2>>> crossing_pairs(const TriangleMesh& tm)
 {
     try {
         return self_intersecting_pairs(tm);
     } catch (const InvalidInput&) {
-        return {};
+        return std::nullopt;
     }
 }
 
@@ -216,18 +216,19 @@ void fill_holes(Mesh& mesh, RepairReport& r, std::optional<std::vector<std::arra
     if (faired > 0 && CGAL::is_closed(mesh)) {
         const TriangleMesh tm = to_triangle_mesh(mesh);
         const std::vector<std::size_t> patch_of = patch_of_faces(mesh);
-        const auto found = crossing_pairs(tm);
-        for (const auto& pair : found)
-            for (std::size_t t : pair)
-                if (t < patch_of.size() && patch_of[t] > 0 && !unfaired[patch_of[t] - 1]) {
-                    unfaired[patch_of[t] - 1] = 1;
-                    ++refilled;
-                }
+        auto found = crossing_pairs(tm);
+        if (found)
+            for (const auto& pair : *found)
+                for (std::size_t t : pair)
+                    if (t < patch_of.size() && patch_of[t] > 0 && !unfaired[patch_of[t] - 1]) {
+                        unfaired[patch_of[t] - 1] = 1;
+                        ++refilled;
+                    }
         if (refilled > 0) {
             mesh = before;
             std::tie(filled, faired) = fill_holes_once(mesh, borders, unfaired, patch_map(mesh));
-        } else if (pairs) {
-            *pairs = found;
+        } else if (pairs && found) {
+            *pairs = std::move(*found);
         }
     }
     r.holes_filled += filled;
