@@ -26,13 +26,17 @@
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #endif
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/boost/graph/Euler_operations.h>
 #include <CGAL/Polygon_mesh_processing/border.h>
 #include <CGAL/Polygon_mesh_processing/connected_components.h>
+#include <CGAL/Polygon_mesh_processing/fair.h>
 #include <CGAL/Polygon_mesh_processing/manifoldness.h>
 #include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
 #include <CGAL/Polygon_mesh_processing/orientation.h>
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
+#include <CGAL/Polygon_mesh_processing/refine.h>
 #include <CGAL/Polygon_mesh_processing/repair_polygon_soup.h>
+#include <CGAL/Polygon_mesh_processing/triangulate_faces.h>
 #include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
 #include <CGAL/Surface_mesh.h>
 #pragma GCC diagnostic pop
@@ -142,30 +146,102 @@ void keep_largest_component(Mesh& mesh, RepairReport& r)
                       std::to_string(faces_before - mesh.number_of_faces()) + " triangles)");
 }
 
-/// Fills the holes whose boundary cycles start at `borders`, each with a refined, faired
-/// patch unless `unfaired` flags it (a refined patch then, not faired), or a plain
-/// minimal-area one when that gives nothing; `patch` receives, per face, 1 + the index of
-/// the hole it fills (0: not a patch face). Returns how many were filled and faired.
-std::pair<std::size_t, std::size_t> fill_holes_once(Mesh& mesh, const std::vector<Mesh::Halfedge_index>& borders,
-                                                    const std::vector<char>& unfaired,
-                                                    Mesh::Property_map<Mesh::Face_index, std::size_t> patch)
+/// Holes with more border edges than this are filled by methods whose time and memory grow
+/// about linearly with the border. CGAL's default search looks for the best patch among the
+/// faces of the border points' 3D Delaunay triangulation, which on a long border that is
+/// nearly flat or nearly on a sphere (the cut-off base of a scan) holds a large share of
+/// all point pairs: 550 MB for 2,000 edges, 1.6 GB for 3,000. When that search finds
+/// nothing it falls back to the cubic search over all triangulations of the border, which
+/// on thousands of edges would run for hours. Holes up to this size keep the best patch;
+/// the reference models' largest hole (the bunny's base) has 80 edges.
+constexpr std::size_t kLargeHole = 200;
+
+std::size_t border_edges(const Mesh& mesh, Mesh::Halfedge_index h)
 {
-    std::size_t filled = 0, faired = 0;
+    std::size_t n = 0;
+    for (auto it = h;;) {
+        ++n;
+        it = mesh.next(it);
+        if (it == h) return n;
+    }
+}
+
+/// Collects the faces triangulate_face makes (it copies its visitor: a pointer is shared).
+struct CollectFaces {
+    std::vector<Mesh::Face_index>* faces;
+    void before_subface_creations(Mesh::Face_index) {}
+    void after_subface_created(Mesh::Face_index f) { faces->push_back(f); }
+    void after_subface_creations() {}
+};
+
+/// Fills a large hole (kLargeHole) and refines the patch, faired unless `unfaired`. The hole
+/// becomes one polygon, triangulated by a 2D constrained Delaunay triangulation in the plane
+/// of its vector area (CGAL's triangulate_face), which holds where the border projects onto
+/// that plane without crossing itself (the wavy base of a scan); otherwise by a fan from the
+/// border's centroid, always a valid manifold patch. Either may cross the surface; the
+/// crossing check after filling deals with that. Linear memory, O(n log n) time.
+/// (CGAL's own planar route in triangulate_hole averages the normals of a fan after turning
+/// each to positive x, which fails on a flat border seen edge-on in x.)
+/// Returns whether the patch was faired; `by_fan` tells which way it was made.
+bool fill_large_hole(Mesh& mesh, Mesh::Halfedge_index h, bool unfaired, std::vector<Mesh::Face_index>& new_faces,
+                     std::vector<VertexIndex>& new_vertices, bool& by_fan)
+{
+    double c[3] = {0, 0, 0};
+    std::size_t n = 0;
+    for (VertexIndex v : CGAL::vertices_around_face(h, mesh)) {
+        const Point& p = mesh.point(v);
+        c[0] += p.x();
+        c[1] += p.y();
+        c[2] += p.z();
+        ++n;
+    }
+    CGAL::Euler::fill_hole(h, mesh);
+    const Mesh::Face_index polygon = mesh.face(h);
+    std::vector<Mesh::Face_index> patch;
+    by_fan = !PMP::triangulate_face(polygon, mesh, PMP::parameters::visitor(CollectFaces{&patch}));
+    if (by_fan) {
+        patch.clear();
+        const Mesh::Halfedge_index spoke = CGAL::Euler::add_center_vertex(mesh.halfedge(polygon), mesh);
+        const VertexIndex centre = mesh.target(spoke);
+        const double inv = 1.0 / static_cast<double>(n);
+        mesh.point(centre) = Point(c[0] * inv, c[1] * inv, c[2] * inv);
+        new_vertices.push_back(centre);
+        for (auto f : CGAL::faces_around_target(spoke, mesh)) patch.push_back(f);
+    }
+    new_faces = patch;
+    PMP::refine(mesh, patch, std::back_inserter(new_faces), std::back_inserter(new_vertices));
+    return !unfaired && PMP::fair(mesh, new_vertices);
+}
+
+struct FillCounts {
+    std::size_t filled = 0, faired = 0, fans = 0; ///< fans: large holes filled by a fan
+};
+
+FillCounts fill_holes_once(Mesh& mesh, const std::vector<Mesh::Halfedge_index>& borders,
+                                           const std::vector<char>& unfaired,
+                                           Mesh::Property_map<Mesh::Face_index, std::size_t> patch)
+{
+    FillCounts n;
     for (std::size_t i = 0; i < borders.size(); ++i) {
         const Mesh::Halfedge_index h = borders[i];
         std::vector<Mesh::Face_index> new_faces;
         std::vector<VertexIndex> new_vertices;
-        if (unfaired[i]) {
+        const bool large = border_edges(mesh, h) > kLargeHole;
+        if (large) {
+            bool by_fan = false;
+            if (fill_large_hole(mesh, h, unfaired[i] != 0, new_faces, new_vertices, by_fan)) ++n.faired;
+            if (by_fan) ++n.fans;
+        } else if (unfaired[i]) {
             PMP::triangulate_and_refine_hole(mesh, h, std::back_inserter(new_faces), std::back_inserter(new_vertices));
         } else if (std::get<0>(PMP::triangulate_refine_and_fair_hole(mesh, h, std::back_inserter(new_faces),
                                                                       std::back_inserter(new_vertices)))) {
-            ++faired;
+            ++n.faired;
         }
-        if (new_faces.empty()) PMP::triangulate_hole(mesh, h, std::back_inserter(new_faces));
-        if (!new_faces.empty()) ++filled;
+        if (new_faces.empty() && !large) PMP::triangulate_hole(mesh, h, std::back_inserter(new_faces));
+        if (!new_faces.empty()) ++n.filled;
         for (Mesh::Face_index f : new_faces) patch[f] = i + 1;
     }
-    return {filled, faired};
+    return n;
 }
 
 /// Which hole's patch each face of `mesh` belongs to (1 + its index; 0: none), kept from
@@ -211,9 +287,9 @@ void fill_holes(Mesh& mesh, RepairReport& r, std::optional<std::vector<std::arra
     if (borders.empty()) return;
     const Mesh before = mesh; // halfedge indices (the borders) stay valid in the copy
     std::vector<char> unfaired(borders.size(), 0);
-    auto [filled, faired] = fill_holes_once(mesh, borders, unfaired, patch_map(mesh));
+    FillCounts n = fill_holes_once(mesh, borders, unfaired, patch_map(mesh));
     std::size_t refilled = 0;
-    if (faired > 0 && CGAL::is_closed(mesh)) {
+    if (n.faired > 0 && CGAL::is_closed(mesh)) {
         const TriangleMesh tm = to_triangle_mesh(mesh);
         const std::vector<std::size_t> patch_of = patch_of_faces(mesh);
         auto found = crossing_pairs(tm);
@@ -226,20 +302,22 @@ void fill_holes(Mesh& mesh, RepairReport& r, std::optional<std::vector<std::arra
                     }
         if (refilled > 0) {
             mesh = before;
-            std::tie(filled, faired) = fill_holes_once(mesh, borders, unfaired, patch_map(mesh));
+            n = fill_holes_once(mesh, borders, unfaired, patch_map(mesh));
         } else if (pairs && found) {
             *pairs = std::move(*found);
         }
     }
-    r.holes_filled += filled;
-    r.holes_faired += faired;
+    r.holes_filled += n.filled;
+    r.holes_faired += n.faired;
     r.holes_not_faired += refilled;
-    r.notes.push_back("filled " + std::to_string(filled) + " of " + std::to_string(borders.size()) + " holes (" +
-                      std::to_string(faired) + " faired" +
+    r.holes_fanned += n.fans;
+    r.notes.push_back("filled " + std::to_string(n.filled) + " of " + std::to_string(borders.size()) + " holes (" +
+                      std::to_string(n.faired) + " faired" +
                       (refilled ? ", " + std::to_string(refilled) + " not faired: a faired patch crossed the surface" : "") +
+                      (n.fans ? ", " + std::to_string(n.fans) + " large and far from flat: filled by a fan from the centre" : "") +
                       ")");
     if (!CGAL::is_closed(mesh))
-        throw InvalidInput("repair_mesh: a hole could not be filled (" + std::to_string(borders.size() - filled) +
+        throw InvalidInput("repair_mesh: a hole could not be filled (" + std::to_string(borders.size() - n.filled) +
                            " of " + std::to_string(borders.size()) + " left open)");
 }
 

@@ -345,10 +345,11 @@ TEST(Repair, AFairedPatchThatCrossesTheSurfaceIsReplacedByAnUnfairedOneAndTheMes
 
 TEST(Repair, APatchThatStillCrossesTheSurfaceUnfairedIsLeftRatherThanCuttingTheMeshAway)
 {
-    // 120 waves over 600 edges: the border zig-zags so steeply that the unfaired patch crosses
+    // 40 waves over 200 edges: the border zig-zags so steeply that the unfaired patch crosses
     // the surface too. The dome itself does not intersect itself, so the crossings are the
-    // patch's: they are left, counted, and the dome kept whole.
-    const TriangleMesh dome = dome_with_wavy_base(600, 120, 20.0);
+    // patch's: they are left, counted, and the dome kept whole. (A hole of 200 edges still
+    // gets CGAL's search for the best patch; larger ones are the next tests'.)
+    const TriangleMesh dome = dome_with_wavy_base(200, 40, 20.0);
     ASSERT_FALSE(self_intersects(dome));
     RepairReport r;
     const TriangleMesh out = repair_mesh(dome, &r);
@@ -360,6 +361,78 @@ TEST(Repair, APatchThatStillCrossesTheSurfaceUnfairedIsLeftRatherThanCuttingTheM
     EXPECT_TRUE(q.closed && q.manifold && q.outward);
     EXPECT_EQ(triangles_kept(dome, out), dome.triangles.size());
     EXPECT_EQ(self_intersecting_pairs(out).size(), r.hole_patch_crossings);
+}
+
+TEST(Repair, ALongWavyHoleGetsASmoothPlanarPatchInsteadOfTheBestPatchSearch)
+{
+    // 3,000 edges in 600 waves, the cut-off base of a scan. CGAL's search for the best patch
+    // ran over the faces of the border's 3D Delaunay triangulation: 1.6 GB and 55 s in
+    // `lobesketch lobes`, and its patch, faired or not, crossed the surface 2,599 times. The
+    // border projects onto its plane without crossing itself, so it is triangulated there,
+    // refined and faired, and that patch stays clear of the surface.
+    const TriangleMesh dome = dome_with_wavy_base(3000, 600, 20.0);
+    ASSERT_FALSE(self_intersects(dome));
+    RepairReport r;
+    const TriangleMesh out = repair_mesh(dome, &r);
+    EXPECT_EQ(r.holes_filled, 1u);
+    EXPECT_EQ(r.holes_faired, 1u);
+    EXPECT_EQ(r.holes_not_faired, 0u);
+    EXPECT_EQ(r.holes_fanned, 0u);
+    EXPECT_EQ(r.hole_patch_crossings, 0u);
+    EXPECT_FALSE(self_intersects(out));
+    const MeshQuality q = measure_quality(out);
+    EXPECT_TRUE(q.closed && q.manifold && q.outward);
+    EXPECT_EQ(triangles_kept(dome, out), dome.triangles.size());
+}
+
+/// A UV sphere (`segments` longitudes, `rings` latitude bands) with a slit cut out of the
+/// band just north of the equator over its first `slit_degrees` of longitude: a long, thin,
+/// curved hole whose border, seen along its vector area, runs over itself.
+TriangleMesh sphere_with_slit(int segments, int rings, double slit_degrees)
+{
+    TriangleMesh m;
+    for (int r = 1; r < rings; ++r) {
+        const double lat = -0.5 * kPi + kPi * r / rings;
+        for (int i = 0; i < segments; ++i) {
+            const double lon = 2.0 * kPi * i / segments;
+            m.positions.emplace_back(std::cos(lat) * std::cos(lon), std::cos(lat) * std::sin(lon), std::sin(lat));
+        }
+    }
+    const int south = static_cast<int>(m.positions.size());
+    m.positions.emplace_back(0.0f, 0.0f, -1.0f);
+    m.positions.emplace_back(0.0f, 0.0f, 1.0f);
+    auto at = [&](int r, int i) { return (r - 1) * segments + i % segments; };
+    for (int r = 1; r + 1 < rings; ++r)
+        for (int i = 0; i < segments; ++i) {
+            if (r == rings / 2 && i < segments * slit_degrees / 360.0) continue;
+            m.triangles.push_back({at(r, i), at(r, i + 1), at(r + 1, i + 1)});
+            m.triangles.push_back({at(r, i), at(r + 1, i + 1), at(r + 1, i)});
+        }
+    for (int i = 0; i < segments; ++i) {
+        m.triangles.push_back({south, at(1, i + 1), at(1, i)});
+        m.triangles.push_back({south + 1, at(rings - 1, i), at(rings - 1, i + 1)});
+    }
+    return m;
+}
+
+TEST(Repair, ALongHoleWithNoPlaneToTriangulateInIsFilledByAFanFromItsCentre)
+{
+    // A slit over 300° of the equator, 1,002 border edges: no plane sees its border as a
+    // simple polygon, so it is filled by a fan from the border's centroid, refined (faired
+    // where that does not cross the surface). Bounded time and memory, and closed.
+    const TriangleMesh sphere = sphere_with_slit(600, 120, 300.0);
+    ASSERT_FALSE(self_intersects(sphere));
+    RepairReport r;
+    const TriangleMesh out = repair_mesh(sphere, &r);
+    EXPECT_EQ(r.holes_filled, 1u);
+    EXPECT_EQ(r.holes_fanned, 1u);
+    const MeshQuality q = measure_quality(out);
+    EXPECT_TRUE(q.closed && q.manifold && q.outward);
+    EXPECT_EQ(triangles_kept(sphere, out), sphere.triangles.size());
+    EXPECT_EQ(self_intersecting_pairs(out).size(), r.hole_patch_crossings);
+    bool noted = false;
+    for (const auto& n : r.notes) noted = noted || n.find("filled by a fan") != std::string::npos;
+    EXPECT_TRUE(noted);
 }
 
 TEST(Repair, SplitsTheCowsNonManifoldVertex)
