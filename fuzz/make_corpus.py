@@ -308,18 +308,42 @@ def lobe_strokes_seeds():
     put("lobe_strokes", "a-loop-again-a-far-one-a-fold-and-a-nan", bytes([6] + sum(odd, [])))
 
 
+def hole_fill_seeds():
+    """Byte strings for hole_fill (fuzz/hole_fill_fuzz.cpp): shape, two bytes of size, waves
+    or bands, amplitude, then one byte per vertex moved beside the hole."""
+    def dome(edges, waves, amplitude, moves=b""):
+        wide = edges - 201
+        return bytes([0, wide & 255, wide >> 8, waves, amplitude]) + moves
+    def slit(degrees, bands, moves=b""):
+        wide = degrees - 60
+        return bytes([1, wide & 255, wide >> 8, bands - 20, 0]) + moves
+    put("hole_fill", "dome-300-edges-40-waves", dome(300, 40, 15))
+    put("hole_fill", "dome-700-edges-140-waves", dome(700, 140, 20))
+    put("hole_fill", "dome-250-edges-flat-base", dome(250, 0, 0))
+    put("hole_fill", "dome-400-edges-folding", dome(400, 80, 45))
+    put("hole_fill", "dome-300-edges-bumped", dome(300, 20, 10, bytes((i * 37) & 255 for i in range(120))))
+    # the target's findings (docs/fuzzing.md): each took over 30 s under ASan
+    put("hole_fill", "dome-400-edges-steep-zigzag", dome(400, 80, 37, bytes([0x2d])))
+    put("hole_fill", "dome-316-edges-shifted-base", bytes.fromhex(
+        "00f33e3e3e" + "00" * 45 + "013c000a0000356a9fd4093e73a8dd12477cb1e61b5085baef24598ec3f82d6297cc01366ba0d50a3f74a9de"
+        "13487db2e71c5186bbf0255a8fc4f9dd12477cb1e61b5085baef24598ec3f82d6297cc01366ba0d50a3f74a9de133e3e7eb33e"))
+    put("hole_fill", "slit-300-degrees", slit(300, 40))
+    put("hole_fill", "slit-120-degrees-bumped", slit(120, 30, bytes((i * 53) & 255 for i in range(200))))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--lobesketch", help="a built lobesketch, to remake the text-recording and session seeds")
     a = ap.parse_args()
     for t in ["import_leap", "import_webxr", "recording_binary", "mesh_obj", "mesh_ply", "mesh_off", "mesh_repair",
-              "lobe_strokes", "species", "desktop_script", "scenario"]:
+              "hole_fill", "lobe_strokes", "species", "desktop_script", "scenario"]:
         shutil.rmtree(OUT / t, ignore_errors=True)
     leap_seeds()
     webxr_seeds()
     recording_binary_seeds()
     mesh_seeds()
     repair_seeds()
+    hole_fill_seeds()
     lobe_strokes_seeds()
     species_seeds()
     desktop_script_seeds()

@@ -25,8 +25,9 @@ struct RepairReport {
     std::size_t holes_faired = 0;            ///< of those, filled with a smooth (faired) patch
     std::size_t holes_not_faired = 0;        ///< of those, filled again without fairing: the faired
                                              ///< patch crossed itself or the surface
-    std::size_t holes_fanned = 0;            ///< of those, holes of over 200 edges far from a plane:
-                                             ///< filled by a fan from their centroid, refined
+    std::size_t holes_fanned = 0;            ///< of those, holes of over 200 edges that run over
+                                             ///< themselves in their plane and got no searched
+                                             ///< patch: filled by a fan from their centroid
     std::size_t hole_patch_crossings = 0;    ///< pairs of triangles where a hole's patch (unfaired
                                              ///< too) crosses itself or the surface: left as they are
     std::size_t components = 0;              ///< connected components before keeping the largest
@@ -47,9 +48,10 @@ struct RepairReport {
 ///    hair apart (1% towards their own fan) so the surface does not touch itself there;
 /// 3. keeps the largest connected component (by triangle count), noting the others;
 /// 4. fills every hole (triangulate_refine_and_fair_hole; plain triangulate_hole when
-///    that gives nothing); holes of over 200 edges by a planar constrained Delaunay patch,
-///    or a fan from their centroid where the border is far from a plane, refined and faired
-///    (CGAL's search for the best patch takes memory and time that grow faster than the
+///    that gives nothing); holes of over 200 edges by a constrained Delaunay patch in their
+///    plane where the border is a simple polygon there, else by the Delaunay search without
+///    its cubic fallback (up to 1,000 edges) or a fan from their centroid, then refined and
+///    faired (CGAL's full search takes memory and time that grow much faster than the
 ///    border there: gigabytes, or hours); a faired patch that intersects itself or the surface (a long,
 ///    wavy border) is replaced by the refined patch without fairing;
 ///    where a patch still crosses itself or the surface and the rest of the mesh does not

@@ -26,8 +26,11 @@
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #endif
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_2_algorithms.h>
+#include <CGAL/Projection_traits_3.h>
 #include <CGAL/boost/graph/Euler_operations.h>
 #include <CGAL/Polygon_mesh_processing/border.h>
+#include <CGAL/Polygon_mesh_processing/compute_normal.h>
 #include <CGAL/Polygon_mesh_processing/connected_components.h>
 #include <CGAL/Polygon_mesh_processing/fair.h>
 #include <CGAL/Polygon_mesh_processing/manifoldness.h>
@@ -146,15 +149,19 @@ void keep_largest_component(Mesh& mesh, RepairReport& r)
                       std::to_string(faces_before - mesh.number_of_faces()) + " triangles)");
 }
 
-/// Holes with more border edges than this are filled by methods whose time and memory grow
-/// about linearly with the border. CGAL's default search looks for the best patch among the
-/// faces of the border points' 3D Delaunay triangulation, which on a long border that is
-/// nearly flat or nearly on a sphere (the cut-off base of a scan) holds a large share of
-/// all point pairs: 550 MB for 2,000 edges, 1.6 GB for 3,000. When that search finds
-/// nothing it falls back to the cubic search over all triangulations of the border, which
-/// on thousands of edges would run for hours. Holes up to this size keep the best patch;
+/// Holes with more border edges than this are not handed to CGAL's whole search for the best
+/// patch. It runs over the faces of the border points' 3D Delaunay triangulation, which on a
+/// long border that is nearly flat or nearly on a sphere (the cut-off base of a scan) holds a
+/// large share of all point pairs: 550 MB for 2,000 edges, 1.6 GB for 3,000. When that finds
+/// nothing it falls back to a search over all triangulations of the border, cubic in its
+/// length, which on thousands of edges would run for hours. Up to this size both are kept;
 /// the reference models' largest hole (the bunny's base) has 80 edges.
 constexpr std::size_t kLargeHole = 200;
+/// Large holes whose border is not a simple polygon in its plane still get the Delaunay
+/// search, without the cubic fallback, up to this size (about 140 MB at worst): its patch
+/// crosses the surface far less often than a fan, and crossings can cost the
+/// self-intersection removal tens of seconds.
+constexpr std::size_t kSearchedHole = 1000;
 
 std::size_t border_edges(const Mesh& mesh, Mesh::Halfedge_index h)
 {
@@ -174,15 +181,17 @@ struct CollectFaces {
     void after_subface_creations() {}
 };
 
-/// Fills a large hole (kLargeHole) and refines the patch, faired unless `unfaired`. The hole
-/// becomes one polygon, triangulated by a 2D constrained Delaunay triangulation in the plane
-/// of its vector area (CGAL's triangulate_face), which holds where the border projects onto
-/// that plane without crossing itself (the wavy base of a scan); otherwise by a fan from the
-/// border's centroid, always a valid manifold patch. Either may cross the surface; the
-/// crossing check after filling deals with that. Linear memory, O(n log n) time.
+/// Fills a large hole (kLargeHole) and refines the patch, faired unless `unfaired`:
+/// 1. in the plane of its vector area, by a 2D constrained Delaunay triangulation (CGAL's
+///    triangulate_face on the hole made one polygon), where the border seen in that plane is
+///    a simple polygon (the wavy base of a scan): O(n log n) time, linear memory;
+/// 2. otherwise, up to kSearchedHole edges, by CGAL's search for the best patch among the
+///    faces of the border's 3D Delaunay triangulation, without its cubic fallback;
+/// 3. otherwise by a fan from the border's centroid, always a manifold patch.
+/// Any of them may cross the surface; the crossing check after filling deals with that.
 /// (CGAL's own planar route in triangulate_hole averages the normals of a fan after turning
-/// each to positive x, which fails on a flat border seen edge-on in x.)
-/// Returns whether the patch was faired; `by_fan` tells which way it was made.
+/// each towards positive x, which fails on a flat border seen edge-on in x.)
+/// Returns whether the patch was faired; `by_fan` tells whether step 3 made it.
 bool fill_large_hole(Mesh& mesh, Mesh::Halfedge_index h, bool unfaired, std::vector<Mesh::Face_index>& new_faces,
                      std::vector<VertexIndex>& new_vertices, bool& by_fan)
 {
@@ -195,18 +204,40 @@ bool fill_large_hole(Mesh& mesh, Mesh::Halfedge_index h, bool unfaired, std::vec
         c[2] += p.z();
         ++n;
     }
-    CGAL::Euler::fill_hole(h, mesh);
-    const Mesh::Face_index polygon = mesh.face(h);
+    by_fan = false;
     std::vector<Mesh::Face_index> patch;
-    by_fan = !PMP::triangulate_face(polygon, mesh, PMP::parameters::visitor(CollectFaces{&patch}));
-    if (by_fan) {
+    CGAL::Euler::fill_hole(h, mesh);
+    // triangulate_face refuses a polygon that runs over itself in its plane only after
+    // inserting every crossing exactly, which takes minutes on a steep zig-zag: the polygon is
+    // tested first (a sweep), seen along the normal triangulate_face uses.
+    bool simple = false;
+    {
+        const Kernel::Vector_3 normal = PMP::compute_face_normal(mesh.face(h), mesh);
+        if (normal != CGAL::NULL_VECTOR) {
+            std::vector<Point> ring;
+            ring.reserve(n);
+            for (VertexIndex v : CGAL::vertices_around_face(h, mesh)) ring.push_back(mesh.point(v));
+            simple = CGAL::is_simple_2(ring.begin(), ring.end(), CGAL::Projection_traits_3<Kernel>(normal));
+        }
+    }
+    if (!simple || !PMP::triangulate_face(mesh.face(h), mesh, PMP::parameters::visitor(CollectFaces{&patch}))) {
         patch.clear();
-        const Mesh::Halfedge_index spoke = CGAL::Euler::add_center_vertex(mesh.halfedge(polygon), mesh);
-        const VertexIndex centre = mesh.target(spoke);
-        const double inv = 1.0 / static_cast<double>(n);
-        mesh.point(centre) = Point(c[0] * inv, c[1] * inv, c[2] * inv);
-        new_vertices.push_back(centre);
-        for (auto f : CGAL::faces_around_target(spoke, mesh)) patch.push_back(f);
+        if (n <= kSearchedHole) {
+            CGAL::Euler::remove_face(h, mesh); // a hole again (a refusing triangulate_face leaves the polygon)
+            PMP::triangulate_hole(mesh, h, std::back_inserter(patch),
+                                  PMP::parameters::use_2d_constrained_delaunay_triangulation(false)
+                                      .do_not_use_cubic_algorithm(true));
+            if (patch.empty()) CGAL::Euler::fill_hole(h, mesh);
+        }
+        if (patch.empty()) {
+            by_fan = true;
+            const Mesh::Halfedge_index spoke = CGAL::Euler::add_center_vertex(h, mesh);
+            const VertexIndex centre = mesh.target(spoke);
+            const double inv = 1.0 / static_cast<double>(n);
+            mesh.point(centre) = Point(c[0] * inv, c[1] * inv, c[2] * inv);
+            new_vertices.push_back(centre);
+            for (auto f : CGAL::faces_around_target(spoke, mesh)) patch.push_back(f);
+        }
     }
     new_faces = patch;
     PMP::refine(mesh, patch, std::back_inserter(new_faces), std::back_inserter(new_vertices));
@@ -217,9 +248,12 @@ struct FillCounts {
     std::size_t filled = 0, faired = 0, fans = 0; ///< fans: large holes filled by a fan
 };
 
+/// Fills the holes whose boundary cycles start at `borders`, each with a refined, faired
+/// patch unless `unfaired` flags it (a refined patch then, not faired), or a plain
+/// minimal-area one when that gives nothing; large holes (kLargeHole) by fill_large_hole.
+/// `patch` receives, per face, 1 + the index of the hole it fills (0: not a patch face).
 FillCounts fill_holes_once(Mesh& mesh, const std::vector<Mesh::Halfedge_index>& borders,
-                                           const std::vector<char>& unfaired,
-                                           Mesh::Property_map<Mesh::Face_index, std::size_t> patch)
+                           const std::vector<char>& unfaired, Mesh::Property_map<Mesh::Face_index, std::size_t> patch)
 {
     FillCounts n;
     for (std::size_t i = 0; i < borders.size(); ++i) {
@@ -314,7 +348,7 @@ void fill_holes(Mesh& mesh, RepairReport& r, std::optional<std::vector<std::arra
     r.notes.push_back("filled " + std::to_string(n.filled) + " of " + std::to_string(borders.size()) + " holes (" +
                       std::to_string(n.faired) + " faired" +
                       (refilled ? ", " + std::to_string(refilled) + " not faired: a faired patch crossed the surface" : "") +
-                      (n.fans ? ", " + std::to_string(n.fans) + " large and far from flat: filled by a fan from the centre" : "") +
+                      (n.fans ? ", " + std::to_string(n.fans) + " filled by a fan from the centre (long, and running over itself in its plane)" : "") +
                       ")");
     if (!CGAL::is_closed(mesh))
         throw InvalidInput("repair_mesh: a hole could not be filled (" + std::to_string(borders.size() - n.filled) +

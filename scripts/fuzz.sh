@@ -3,7 +3,7 @@
 # the other, from the committed seeds (fuzz/corpus/<target>) into a scratch corpus that is
 # kept between runs (build/fuzz/<target>/corpus). Prints each target's statistics and exits
 # non-zero when any target found something: a crash, a sanitizer report, an uncaught
-# exception, a multi-line error, a timeout (10 s, lobe_strokes 30 s; LOBE_FUZZ_TIMEOUT=S sets
+# exception, a multi-line error, a timeout (10 s, lobe_strokes and hole_fill 30 s; LOBE_FUZZ_TIMEOUT=S sets
 # another, for runs on a loaded machine) or more than 2 GiB of memory. The inputs
 # that did it are in build/fuzz/<target>/artifacts/.
 #
@@ -24,14 +24,14 @@ declare -A MAX_LEN=(
   [recording_binary]=16384 [recording_text]=16384
   [import_leap]=16384 [import_webxr]=16384
   [document]=16384 [settings]=8192 [species]=4096
-  [mesh_obj]=8192 [mesh_ply]=8192 [mesh_off]=8192 [mesh_repair]=4096 [lobe_strokes]=128
+  [mesh_obj]=8192 [mesh_ply]=8192 [mesh_off]=8192 [mesh_repair]=4096 [hole_fill]=1024 [lobe_strokes]=128
   [desktop_script]=4096 [scenario]=8192
 )
 # target → seconds one input may take (LOBE_FUZZ_TIMEOUT sets every target's): a lobe of six
 # strokes, each built twice (continued and whole) and checked for self-intersections, takes
 # a few seconds under ASan.
-declare -A TIMEOUT=([lobe_strokes]=30)
-ALL=(recording_binary recording_text import_leap import_webxr document settings species mesh_obj mesh_ply mesh_off mesh_repair lobe_strokes desktop_script scenario)
+declare -A TIMEOUT=([lobe_strokes]=30 [hole_fill]=30)
+ALL=(recording_binary recording_text import_leap import_webxr document settings species mesh_obj mesh_ply mesh_off mesh_repair hole_fill lobe_strokes desktop_script scenario)
 TARGETS=("$@")
 [ ${#TARGETS[@]} -eq 0 ] && TARGETS=("${ALL[@]}")
 

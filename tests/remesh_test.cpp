@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <cmath>
 #include <map>
@@ -13,15 +14,19 @@
 
 #include <glm/geometric.hpp>
 
+#include "core/atomic_file.h"
 #include "core/errors.h"
 #include "meshing/mesh_io.h"
 #include "meshing/mesh_quality.h"
 #include "meshing/model_import.h"
 #include "meshing/remesh.h"
 #include "meshing/repair.h"
+#include "tests/hole_meshes.h"
 #include "tests/test_paths.h"
 
 using namespace lobe;
+using lobe::test::dome_with_wavy_base;
+using lobe::test::sphere_with_slit;
 
 namespace {
 
@@ -274,33 +279,6 @@ TEST(Repair, FillsHolesAndKeepsTheLargestComponent)
     EXPECT_TRUE(noted);
 }
 
-/// A dome (a unit sphere above latitude −40°) whose open base runs up and down by
-/// ±`amplitude_deg` of latitude in `waves` waves over `segments` edges, as the cut-off base of
-/// a scan can.
-TriangleMesh dome_with_wavy_base(int segments, int waves, double amplitude_deg)
-{
-    TriangleMesh m;
-    constexpr int kRings = 6;
-    for (int r = 0; r < kRings; ++r)
-        for (int i = 0; i < segments; ++i) {
-            const double lon = 2.0 * kPi * i / segments;
-            const double lat = (-40.0 + 130.0 * r / kRings + (r == 0 ? amplitude_deg * std::sin(waves * lon) : 0.0)) * kPi / 180.0;
-            m.positions.emplace_back(std::cos(lat) * std::cos(lon), std::sin(lat), std::cos(lat) * std::sin(lon));
-        }
-    m.positions.emplace_back(0.0f, 1.0f, 0.0f);
-    for (int r = 0; r + 1 < kRings; ++r)
-        for (int i = 0; i < segments; ++i) {
-            const int a = r * segments + i, b = r * segments + (i + 1) % segments;
-            const int c = (r + 1) * segments + (i + 1) % segments, d = (r + 1) * segments + i;
-            m.triangles.push_back({a, c, b});
-            m.triangles.push_back({a, d, c});
-        }
-    const int pole = kRings * segments;
-    for (int i = 0; i < segments; ++i)
-        m.triangles.push_back({(kRings - 1) * segments + i, pole, (kRings - 1) * segments + (i + 1) % segments});
-    return m;
-}
-
 /// How many triangles of `in` are triangles of `out` too, at the same place (either way round).
 std::size_t triangles_kept(const TriangleMesh& in, const TriangleMesh& out)
 {
@@ -322,17 +300,31 @@ std::size_t triangles_kept(const TriangleMesh& in, const TriangleMesh& out)
     return found;
 }
 
-/// repair_mesh on `in`, which must not intersect itself and has one hole: the result is
-/// closed, 2-manifold and outward, the hole filled and every input triangle kept.
-TriangleMesh repaired_keeping_every_triangle(const TriangleMesh& in, RepairReport& r)
+/// repair_mesh on `in`, which has one hole: the result is closed, 2-manifold and outward,
+/// with the hole filled.
+TriangleMesh repaired_closed(const TriangleMesh& in, RepairReport& r)
 {
-    EXPECT_FALSE(self_intersects(in));
     TriangleMesh out = repair_mesh(in, &r);
     EXPECT_EQ(r.holes_filled, 1u);
     const MeshQuality q = measure_quality(out);
     EXPECT_TRUE(q.closed && q.manifold && q.outward);
+    return out;
+}
+
+/// repaired_closed for an `in` that does not intersect itself: every input triangle is kept.
+TriangleMesh repaired_keeping_every_triangle(const TriangleMesh& in, RepairReport& r)
+{
+    EXPECT_FALSE(self_intersects(in));
+    TriangleMesh out = repaired_closed(in, r);
     EXPECT_EQ(triangles_kept(in, out), in.triangles.size());
     return out;
+}
+
+/// The mesh the hole_fill fuzz target makes of its seed `name` (fuzz/corpus/hole_fill/).
+TriangleMesh hole_fill_seed(const std::string& name)
+{
+    const std::string bytes = read_file_limited(test::source_path("fuzz/corpus/hole_fill/" + name), 4096);
+    return lobe::test::hole_fill_mesh(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size());
 }
 
 TEST(Repair, AFairedPatchThatCrossesTheSurfaceIsReplacedByAnUnfairedOneAndTheMeshKept)
@@ -380,44 +372,54 @@ TEST(Repair, ALongWavyHoleGetsASmoothPlanarPatchInsteadOfTheBestPatchSearch)
     EXPECT_FALSE(self_intersects(out));
 }
 
-/// A UV sphere (`segments` longitudes, `rings` latitude bands) with a slit cut out of the
-/// band just north of the equator over its first `slit_degrees` of longitude: a long, thin,
-/// curved hole whose border, seen along its vector area, runs over itself.
-TriangleMesh sphere_with_slit(int segments, int rings, double slit_degrees)
+TEST(Repair, ALargeBumpyHoleThatIsNoPolygonInItsPlaneGetsTheSearchedPatchNotAFan)
 {
-    TriangleMesh m;
-    for (int r = 1; r < rings; ++r) {
-        const double lat = -0.5 * kPi + kPi * r / rings;
-        for (int i = 0; i < segments; ++i) {
-            const double lon = 2.0 * kPi * i / segments;
-            m.positions.emplace_back(std::cos(lat) * std::cos(lon), std::cos(lat) * std::sin(lon), std::sin(lat));
-        }
-    }
-    const int south = static_cast<int>(m.positions.size());
-    m.positions.emplace_back(0.0f, 0.0f, -1.0f);
-    m.positions.emplace_back(0.0f, 0.0f, 1.0f);
-    auto at = [&](int r, int i) { return (r - 1) * segments + i % segments; };
-    for (int r = 1; r + 1 < rings; ++r)
-        for (int i = 0; i < segments; ++i) {
-            if (r == rings / 2 && i < segments * slit_degrees / 360.0) continue;
-            m.triangles.push_back({at(r, i), at(r, i + 1), at(r + 1, i + 1)});
-            m.triangles.push_back({at(r, i), at(r + 1, i + 1), at(r + 1, i)});
-        }
-    for (int i = 0; i < segments; ++i) {
-        m.triangles.push_back({south, at(1, i + 1), at(1, i)});
-        m.triangles.push_back({south + 1, at(rings - 1, i), at(rings - 1, i + 1)});
-    }
-    return m;
+    // The hole_fill fuzz target's first finding (its seed dome-300-edges-bumped): a 300-edge
+    // wavy base with its vertices bumped by up to ±5 % (so the dome now intersects itself)
+    // runs over itself in its plane. A fan crossed the surface so often that the
+    // self-intersection removal took 23 s (`lobesketch lobes`, release; over 30 s under
+    // ASan); over the Delaunay search's patch, 0.6 s.
+    const TriangleMesh dome = hole_fill_seed("dome-300-edges-bumped");
+    ASSERT_TRUE(self_intersects(dome));
+    RepairReport r;
+    repaired_closed(dome, r);
+    EXPECT_EQ(r.holes_fanned, 0u);
+}
+
+TEST(Repair, ASteepZigZagHoleIsTestedForCrossingsBeforeItIsTriangulatedInItsPlane)
+{
+    // The hole_fill fuzz target's second finding (its seed dome-400-edges-steep-zigzag): 400
+    // edges zig-zagging ±37° in 80 waves run over themselves in their plane many times.
+    // CGAL's triangulate_face refuses such a polygon only after constructing every crossing
+    // exactly (over 30 s under ASan); a sweep tests it first, and the hole gets the searched
+    // patch (5.8 s under ASan, 1.2 s in `lobesketch lobes`).
+    RepairReport r;
+    repaired_closed(hole_fill_seed("dome-400-edges-steep-zigzag"), r);
+    EXPECT_EQ(r.holes_fanned, 0u);
+}
+
+TEST(Repair, SelfIntersectionRemovalOnADomeWithAShiftedBaseStopsAfterFourSteps)
+{
+    // The hole_fill fuzz target's third finding (its seed dome-316-edges-shifted-base): the
+    // base of a 316-edge dome shifted into its first band. CGAL's removal in its default seven
+    // steps smoothed one component for minutes (3.5 min in `lobesketch lobes`); in four it
+    // stops within a second, leaving some crossings, and the result is still closed.
+    const TriangleMesh dome = hole_fill_seed("dome-316-edges-shifted-base");
+    ASSERT_TRUE(self_intersects(dome));
+    RepairReport r;
+    repaired_closed(dome, r);
+    EXPECT_TRUE(r.self_intersections_left);
 }
 
 TEST(Repair, ALongHoleWhoseBorderRunsOverItselfInItsPlaneIsFilledByAFanFromItsCentre)
 {
-    // A slit over 300° of the equator, 1,002 border edges: seen in the plane of its vector
-    // area the border runs over itself, so it is filled by a fan from its centroid, refined
-    // (and faired where that does not cross the surface). Time and memory stay about linear
-    // in the border (4.6 s and 147 MB in `lobesketch lobes`), and the surface is closed.
+    // A slit over 300° of the equator, 1,336 border edges: seen in the plane of its vector
+    // area the border runs over itself, and it is too long for the Delaunay search, so it is
+    // filled by a fan from its centroid, refined (and faired where that does not cross the
+    // surface). Time and memory stay about linear in the border (4.3 s and 163 MB in
+    // `lobesketch lobes`), and the surface is closed.
     RepairReport r;
-    const TriangleMesh out = repaired_keeping_every_triangle(sphere_with_slit(600, 120, 300.0), r);
+    const TriangleMesh out = repaired_keeping_every_triangle(sphere_with_slit(800, 120, 300.0), r);
     EXPECT_EQ(r.holes_fanned, 1u);
     EXPECT_EQ(self_intersecting_pairs(out).size(), r.hole_patch_crossings);
     bool noted = false;

@@ -1,0 +1,39 @@
+// libFuzzer target: repair_mesh on meshes with one long hole (over the 200 edges above which
+// holes are triangulated in their plane or fanned from their centre instead of CGAL's search
+// for the best patch; docs/lobes-from-models.md, step 4). A text mesh small enough for the
+// other mesh targets cannot hold such a hole, so the bytes choose a shape and bend it
+// (tests/hole_meshes.h, hole_fill_mesh, which the repair tests use for the findings too):
+//   byte 0      shape: even a dome whose open base runs up and down in waves, odd a sphere
+//               with a slit along its equator;
+//   bytes 1–2   border edges (dome: 201–700) or the slit's length (sphere: 60°–330°);
+//   byte 3      waves (dome) or latitude bands (sphere: 20–83);
+//   byte 4      the waves' amplitude, 0–50° of latitude (dome);
+//   the rest    each byte moves one vertex (in order from the ring at the hole's edge) by up
+//               to ±5 % of the radius along an axis the byte also picks.
+// The input may intersect itself (a steep base folds the dome's first band). The promise:
+// a closed, 2-manifold, outward-oriented surface, or a one-line refusal; a report whose counts
+// add up; one-line notes; and within the fuzzer's time and memory limits.
+#include <cstdint>
+
+#include "fuzz/fuzz_common.h"
+#include "meshing/mesh_quality.h"
+#include "meshing/repair.h"
+#include "tests/hole_meshes.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
+{
+    const lobe::TriangleMesh m = lobe::test::hole_fill_mesh(data, size);
+    if (m.triangles.empty()) return 0;
+    return lobe::fuzz::run_reader([&] {
+        lobe::RepairReport report;
+        const lobe::TriangleMesh repaired = lobe::repair_mesh(m, &report);
+        lobe::fuzz::check_mesh(repaired);
+        const lobe::MeshQuality q = lobe::measure_quality(repaired);
+        lobe::fuzz::require(q.closed && q.manifold && q.outward, "a repaired mesh that is not closed, 2-manifold and outward");
+        lobe::fuzz::require(report.output_triangles == repaired.triangles.size(), "a repair report that miscounts the triangles");
+        lobe::fuzz::require(report.holes_faired + report.holes_not_faired <= report.holes_filled &&
+                                report.holes_fanned <= report.holes_filled,
+                            "a repair report whose hole counts do not add up");
+        for (const std::string& note : report.notes) lobe::fuzz::check_one_line(note.c_str());
+    });
+}
