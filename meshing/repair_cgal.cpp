@@ -195,34 +195,20 @@ struct CollectFaces {
 bool fill_large_hole(Mesh& mesh, Mesh::Halfedge_index h, bool unfaired, std::vector<Mesh::Face_index>& new_faces,
                      std::vector<VertexIndex>& new_vertices, bool& by_fan)
 {
-    double c[3] = {0, 0, 0};
-    std::size_t n = 0;
-    for (VertexIndex v : CGAL::vertices_around_face(h, mesh)) {
-        const Point& p = mesh.point(v);
-        c[0] += p.x();
-        c[1] += p.y();
-        c[2] += p.z();
-        ++n;
-    }
+    std::vector<Point> ring; // the border, from h on
+    for (VertexIndex v : CGAL::vertices_around_face(h, mesh)) ring.push_back(mesh.point(v));
     by_fan = false;
     std::vector<Mesh::Face_index> patch;
     CGAL::Euler::fill_hole(h, mesh);
     // triangulate_face refuses a polygon that runs over itself in its plane only after
     // inserting every crossing exactly, which takes minutes on a steep zig-zag: the polygon is
     // tested first (a sweep), seen along the normal triangulate_face uses.
-    bool simple = false;
-    {
-        const Kernel::Vector_3 normal = PMP::compute_face_normal(mesh.face(h), mesh);
-        if (normal != CGAL::NULL_VECTOR) {
-            std::vector<Point> ring;
-            ring.reserve(n);
-            for (VertexIndex v : CGAL::vertices_around_face(h, mesh)) ring.push_back(mesh.point(v));
-            simple = CGAL::is_simple_2(ring.begin(), ring.end(), CGAL::Projection_traits_3<Kernel>(normal));
-        }
-    }
+    const Kernel::Vector_3 normal = PMP::compute_face_normal(mesh.face(h), mesh);
+    const bool simple = normal != CGAL::NULL_VECTOR &&
+                        CGAL::is_simple_2(ring.begin(), ring.end(), CGAL::Projection_traits_3<Kernel>(normal));
     if (!simple || !PMP::triangulate_face(mesh.face(h), mesh, PMP::parameters::visitor(CollectFaces{&patch}))) {
         patch.clear();
-        if (n <= kSearchedHole) {
+        if (ring.size() <= kSearchedHole) {
             CGAL::Euler::remove_face(h, mesh); // a hole again (a refusing triangulate_face leaves the polygon)
             PMP::triangulate_hole(mesh, h, std::back_inserter(patch),
                                   PMP::parameters::use_2d_constrained_delaunay_triangulation(false)
@@ -233,7 +219,13 @@ bool fill_large_hole(Mesh& mesh, Mesh::Halfedge_index h, bool unfaired, std::vec
             by_fan = true;
             const Mesh::Halfedge_index spoke = CGAL::Euler::add_center_vertex(h, mesh);
             const VertexIndex centre = mesh.target(spoke);
-            const double inv = 1.0 / static_cast<double>(n);
+            double c[3] = {0, 0, 0};
+            for (const Point& p : ring) {
+                c[0] += p.x();
+                c[1] += p.y();
+                c[2] += p.z();
+            }
+            const double inv = 1.0 / static_cast<double>(ring.size());
             mesh.point(centre) = Point(c[0] * inv, c[1] * inv, c[2] * inv);
             new_vertices.push_back(centre);
             for (auto f : CGAL::faces_around_target(spoke, mesh)) patch.push_back(f);
