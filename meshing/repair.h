@@ -32,6 +32,10 @@ struct RepairReport {
                                              ///< too) crosses itself or the surface: left as they are
     std::size_t components = 0;              ///< connected components before keeping the largest
     std::size_t removed_component_triangles = 0; ///< triangles of the smaller components, dropped
+    std::size_t crossing_pairs = 0;          ///< pairs of intersecting triangles step 5 set out to remove
+    unsigned removal_steps = 0;              ///< cuts step 5 made (each one ring wider)
+    std::size_t cut_triangles = 0;           ///< triangles those cuts took out
+    std::size_t cut_holes_filled = 0;        ///< holes those cuts left, filled as in step 4
     bool self_intersections_left = false;    ///< the input self-intersected and not all could be removed
     bool reoriented = false;                 ///< all faces were flipped to point outward
     std::size_t output_vertices = 0;
@@ -57,8 +61,9 @@ struct RepairReport {
 ///    where a patch still crosses itself or the surface and the rest of the mesh does not
 ///    self-intersect, the crossings are left (RepairReport::hole_patch_crossings) rather
 ///    than handed to step 5, which can take minutes on them and cut away much of the mesh;
-/// 5. removes self-intersections where it can (CGAL's experimental
-///    remove_self_intersections, preserve_genus(false)); what is left is reported in
+/// 5. removes self-intersections where it can: cuts out the crossing triangles with a ring
+///    of neighbours (one ring wider at each of up to four steps, never the whole mesh),
+///    keeps the largest piece and fills the holes as in step 4; what is left is reported in
 ///    RepairReport::self_intersections_left, not thrown;
 /// 6. orients the faces outward (is_outward_oriented, reverse_face_orientations).
 /// Feature edges of the input are dropped. `report` (optional) receives what was done.
@@ -71,13 +76,6 @@ TriangleMesh repair_mesh(const TriangleMesh& mesh, RepairReport* report = nullpt
 /// oriented outward (…)", unless `mesh` (measured as `q`) is closed, 2-manifold and encloses
 /// a positive volume of at least a millionth of its bounding cube (its largest side cubed).
 void check_encloses_volume(const TriangleMesh& mesh, const MeshQuality& q, const std::string& what);
-
-/// Removes self-intersections where it can: CGAL's experimental remove_self_intersections
-/// (preserve_genus(false)) takes out the faces involved and fills the gaps by smoothing or
-/// re-triangulating; the result may have holes or several components (repair_mesh deals
-/// with them). Feature edges are dropped. Returns true when none is left.
-/// \pre mesh is 2-manifold. \throw InvalidInput when it is not.
-bool remove_self_intersections(TriangleMesh& mesh);
 
 /// True when two non-adjacent triangles of `mesh` intersect
 /// (CGAL::Polygon_mesh_processing::does_self_intersect).

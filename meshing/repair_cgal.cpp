@@ -1,5 +1,5 @@
-// Mesh repair with CGAL's Polygon Mesh Processing (self-intersections are in
-// self_intersections_cgal.cpp, a translation unit of their own: they double the compile time). Works on CGAL::Surface_mesh rather than
+// Mesh repair with CGAL's Polygon Mesh Processing (finding self-intersections is in
+// self_intersections_cgal.cpp, a translation unit of its own). Works on CGAL::Surface_mesh rather than
 // OpenMesh: the soup-to-mesh functions, hole filling and component removal need no
 // per-element status bookkeeping there, and nothing outside this file sees the type.
 #include "meshing/repair.h"
@@ -8,6 +8,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <iterator>
 #include <map>
 #include <optional>
@@ -29,6 +30,7 @@
 #include <CGAL/Polygon_2_algorithms.h>
 #include <CGAL/Projection_traits_3.h>
 #include <CGAL/boost/graph/Euler_operations.h>
+#include <CGAL/boost/graph/selection.h>
 #include <CGAL/Polygon_mesh_processing/border.h>
 #include <CGAL/Polygon_mesh_processing/compute_normal.h>
 #include <CGAL/Polygon_mesh_processing/connected_components.h>
@@ -301,7 +303,7 @@ std::optional<std::vector<std::array<std::size_t, 2>>> crossing_pairs(const Tria
 /// Fairing keeps the patch's interior smooth but not out of the surface's way: over a long,
 /// wavy border (the open base of a scan, say) the faired patch can fold through itself or
 /// the surface. Those holes are filled again with the refined patch alone, which lies on the
-/// border's triangulation. Left to remove_self_intersections, such a fold cost a minute on a
+/// border's triangulation. Left to CGAL's self-intersection removal, such a fold cost a minute on a
 /// 1,000-edge border and took most of the mesh with it. The patch faces stay marked
 /// (patch_map) for the self-intersection step, and `pairs` (when given) receives the
 /// intersecting pairs of the result when they were found on the way (one pass saved).
@@ -345,6 +347,112 @@ void fill_holes(Mesh& mesh, RepairReport& r, std::optional<std::vector<std::arra
     if (!CGAL::is_closed(mesh))
         throw InvalidInput("repair_mesh: a hole could not be filled (" + std::to_string(borders.size() - n.filled) +
                            " of " + std::to_string(borders.size()) + " left open)");
+}
+
+/// Steps of cut_out_crossings; each cuts one ring wider round what still crosses.
+constexpr unsigned kRemovalSteps = 4;
+
+/// `mesh` without the faces `cut` flags, its vertices renumbered (unused ones dropped).
+Mesh without_faces(const Mesh& mesh, Mesh::Property_map<Mesh::Face_index, bool> cut)
+{
+    std::vector<Point> points;
+    std::vector<Polygon> polygons;
+    std::vector<std::size_t> index(mesh.number_of_vertices() + mesh.number_of_removed_vertices(), SIZE_MAX);
+    for (auto f : mesh.faces()) {
+        if (cut[f]) continue;
+        Polygon t;
+        for (VertexIndex v : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) {
+            std::size_t& i = index[v.idx()];
+            if (i == SIZE_MAX) {
+                i = points.size();
+                points.push_back(mesh.point(v));
+            }
+            t.push_back(i);
+        }
+        polygons.push_back(std::move(t));
+    }
+    Mesh out;
+    PMP::polygon_soup_to_polygon_mesh(points, polygons, out);
+    return out;
+}
+
+/// What cut_out_crossings left, and why it stopped.
+struct Removal {
+    std::size_t left = 0; ///< crossing pairs left
+    enum class Stop { Clean, Steps, WholeMesh, Unfillable } stop = Stop::Clean;
+};
+
+/// Removes self-intersections (the cow's tail runs into its body) by cutting out the
+/// crossing triangles, `pairs` (indices in the order to_triangle_mesh writes the faces), with
+/// one ring of neighbours at the first step, two at the second and so on, widened so that the
+/// cut pinches no vertex (expand_face_selection_for_removal); then the largest piece is kept
+/// and the holes are filled as in step 4 (fill_holes), whose time and memory are bounded by
+/// the border: CGAL's full search only up to kLargeHole edges, linear work beyond. Stops when
+/// nothing crosses, after kRemovalSteps, or before a cut that would take the whole mesh or
+/// leave a hole that cannot be filled (the mesh is then kept as it was before that step).
+/// Counts the cuts in `r` (removal_steps, cut_triangles, cut_holes_filled).
+///
+/// Our own rather than CGAL's experimental remove_self_intersections, which bounds neither
+/// time nor memory: it smooths each region for 100 rounds, projecting every vertex onto the
+/// region's input in each, after growing the region to the bounding box of its crossings (on
+/// a dome folded through its first band, tens of thousands of vertices: 20 s in release,
+/// minutes under ASan); and it fills what it cuts with CGAL's full hole search, whose memory
+/// grows with the square of the border. On the cow it also cut the tail off, where this keeps it.
+Removal cut_out_crossings(Mesh& mesh, std::vector<std::array<std::size_t, 2>> pairs, RepairReport& r)
+{
+    Removal out;
+    while (!pairs.empty()) {
+        if (r.removal_steps == kRemovalSteps) {
+            out.stop = Removal::Stop::Steps;
+            break;
+        }
+        mesh.collect_garbage(); // face i is triangle i of to_triangle_mesh
+        auto cut = mesh.add_property_map<Mesh::Face_index, bool>("f:lobe_cut", false).first;
+        std::vector<Mesh::Face_index> seeds;
+        for (const auto& pair : pairs)
+            for (std::size_t t : pair) {
+                const Mesh::Face_index f(static_cast<Mesh::size_type>(t));
+                if (t < mesh.number_of_faces() && !cut[f]) {
+                    cut[f] = true;
+                    seeds.push_back(f);
+                }
+            }
+        const unsigned rings = r.removal_steps + 1;
+        std::vector<Mesh::Face_index> grown = seeds;
+        CGAL::expand_face_selection(seeds, mesh, rings, cut, std::back_inserter(grown));
+        CGAL::expand_face_selection_for_removal(grown, mesh, cut);
+        std::size_t n = 0;
+        for (auto f : mesh.faces()) n += cut[f] ? 1 : 0;
+        if (n >= mesh.number_of_faces()) {
+            mesh.remove_property_map(cut);
+            out.stop = Removal::Stop::WholeMesh;
+            break;
+        }
+        Mesh next = without_faces(mesh, cut);
+        mesh.remove_property_map(cut);
+        // The fills' own notes are left out: the removal's note says it filled the gaps.
+        RepairReport trial = r, fills;
+        try {
+            keep_largest_component(next, trial);
+            fill_holes(next, fills);
+        } catch (const InvalidInput&) {
+            out.stop = Removal::Stop::Unfillable;
+            break;
+        }
+        r = std::move(trial);
+        r.removal_steps = rings;
+        r.cut_triangles += n;
+        r.cut_holes_filled += fills.holes_filled;
+        mesh = std::move(next);
+        auto found = crossing_pairs(to_triangle_mesh(mesh));
+        if (!found) { // cannot happen on a filled mesh; the old pairs then count as left
+            out.stop = Removal::Stop::Unfillable;
+            break;
+        }
+        pairs = std::move(*found);
+    }
+    out.left = pairs.size();
+    return out;
 }
 
 } // namespace
@@ -424,16 +532,15 @@ TriangleMesh repair_mesh(const TriangleMesh& in, RepairReport* report)
     // Copies of split vertices would make the surface touch itself at a point.
     if (separate_coincident_vertices(mesh) > 0) known_pairs.reset();
 
-    // 5. Self-intersections (the cow's tail runs into its body): CGAL's experimental local
-    //    repair removes the faces involved and fills the gap, smoothing or re-triangulating;
-    //    with preserve_genus(false) it may also cut through a handle, which a lobe (an
-    //    envelope of foliage) does not mind.
+    // 5. Self-intersections (the cow's tail runs into its body): cut_out_crossings cuts out
+    //    the faces involved with a growing ring round them and fills the gaps as in step 4; it
+    //    may also cut through a handle, which a lobe (an envelope of foliage) does not mind.
     //    Where only hole patches cross (their own triangles or the surface's), the crossings
-    //    are left: the removal can take minutes on a patch over a long zig-zag border and
-    //    cut away much of the mesh, and a lobe is an envelope of attractors, which a fold at
-    //    its filled base hardly changes.
+    //    are left: cutting a patch over a long zig-zag border out again gives the same
+    //    border back, and a lobe is an envelope of attractors, which a fold at its filled
+    //    base hardly changes.
     {
-        TriangleMesh tm = to_triangle_mesh(mesh);
+        const TriangleMesh tm = to_triangle_mesh(mesh);
         const std::vector<std::size_t> patch_of = patch_of_faces(mesh);
         const auto pairs = known_pairs ? std::move(*known_pairs) : self_intersecting_pairs(tm);
         const bool patches_only = std::all_of(pairs.begin(), pairs.end(), [&](const std::array<std::size_t, 2>& p) {
@@ -444,16 +551,25 @@ TriangleMesh repair_mesh(const TriangleMesh& in, RepairReport* report)
             r.notes.push_back("left " + std::to_string(pairs.size()) +
                               " crossings of a filled hole's triangles with themselves or the surface");
         } else if (!pairs.empty()) {
-            r.self_intersections_left = !remove_self_intersections(tm);
-            r.notes.push_back(r.self_intersections_left ? "some self-intersections could not be removed"
-                                                        : "removed self-intersections");
-            mesh.clear();
-            std::vector<Point> pts;
-            std::vector<Polygon> polys;
-            to_soup(tm, "repair_mesh", pts, polys);
-            PMP::polygon_soup_to_polygon_mesh(pts, polys, mesh);
-            keep_largest_component(mesh, r);
-            fill_holes(mesh, r);
+            r.crossing_pairs = pairs.size();
+            const Removal removal = cut_out_crossings(mesh, pairs, r);
+            r.self_intersections_left = removal.left > 0;
+            const std::string cuts = std::to_string(r.cut_triangles) + " triangles round them in " +
+                                     std::to_string(r.removal_steps) + (r.removal_steps == 1 ? " step" : " steps");
+            using Stop = Removal::Stop;
+            std::string note;
+            if (removal.left == 0) {
+                note = "removed self-intersections (" + std::to_string(pairs.size()) + " crossing pairs; cut out " + cuts +
+                       " and filled the " + std::to_string(r.cut_holes_filled) + " holes left)";
+            } else {
+                note = "some self-intersections could not be removed (" + std::to_string(pairs.size()) + " crossing pairs";
+                if (r.removal_steps > 0)
+                    note += ", " + std::to_string(removal.left) + " left after cutting out " + cuts;
+                note += removal.stop == Stop::WholeMesh    ? ": cutting them out would take the whole mesh)"
+                        : removal.stop == Stop::Unfillable ? ": a cut left a hole that could not be filled)"
+                                                           : ")";
+            }
+            r.notes.push_back(note);
         }
     }
 

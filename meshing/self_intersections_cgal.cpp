@@ -1,6 +1,5 @@
-// Self-intersection test and removal (CGAL Polygon Mesh Processing on a Surface_mesh), in a
-// translation unit of their own: repair_self_intersections.h alone takes about as long to
-// compile as the rest of the repair code.
+// Self-intersection tests (CGAL Polygon Mesh Processing on a Surface_mesh), in a translation
+// unit of their own: self_intersections.h is heavy to compile.
 #include "meshing/repair.h"
 
 #include <array>
@@ -22,7 +21,6 @@
 #endif
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
-#include <CGAL/Polygon_mesh_processing/repair_self_intersections.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Surface_mesh.h>
 #pragma GCC diagnostic pop
@@ -80,38 +78,6 @@ std::vector<std::array<std::size_t, 2>> self_intersecting_pairs(const TriangleMe
     out.reserve(pairs.size());
     for (const auto& [f, g] : pairs) out.push_back({static_cast<std::size_t>(f.idx()), static_cast<std::size_t>(g.idx())});
     return out;
-}
-
-bool remove_self_intersections(TriangleMesh& mesh)
-{
-    Mesh sm = to_surface_mesh(mesh, "remove_self_intersections");
-    // With preserve_genus(true) CGAL left 19 intersecting pairs on the cow; a lobe (an
-    // envelope of foliage) does not mind a cut handle.
-    // Four steps, not CGAL's default seven: each step widens the region smoothed round what is
-    // left, and on a 1,900-vertex dome whose shifted base runs through its first band (found by
-    // the hole_fill fuzz target) one component's smoothing in a later step ran for minutes
-    // (3.5 min in all, against 1 s with four steps and some crossings left). The cow is clean
-    // after three, and the four reference models repair to the same bytes as with seven.
-    // This narrows what can take long; it bounds nothing (docs/lobes-from-models.md, Limits).
-    PMP::experimental::remove_self_intersections(faces(sm), sm,
-                                                 CGAL::parameters::preserve_genus(false).number_of_iterations(4));
-    const bool clean = !PMP::does_self_intersect(sm);
-    sm.collect_garbage();
-    TriangleMesh out;
-    out.positions.reserve(sm.number_of_vertices());
-    for (auto v : sm.vertices()) {
-        const Point& p = sm.point(v);
-        out.positions.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
-    }
-    for (auto f : sm.faces()) {
-        std::array<int, 3> t{};
-        int k = 0;
-        for (auto v : CGAL::vertices_around_face(sm.halfedge(f), sm))
-            if (k < 3) t[static_cast<std::size_t>(k++)] = static_cast<int>(v.idx());
-        out.triangles.push_back(t);
-    }
-    mesh = std::move(out);
-    return clean;
 }
 
 } // namespace lobe
