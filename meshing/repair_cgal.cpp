@@ -560,7 +560,9 @@ TriangleMesh repair_mesh(const TriangleMesh& in, RepairReport* report)
             std::string note;
             if (removal.left == 0) {
                 note = "removed self-intersections (" + std::to_string(pairs.size()) + " crossing pairs; cut out " + cuts +
-                       " and filled the " + std::to_string(r.cut_holes_filled) + " holes left)";
+                       " and filled the " +
+                       (r.cut_holes_filled == 1 ? std::string("hole") : std::to_string(r.cut_holes_filled) + " holes") +
+                       " left)";
             } else {
                 note = "some self-intersections could not be removed (" + std::to_string(pairs.size()) + " crossing pairs";
                 if (r.removal_steps > 0)
