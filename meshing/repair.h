@@ -36,6 +36,7 @@ struct RepairReport {
     unsigned removal_steps = 0;              ///< cuts step 5 made (each one ring wider)
     std::size_t cut_triangles = 0;           ///< triangles those cuts took out
     std::size_t cut_holes_filled = 0;        ///< holes those cuts left, filled as in step 4
+    std::size_t crossing_pairs_left = 0;     ///< of those, or of the pairs the cuts made, left
     bool self_intersections_left = false;    ///< the input self-intersected and not all could be removed
     bool reoriented = false;                 ///< all faces were flipped to point outward
     std::size_t output_vertices = 0;

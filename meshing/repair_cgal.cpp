@@ -539,6 +539,7 @@ TriangleMesh repair_mesh(const TriangleMesh& in, RepairReport* report)
     //    are left: cutting a patch over a long zig-zag border out again gives the same
     //    border back, and a lobe is an envelope of attractors, which a fold at its filled
     //    base hardly changes.
+    std::string removal_note;
     {
         const TriangleMesh tm = to_triangle_mesh(mesh);
         const std::vector<std::size_t> patch_of = patch_of_faces(mesh);
@@ -553,6 +554,7 @@ TriangleMesh repair_mesh(const TriangleMesh& in, RepairReport* report)
         } else if (!pairs.empty()) {
             r.crossing_pairs = pairs.size();
             const Removal removal = cut_out_crossings(mesh, pairs, r);
+            r.crossing_pairs_left = removal.left;
             r.self_intersections_left = removal.left > 0;
             const std::string cuts = std::to_string(r.cut_triangles) + " triangles round them in " +
                                      std::to_string(r.removal_steps) + (r.removal_steps == 1 ? " step" : " steps");
@@ -572,6 +574,7 @@ TriangleMesh repair_mesh(const TriangleMesh& in, RepairReport* report)
                                                            : ")";
             }
             r.notes.push_back(note);
+            removal_note = note;
         }
     }
 
@@ -584,7 +587,13 @@ TriangleMesh repair_mesh(const TriangleMesh& in, RepairReport* report)
 
     TriangleMesh out = to_triangle_mesh(mesh);
     const MeshQuality q = measure_quality(out);
-    check_encloses_volume(out, q, "repair_mesh: the result");
+    try {
+        check_encloses_volume(out, q, "repair_mesh: the result");
+    } catch (const InvalidInput& e) {
+        if (!r.self_intersections_left) throw;
+        // A surface that still passes through itself has no consistent inside: say why.
+        throw InvalidInput(std::string(e.what()) + "; " + removal_note);
+    }
     r.output_vertices = out.positions.size();
     r.output_triangles = out.triangles.size();
     if (report) *report = std::move(r);

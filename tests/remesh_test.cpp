@@ -406,6 +406,7 @@ TriangleMesh repaired_without_crossings(const TriangleMesh& in, RepairReport& r)
     TriangleMesh out = repaired_closed(in, r);
     EXPECT_GT(r.crossing_pairs, 0u);
     EXPECT_FALSE(r.self_intersections_left);
+    EXPECT_EQ(r.crossing_pairs_left, 0u);
     EXPECT_FALSE(self_intersects(out));
     EXPECT_GE(r.removal_steps, 1u);
     EXPECT_LE(r.removal_steps, 4u);
@@ -435,6 +436,56 @@ TEST(Repair, ADomeFoldedThroughItsFirstBandIsCutClearAndKeepsItsUpperHalf)
     RepairReport r;
     const TriangleMesh out = repaired_without_crossings(hole_fill_seed("dome-638-edges-folded-and-shifted"), r);
     EXPECT_GT(measure_quality(out).signed_volume_m3, 2.0 * 3.14159265 / 3.0);
+}
+
+/// A closed UV sphere (24 longitudes, 16 bands, unit radius) whose vertices are each moved
+/// along x, y and z by up to ±`amplitude`/2 (a fixed pseudo-random sequence), so that it
+/// passes through itself in many places.
+TriangleMesh scrambled_sphere(double amplitude)
+{
+    TriangleMesh m = sphere_with_slit(24, 16, 0.0);
+    std::uint32_t state = 12345;
+    auto next = [&] {
+        state = state * 1664525u + 1013904223u;
+        return static_cast<double>(state >> 8) / 16777216.0 - 0.5;
+    };
+    for (glm::vec3& p : m.positions) {
+        const double dx = next(), dy = next(), dz = next();
+        p += glm::vec3(glm::dvec3(dx, dy, dz) * amplitude);
+    }
+    return m;
+}
+
+TEST(Repair, ASphereWithScrambledVerticesIsCutClearOfItsCrossings)
+{
+    // Vertices moved by up to ±15 % of the radius: 335 crossing pairs, cleared in one cut.
+    const TriangleMesh sphere = scrambled_sphere(0.3);
+    ASSERT_TRUE(self_intersects(sphere));
+    RepairReport r;
+    const TriangleMesh out = repair_mesh(sphere, &r);
+    EXPECT_GT(r.crossing_pairs, 100u);
+    EXPECT_FALSE(r.self_intersections_left);
+    EXPECT_EQ(r.crossing_pairs_left, 0u);
+    EXPECT_FALSE(self_intersects(out));
+    const MeshQuality q = measure_quality(out);
+    EXPECT_TRUE(q.closed && q.manifold && q.outward);
+    // Most of the ball is kept: at least half of a unit sphere's 4.19 m³.
+    EXPECT_GT(q.signed_volume_m3, 0.5 * 4.0 * 3.14159265 / 3.0);
+}
+
+TEST(Repair, ASurfaceThatCrossesItselfAlmostEverywhereIsRefusedInOneLineSayingWhy)
+{
+    // Moved by up to ±30 % of the radius, nearly every triangle crosses another, so a cut
+    // would take the whole mesh; what is left has no consistent inside.
+    try {
+        repair_mesh(scrambled_sphere(0.6));
+        FAIL() << "a sphere that crosses itself nearly everywhere was accepted";
+    } catch (const InvalidInput& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("some self-intersections could not be removed"), std::string::npos) << what;
+        EXPECT_NE(what.find("cutting them out would take the whole mesh"), std::string::npos) << what;
+        EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    }
 }
 
 TEST(Repair, TheCowKeepsItsTailWhenItsSelfIntersectionsAreCutOut)
