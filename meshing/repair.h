@@ -28,8 +28,6 @@ struct RepairReport {
     std::size_t holes_fanned = 0;            ///< of those, holes of over 200 edges that run over
                                              ///< themselves in their plane and got no searched
                                              ///< patch: filled by a fan from their centroid
-    std::size_t hole_patch_crossings = 0;    ///< pairs of triangles where a hole's patch (unfaired
-                                             ///< too) crosses itself or the surface: left as they are
     std::size_t components = 0;              ///< connected components before keeping the largest
     std::size_t removed_component_triangles = 0; ///< triangles of the smaller components, dropped
     std::size_t crossing_pairs = 0;          ///< pairs of intersecting triangles step 5 set out to remove
@@ -59,10 +57,8 @@ struct RepairReport {
 ///    faired (CGAL's full search takes memory and time that grow much faster than the
 ///    border there: gigabytes, or hours); a faired patch that intersects itself or the surface (a long,
 ///    wavy border) is replaced by the refined patch without fairing;
-///    where a patch still crosses itself or the surface and the rest of the mesh does not
-///    self-intersect, the crossings are left (RepairReport::hole_patch_crossings) rather
-///    than handed to step 5, which can take minutes on them and cut away much of the mesh;
-/// 5. removes self-intersections where it can: cuts out the crossing triangles with a ring
+/// 5. removes self-intersections (the input's, or a patch's that still crosses) where it
+///    can: cuts out the crossing triangles with a ring
 ///    of neighbours (one ring wider at each of up to four steps, never the whole mesh),
 ///    keeps the largest piece and fills the holes as in step 4; what is left is reported in
 ///    RepairReport::self_intersections_left, not thrown;

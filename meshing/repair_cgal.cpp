@@ -272,8 +272,8 @@ FillCounts fill_holes_once(Mesh& mesh, const std::vector<Mesh::Halfedge_index>& 
     return n;
 }
 
-/// Which hole's patch each face of `mesh` belongs to (1 + its index; 0: none), kept from
-/// fill_holes to the self-intersection step; in the order to_triangle_mesh writes the faces.
+/// Which hole's patch each face of `mesh` belongs to (1 + its index; 0: none), for fill_holes
+/// to tell which patches cross; in the order to_triangle_mesh writes the faces.
 Mesh::Property_map<Mesh::Face_index, std::size_t> patch_map(Mesh& mesh)
 {
     return mesh.add_property_map<Mesh::Face_index, std::size_t>("f:lobe_patch", 0).first;
@@ -304,8 +304,7 @@ std::optional<std::vector<std::array<std::size_t, 2>>> crossing_pairs(const Tria
 /// wavy border (the open base of a scan, say) the faired patch can fold through itself or
 /// the surface. Those holes are filled again with the refined patch alone, which lies on the
 /// border's triangulation. Left to CGAL's self-intersection removal, such a fold cost a minute on a
-/// 1,000-edge border and took most of the mesh with it. The patch faces stay marked
-/// (patch_map) for the self-intersection step, and `pairs` (when given) receives the
+/// 1,000-edge border and took most of the mesh with it. `pairs` (when given) receives the
 /// intersecting pairs of the result when they were found on the way (one pass saved).
 /// \throw InvalidInput when a hole stays open.
 void fill_holes(Mesh& mesh, RepairReport& r, std::optional<std::vector<std::array<std::size_t, 2>>>* pairs = nullptr)
@@ -532,26 +531,14 @@ TriangleMesh repair_mesh(const TriangleMesh& in, RepairReport* report)
     // Copies of split vertices would make the surface touch itself at a point.
     if (separate_coincident_vertices(mesh) > 0) known_pairs.reset();
 
-    // 5. Self-intersections (the cow's tail runs into its body): cut_out_crossings cuts out
-    //    the faces involved with a growing ring round them and fills the gaps as in step 4; it
-    //    may also cut through a handle, which a lobe (an envelope of foliage) does not mind.
-    //    Where only hole patches cross (their own triangles or the surface's), the crossings
-    //    are left: cutting a patch over a long zig-zag border out again gives the same
-    //    border back, and a lobe is an envelope of attractors, which a fold at its filled
-    //    base hardly changes.
+    // 5. Self-intersections (the cow's tail runs into its body, or a hole's patch over a
+    //    steep zig-zag border crosses the surface): cut_out_crossings cuts out the faces
+    //    involved with a growing ring round them and fills the gaps as in step 4; it may also
+    //    cut through a handle, which a lobe (an envelope of foliage) does not mind.
     std::string removal_note;
     {
-        const TriangleMesh tm = to_triangle_mesh(mesh);
-        const std::vector<std::size_t> patch_of = patch_of_faces(mesh);
-        const auto pairs = known_pairs ? std::move(*known_pairs) : self_intersecting_pairs(tm);
-        const bool patches_only = std::all_of(pairs.begin(), pairs.end(), [&](const std::array<std::size_t, 2>& p) {
-            return (p[0] < patch_of.size() && patch_of[p[0]] > 0) || (p[1] < patch_of.size() && patch_of[p[1]] > 0);
-        });
-        if (!pairs.empty() && patches_only) {
-            r.hole_patch_crossings = pairs.size();
-            r.notes.push_back("left " + std::to_string(pairs.size()) +
-                              " crossings of a filled hole's triangles with themselves or the surface");
-        } else if (!pairs.empty()) {
+        const auto pairs = known_pairs ? std::move(*known_pairs) : self_intersecting_pairs(to_triangle_mesh(mesh));
+        if (!pairs.empty()) {
             r.crossing_pairs = pairs.size();
             const Removal removal = cut_out_crossings(mesh, pairs, r);
             r.crossing_pairs_left = removal.left;
