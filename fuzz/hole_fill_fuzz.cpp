@@ -12,7 +12,8 @@
 //               to ±5 % of the radius along an axis the byte also picks.
 // The input may intersect itself (a steep base folds the dome's first band). The promise:
 // a closed, 2-manifold, outward-oriented surface, or a one-line refusal; a report whose counts
-// add up; one-line notes; and within the fuzzer's time and memory limits.
+// add up; one-line notes; no self-intersection unless the report says some were left; and
+// within the fuzzer's time and memory limits.
 #include <cstdint>
 
 #include "fuzz/fuzz_common.h"
@@ -35,5 +36,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                                 report.holes_fanned <= report.holes_filled,
                             "a repair report whose hole counts do not add up");
         for (const std::string& note : report.notes) lobe::fuzz::check_one_line(note.c_str());
+        lobe::fuzz::require(report.self_intersections_left == (report.crossing_pairs_left > 0),
+                            "a repair report whose crossings left do not add up");
+        lobe::fuzz::require(report.self_intersections_left || !lobe::self_intersects(repaired),
+                            "a repaired mesh reported free of self-intersections that has some");
     });
 }

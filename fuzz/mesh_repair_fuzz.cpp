@@ -1,7 +1,8 @@
 // libFuzzer target: OBJ meshes read by parse_mesh, repaired (repair_mesh, the first step of
 // `lobesketch lobes MESH`) and remeshed by our rounds (remesh_isotropic with own_rounds, as
 // every lobe drawn with strokes is remeshed). Repair either returns a closed, 2-manifold,
-// outward-oriented surface or refuses with a one-line InvalidInput; so does the remeshing.
+// outward-oriented surface, free of self-intersections unless its report says some were
+// left, or refuses with a one-line InvalidInput; so does the remeshing.
 //
 // The remeshing runs at 15 cm instead of 3 cm so that one input takes milliseconds; its code
 // paths are the same. It does not run CGAL's own rounds, which lobes from models use: CGAL
@@ -29,6 +30,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         lobe::fuzz::require(q.closed && q.manifold && q.outward, "a repaired mesh that is not closed, 2-manifold and outward");
         lobe::fuzz::require(report.output_triangles == repaired.triangles.size(), "a repair report that miscounts the triangles");
         for (const std::string& note : report.notes) lobe::fuzz::check_one_line(note.c_str());
+        lobe::fuzz::require(report.self_intersections_left == (report.crossing_pairs_left > 0),
+                            "a repair report whose crossings left do not add up");
+        lobe::fuzz::require(report.self_intersections_left || !lobe::self_intersects(repaired),
+                            "a repaired mesh reported free of self-intersections that has some");
 
         lobe::RemeshOptions options;
         options.target_edge_length_m = 0.15;
