@@ -330,6 +330,10 @@ def hole_fill_seeds():
     # a 638-edge base swinging ±37° in 241 waves and shifted 4 cm through the dome's first
     # band: over 30 s under ASan in CGAL's removal, which the project's own cut replaced
     put("hole_fill", "dome-638-edges-folded-and-shifted", bytes.fromhex("00" + "f1" * 73 + "31750000"))
+    # a 700-edge base of 93 waves of ±38°, vertices moved: the first cut's patch repeated an
+    # edge of the surface, which the removal's first form kept (refused as not 2-manifold)
+    put("hole_fill", "dome-700-edges-93-waves-moved", bytes.fromhex(
+        "00f3015d8c1400f33e3e3e3e3e3e3e3e3e3e3e3e3e3e3e00f33e3e3e3e3e8c14"))
     put("hole_fill", "slit-300-degrees", slit(300, 40))
     put("hole_fill", "slit-120-degrees-bumped", slit(120, 30, bytes((i * 53) & 255 for i in range(200))))
 

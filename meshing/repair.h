@@ -31,7 +31,7 @@ struct RepairReport {
     std::size_t components = 0;              ///< connected components before keeping the largest
     std::size_t removed_component_triangles = 0; ///< triangles of the smaller components, dropped
     std::size_t crossing_pairs = 0;          ///< pairs of intersecting triangles step 5 set out to remove
-    unsigned removal_steps = 0;              ///< cuts step 5 made (each one ring wider)
+    unsigned removal_steps = 0;              ///< cuts step 5 kept (step k cuts k rings round the crossings)
     std::size_t cut_triangles = 0;           ///< triangles those cuts took out
     std::size_t cut_holes_filled = 0;        ///< holes those cuts left, filled as in step 4
     std::size_t crossing_pairs_left = 0;     ///< of those, or of the pairs the cuts made, left

@@ -387,9 +387,10 @@ struct Removal {
 /// cut pinches no vertex (expand_face_selection_for_removal); then the largest piece is kept
 /// and the holes are filled as in step 4 (fill_holes), whose time and memory are bounded by
 /// the border: CGAL's full search only up to kLargeHole edges, linear work beyond. Stops when
-/// nothing crosses, after kRemovalSteps, or before a cut that would take the whole mesh or
-/// leave a hole that cannot be filled (the mesh is then kept as it was before that step).
-/// Counts the cuts in `r` (removal_steps, cut_triangles, cut_holes_filled).
+/// nothing crosses, after kRemovalSteps rings, or before a cut that would take the whole
+/// mesh. A cut whose holes cannot be filled into a closed 2-manifold surface is not kept (the
+/// next step tries one ring wider). Counts the cuts kept in `r` (removal_steps,
+/// cut_triangles, cut_holes_filled).
 ///
 /// Our own rather than CGAL's experimental remove_self_intersections, which bounds neither
 /// time nor memory: it smooths each region for 100 rounds, projecting every vertex onto the
@@ -400,11 +401,8 @@ struct Removal {
 Removal cut_out_crossings(Mesh& mesh, std::vector<std::array<std::size_t, 2>> pairs, RepairReport& r)
 {
     Removal out;
-    while (!pairs.empty()) {
-        if (r.removal_steps == kRemovalSteps) {
-            out.stop = Removal::Stop::Steps;
-            break;
-        }
+    bool unfillable = false; // the last cut tried could not be filled into a 2-manifold surface
+    for (unsigned rings = 1; rings <= kRemovalSteps && !pairs.empty(); ++rings) {
         mesh.collect_garbage(); // face i is triangle i of to_triangle_mesh
         auto cut = mesh.add_property_map<Mesh::Face_index, bool>("f:lobe_cut", false).first;
         std::vector<Mesh::Face_index> seeds;
@@ -416,7 +414,6 @@ Removal cut_out_crossings(Mesh& mesh, std::vector<std::array<std::size_t, 2>> pa
                     seeds.push_back(f);
                 }
             }
-        const unsigned rings = r.removal_steps + 1;
         std::vector<Mesh::Face_index> grown = seeds;
         CGAL::expand_face_selection(seeds, mesh, rings, cut, std::back_inserter(grown));
         CGAL::expand_face_selection_for_removal(grown, mesh, cut);
@@ -431,26 +428,28 @@ Removal cut_out_crossings(Mesh& mesh, std::vector<std::array<std::size_t, 2>> pa
         mesh.remove_property_map(cut);
         // The fills' own notes are left out: the removal's note says it filled the gaps.
         RepairReport trial = r, fills;
+        std::optional<std::vector<std::array<std::size_t, 2>>> found;
         try {
             keep_largest_component(next, trial);
             fill_holes(next, fills);
+            // Nothing when the filled surface is not 2-manifold: a patch can add an edge the
+            // surface already has, where two of a hole's border vertices are also joined
+            // outside it (found by the hole_fill fuzz target: one edge of three triangles).
+            found = crossing_pairs(to_triangle_mesh(next));
         } catch (const InvalidInput&) {
-            out.stop = Removal::Stop::Unfillable;
-            break;
         }
+        unfillable = !found;
+        if (unfillable) continue; // not kept: the next step cuts a ring wider, bridges too
         r = std::move(trial);
-        r.removal_steps = rings;
+        ++r.removal_steps;
         r.cut_triangles += n;
         r.cut_holes_filled += fills.holes_filled;
         mesh = std::move(next);
-        auto found = crossing_pairs(to_triangle_mesh(mesh));
-        if (!found) { // cannot happen on a filled mesh; the old pairs then count as left
-            out.stop = Removal::Stop::Unfillable;
-            break;
-        }
         pairs = std::move(*found);
     }
     out.left = pairs.size();
+    if (out.left > 0 && out.stop == Removal::Stop::Clean)
+        out.stop = unfillable ? Removal::Stop::Unfillable : Removal::Stop::Steps;
     return out;
 }
 

@@ -447,6 +447,18 @@ TEST(Repair, ADomeFoldedThroughItsFirstBandIsCutClearAndKeepsItsUpperHalf)
     EXPECT_GT(measure_quality(out).signed_volume_m3, 2.0 * 3.14159265 / 3.0);
 }
 
+TEST(Repair, ACutWhoseHolesDoNotFillIntoAManifoldIsDroppedAndTriedOneRingWider)
+{
+    // The hole_fill fuzz target's fifth finding (its seed dome-700-edges-93-waves-moved): a
+    // 700-edge base of 93 waves of ±38°, vertices moved. Filling the first cut's hole left one
+    // edge with more than two triangles; the removal's first form kept that surface and the
+    // repair was refused as not 2-manifold. The cut is now dropped, and the next step's, two
+    // rings wide, fills into a clean surface.
+    RepairReport r;
+    repaired_without_crossings(hole_fill_seed("dome-700-edges-93-waves-moved"), r);
+    EXPECT_EQ(r.removal_steps, 1u);
+}
+
 /// A closed UV sphere (24 longitudes, 16 bands, unit radius) whose vertices are each moved
 /// along x, y and z by up to ±`amplitude`/2 (a fixed pseudo-random sequence), so that it
 /// passes through itself in many places.
