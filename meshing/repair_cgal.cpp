@@ -439,7 +439,7 @@ Removal cut_out_crossings(Mesh& mesh, std::vector<std::array<std::size_t, 2>> pa
         } catch (const InvalidInput&) {
         }
         unfillable = !found;
-        if (unfillable) continue; // not kept: the next step cuts a ring wider, bridges too
+        if (unfillable) continue; // not kept: the next step cuts one ring wider
         r = std::move(trial);
         ++r.removal_steps;
         r.cut_triangles += n;
