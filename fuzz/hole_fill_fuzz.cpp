@@ -17,7 +17,7 @@
 #include <cstdint>
 
 #include "fuzz/fuzz_common.h"
-#include "meshing/mesh_quality.h"
+#include "fuzz/repair_checks.h"
 #include "meshing/repair.h"
 #include "tests/hole_meshes.h"
 
@@ -28,17 +28,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     return lobe::fuzz::run_reader([&] {
         lobe::RepairReport report;
         const lobe::TriangleMesh repaired = lobe::repair_mesh(m, &report);
-        lobe::fuzz::check_mesh(repaired);
-        const lobe::MeshQuality q = lobe::measure_quality(repaired);
-        lobe::fuzz::require(q.closed && q.manifold && q.outward, "a repaired mesh that is not closed, 2-manifold and outward");
-        lobe::fuzz::require(report.output_triangles == repaired.triangles.size(), "a repair report that miscounts the triangles");
-        lobe::fuzz::require(report.holes_faired + report.holes_not_faired <= report.holes_filled &&
-                                report.holes_fanned <= report.holes_filled,
-                            "a repair report whose hole counts do not add up");
-        for (const std::string& note : report.notes) lobe::fuzz::check_one_line(note.c_str());
-        lobe::fuzz::require(report.self_intersections_left == (report.crossing_pairs_left > 0),
-                            "a repair report whose crossings left do not add up");
-        lobe::fuzz::require(report.self_intersections_left || !lobe::self_intersects(repaired),
-                            "a repaired mesh reported free of self-intersections that has some");
+        lobe::fuzz::check_repaired(repaired, report);
     });
 }

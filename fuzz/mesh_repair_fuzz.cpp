@@ -12,6 +12,7 @@
 #include <cstdint>
 
 #include "fuzz/fuzz_common.h"
+#include "fuzz/repair_checks.h"
 #include "meshing/mesh_io.h"
 #include "meshing/mesh_quality.h"
 #include "meshing/model_import.h"
@@ -25,15 +26,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         const lobe::TriangleMesh in = lobe::parse_mesh(bytes, "fuzz.obj");
         lobe::RepairReport report;
         const lobe::TriangleMesh repaired = lobe::repair_mesh(in, &report);
-        lobe::fuzz::check_mesh(repaired);
-        const lobe::MeshQuality q = lobe::measure_quality(repaired);
-        lobe::fuzz::require(q.closed && q.manifold && q.outward, "a repaired mesh that is not closed, 2-manifold and outward");
-        lobe::fuzz::require(report.output_triangles == repaired.triangles.size(), "a repair report that miscounts the triangles");
-        for (const std::string& note : report.notes) lobe::fuzz::check_one_line(note.c_str());
-        lobe::fuzz::require(report.self_intersections_left == (report.crossing_pairs_left > 0),
-                            "a repair report whose crossings left do not add up");
-        lobe::fuzz::require(report.self_intersections_left || !lobe::self_intersects(repaired),
-                            "a repaired mesh reported free of self-intersections that has some");
+        lobe::fuzz::check_repaired(repaired, report);
 
         lobe::RemeshOptions options;
         options.target_edge_length_m = 0.15;

@@ -431,11 +431,11 @@ Removal cut_out_crossings(Mesh& mesh, std::vector<std::array<std::size_t, 2>> pa
         std::optional<std::vector<std::array<std::size_t, 2>>> found;
         try {
             keep_largest_component(next, trial);
-            fill_holes(next, fills);
+            fill_holes(next, fills, &found);
             // Nothing when the filled surface is not 2-manifold: a patch can add an edge the
             // surface already has, where two of a hole's border vertices are also joined
             // outside it (found by the hole_fill fuzz target: one edge of three triangles).
-            found = crossing_pairs(to_triangle_mesh(next));
+            if (!found) found = crossing_pairs(to_triangle_mesh(next));
         } catch (const InvalidInput&) {
         }
         unfillable = !found;
