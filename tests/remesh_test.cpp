@@ -447,16 +447,41 @@ TEST(Repair, ADomeFoldedThroughItsFirstBandIsCutClearAndKeepsItsUpperHalf)
     EXPECT_GT(measure_quality(out).signed_volume_m3, 2.0 * 3.14159265 / 3.0);
 }
 
-TEST(Repair, ACutWhoseHolesDoNotFillIntoAManifoldIsDroppedAndTriedOneRingWider)
+/// The lowest y of `mesh` (the dome seeds stand on their base, apex at y = 1).
+double lowest_y(const TriangleMesh& mesh)
+{
+    glm::dvec3 lo, hi;
+    bounding_box(mesh, lo, hi);
+    return lo.y;
+}
+
+TEST(Repair, ALongThinBandFoldedThroughItselfIsBisectedBeforeTheCutSoTheDomeKeepsItsHeight)
+{
+    // The seed dome-400-edges-folding: a 400-edge base swinging through the dome's lowest band,
+    // whose triangles are 22° of latitude tall and under 1° wide. Cut by rings of whole
+    // triangles, one ring round a crossing was the band's whole height and the next band's
+    // too: the repaired dome ended at y = −0.64 of the input's −0.99 (volume 3.46 m³). The
+    // cut region is now bisected into rungs about six times as long as the triangles are
+    // wide, and the dome keeps its height and 92 % of a unit ball's volume.
+    const TriangleMesh dome = hole_fill_seed("dome-400-edges-folding");
+    RepairReport r;
+    const TriangleMesh out = repaired_without_crossings(dome, r);
+    EXPECT_LT(lowest_y(out), lowest_y(dome) + 0.02);
+    EXPECT_GT(measure_quality(out).signed_volume_m3, 0.88 * 4.0 * 3.14159265 / 3.0);
+}
+
+TEST(Repair, TheFifthFindingsDomeKeepsItsLowerHalfWhenItsThinBandsAreBisectedBeforeTheCut)
 {
     // The hole_fill fuzz target's fifth finding (its seed dome-700-edges-93-waves-moved): a
-    // 700-edge base of 93 waves of ±38°, vertices moved. Filling the first cut's hole left one
-    // edge with more than two triangles; the removal's first form kept that surface and the
-    // repair was refused as not 2-manifold. The cut is now dropped, and the next step's, two
-    // rings wide, fills into a clean surface.
+    // 700-edge base of 93 waves of ±38°, vertices moved, 3,876 crossing pairs. Filling the
+    // first cut's hole once left an edge of three triangles (such a cut is now dropped and the
+    // next step cuts one ring wider). Cut by rings of whole triangles 22° tall, only a cap
+    // 0.08 tall above y = 0.92 was left (0.3 % of a unit ball's volume); bisected first, the
+    // dome reaches below its equator (y = −0.32) and encloses 31 %.
     RepairReport r;
-    repaired_without_crossings(hole_fill_seed("dome-700-edges-93-waves-moved"), r);
-    EXPECT_EQ(r.removal_steps, 1u);
+    const TriangleMesh out = repaired_without_crossings(hole_fill_seed("dome-700-edges-93-waves-moved"), r);
+    EXPECT_LT(lowest_y(out), -0.25);
+    EXPECT_GT(measure_quality(out).signed_volume_m3, 0.25 * 4.0 * 3.14159265 / 3.0);
 }
 
 /// A closed UV sphere (24 longitudes, 16 bands, unit radius) whose vertices are each moved
