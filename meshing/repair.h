@@ -33,6 +33,8 @@ struct RepairReport {
     std::size_t crossing_pairs = 0;          ///< pairs of intersecting triangles step 5 set out to remove
     unsigned removal_steps = 0;              ///< cuts step 5 kept (step k cuts k rings round the crossings)
     std::size_t cut_triangles = 0;           ///< triangles those cuts took out
+    std::size_t bisected_edges = 0;          ///< long edges split in two round the crossings before
+                                             ///< the first cut (long, thin triangles)
     std::size_t cut_holes_filled = 0;        ///< holes those cuts left, filled as in step 4
     std::size_t crossing_pairs_left = 0;     ///< of those, or of the pairs the cuts made, left
     bool self_intersections_left = false;    ///< the input self-intersected and not all could be removed

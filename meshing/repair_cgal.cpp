@@ -538,7 +538,7 @@ Removal cut_out_crossings(Mesh& mesh, std::vector<std::array<std::size_t, 2>> pa
         std::vector<Mesh::Face_index> grown = seeds;
         CGAL::expand_face_selection(seeds, mesh, rings, cut, std::back_inserter(grown));
         if (bisect && rings == 1 &&
-            bisect_long_edges(mesh, cut, rung_length(mesh, seeds), split_budget(mesh)) > 0) {
+            (r.bisected_edges = bisect_long_edges(mesh, cut, rung_length(mesh, seeds), split_budget(mesh))) > 0) {
             // The region is cut finer: what crosses, and the ring round it, again.
             out.bisected = true;
             steps = kBisectedSteps;
@@ -694,8 +694,10 @@ TriangleMesh repair_mesh(const TriangleMesh& in, RepairReport* report)
             }
             r.crossing_pairs_left = removal.left;
             r.self_intersections_left = removal.left > 0;
-            const std::string cuts = std::to_string(r.cut_triangles) + " triangles round them in " +
-                                     std::to_string(r.removal_steps) + (r.removal_steps == 1 ? " step" : " steps");
+            const std::string cuts =
+                std::to_string(r.cut_triangles) + " triangles round them in " + std::to_string(r.removal_steps) +
+                (r.removal_steps == 1 ? " step" : " steps") +
+                (r.bisected_edges ? " after splitting " + std::to_string(r.bisected_edges) + " long edges there in two" : "");
             using Stop = Removal::Stop;
             std::string note;
             if (removal.left == 0) {

@@ -466,6 +466,9 @@ TEST(Repair, ALongThinBandFoldedThroughItselfIsBisectedBeforeTheCutSoTheDomeKeep
     const TriangleMesh dome = hole_fill_seed("dome-400-edges-folding");
     RepairReport r;
     const TriangleMesh out = repaired_without_crossings(dome, r);
+    EXPECT_GT(r.bisected_edges, 0u);
+    EXPECT_TRUE(std::any_of(r.notes.begin(), r.notes.end(),
+                            [](const std::string& n) { return n.find("long edges there in two") != std::string::npos; }));
     EXPECT_LT(lowest_y(out), lowest_y(dome) + 0.02);
     EXPECT_GT(measure_quality(out).signed_volume_m3, 0.88 * 4.0 * 3.14159265 / 3.0);
 }
@@ -548,6 +551,7 @@ TEST(Repair, TheCowKeepsItsTailWhenItsSelfIntersectionsAreCutOut)
     EXPECT_FALSE(r.self_intersections_left);
     EXPECT_FALSE(self_intersects(out));
     EXPECT_EQ(r.removed_component_triangles, 0u);
+    EXPECT_EQ(r.bisected_edges, 0u); // its triangles are even: the cut region is not bisected
     glm::dvec3 lo_in, hi_in, lo_out, hi_out;
     bounding_box(cow, lo_in, hi_in);
     bounding_box(out, lo_out, hi_out);
