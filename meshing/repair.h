@@ -62,8 +62,10 @@ struct RepairReport {
 /// 5. removes self-intersections (the input's, or a patch's that still crosses) where it
 ///    can: cuts out the crossing triangles with a ring of neighbours (one ring wider at each
 ///    of up to four steps, never the whole mesh; a cut that does not fill into a 2-manifold
-///    surface is not kept), keeps the largest piece and fills the holes as in step 4; what
-///    is left is reported in
+///    surface is not kept), keeps the largest piece and fills the holes as in step 4; where
+///    the first cut's triangles are long and thin, that region is bisected first and the
+///    result compared with the cuts of whole triangles (bisected_edges); what is left is
+///    reported in
 ///    RepairReport::self_intersections_left, not thrown;
 /// 6. orients the faces outward (is_outward_oriented, reverse_face_orientations).
 /// Feature edges of the input are dropped. `report` (optional) receives what was done.

@@ -378,6 +378,12 @@ Mesh without_faces(const Mesh& mesh, Mesh::Property_map<Mesh::Face_index, bool> 
     return out;
 }
 
+/// The squared length of the edge of `h`.
+double squared_length(const Mesh& mesh, Mesh::Halfedge_index h)
+{
+    return CGAL::to_double(CGAL::squared_distance(mesh.point(mesh.source(h)), mesh.point(mesh.target(h))));
+}
+
 /// Longest-edge bisection (Rivara) of the faces `region` flags, until no edge of them is
 /// longer than `max_length` or `max_splits` edges were split: the longest edge first, split at
 /// its midpoint and joined to the opposite corner on both sides (a face outside the region
@@ -389,9 +395,7 @@ std::size_t bisect_long_edges(Mesh& mesh, Mesh::Property_map<Mesh::Face_index, b
                               std::size_t max_splits)
 {
     const double limit = max_length * max_length;
-    auto squared = [&](Mesh::Halfedge_index h) {
-        return CGAL::to_double(CGAL::squared_distance(mesh.point(mesh.source(h)), mesh.point(mesh.target(h))));
-    };
+    auto squared = [&](Mesh::Halfedge_index h) { return squared_length(mesh, h); };
     auto in_region = [&](Mesh::Halfedge_index h) {
         const auto f = mesh.face(h), g = mesh.face(mesh.opposite(h));
         return (f != Mesh::null_face() && region[f]) || (g != Mesh::null_face() && region[g]);
@@ -450,7 +454,7 @@ double rung_length(const Mesh& mesh, const std::vector<Mesh::Face_index>& faces)
     for (auto f : faces) {
         double s = std::numeric_limits<double>::infinity();
         for (auto h : CGAL::halfedges_around_face(mesh.halfedge(f), mesh))
-            s = std::min(s, CGAL::to_double(CGAL::squared_distance(mesh.point(mesh.source(h)), mesh.point(mesh.target(h)))));
+            s = std::min(s, squared_length(mesh, h));
         shortest.push_back(std::sqrt(s));
     }
     if (shortest.empty()) return std::numeric_limits<double>::infinity();
@@ -469,8 +473,8 @@ std::size_t split_budget(const Mesh& mesh) { return std::min<std::size_t>(mesh.n
 /// hole's patch makes less often than rings of whole triangles, and every step over a bisected
 /// mesh costs its fill and a crossing search on up to three times the faces. With a second step,
 /// 27 instead of 17 of 350 hole_fill domes kept over 2 % more volume than the whole-triangle
-/// cuts, but the folded 638-edge seed took 22–30 s under ASan (the fuzz timeout is 30 s). One step, then, and repair_mesh compares its result with the
-/// cuts of whole triangles (step 5).
+/// cuts, but the folded 638-edge seed took 22–30 s under ASan (the fuzz timeout was 30 s). One
+/// step, then, and repair_mesh compares its result with the cuts of whole triangles (step 5).
 constexpr unsigned kBisectedSteps = 1;
 
 /// The volume a closed, consistently oriented surface encloses (negative: inside out).
@@ -540,8 +544,9 @@ Removal cut_out_crossings(Mesh& mesh, std::vector<std::array<std::size_t, 2>> pa
         std::vector<Mesh::Face_index> seeds = select_faces(mesh, pairs, cut);
         std::vector<Mesh::Face_index> grown = seeds;
         CGAL::expand_face_selection(seeds, mesh, rings, cut, std::back_inserter(grown));
-        if (bisect && rings == 1 &&
-            (r.bisected_edges = bisect_long_edges(mesh, cut, rung_length(mesh, seeds), split_budget(mesh))) > 0) {
+        if (bisect && rings == 1)
+            r.bisected_edges = bisect_long_edges(mesh, cut, rung_length(mesh, seeds), split_budget(mesh));
+        if (bisect && rings == 1 && r.bisected_edges > 0) {
             // The region is cut finer: what crosses, and the ring round it, again.
             out.bisected = true;
             steps = kBisectedSteps;
