@@ -569,7 +569,7 @@ TEST(Repair, TheCowAndTheBunnyRepairToTheSameMeshAfterADomeWhosePatchFollowsTheH
     // equally good patches by it: the seed dome-400-edges-folding repairs to another mesh
     // after another repair in the same process (docs/lobes-from-models.md, Limits). The
     // bunny's holes and the cow's cut go through that search too, and must not: a model
-    // imported after anything else gives the lobe a fresh `lobesketch lobes` gives.
+    // imported after anything else repairs to the mesh a fresh `lobesketch lobes` repairs it to.
     const TriangleMesh cow = read_mesh(test::shared_path("data/models/cow.obj"));
     const TriangleMesh bunny = read_mesh(test::shared_path("data/models/stanford-bunny.obj"));
     const TriangleMesh cow_first = repair_mesh(cow), bunny_first = repair_mesh(bunny);
