@@ -540,25 +540,29 @@ Removal cut_out_crossings(Mesh& mesh, std::vector<std::array<std::size_t, 2>> pa
     unsigned steps = kRemovalSteps;
     for (unsigned rings = 1; rings <= steps && !pairs.empty(); ++rings) {
         mesh.collect_garbage(); // face i is triangle i of to_triangle_mesh
-        auto cut = mesh.add_property_map<Mesh::Face_index, bool>("f:lobe_cut", false).first;
-        std::vector<Mesh::Face_index> seeds = select_faces(mesh, pairs, cut);
-        std::vector<Mesh::Face_index> grown = seeds;
-        CGAL::expand_face_selection(seeds, mesh, rings, cut, std::back_inserter(grown));
-        if (bisect && rings == 1)
-            r.bisected_edges = bisect_long_edges(mesh, cut, rung_length(mesh, seeds), split_budget(mesh));
-        if (bisect && rings == 1 && r.bisected_edges > 0) {
-            // The region is cut finer: what crosses, and the ring round it, again.
-            out.bisected = true;
-            steps = kBisectedSteps;
-            mesh.remove_property_map(cut);
-            auto found = crossing_pairs(to_triangle_mesh(mesh));
-            if (!found) break; // cannot happen (splits keep a 2-manifold surface as it was): stop as if out of steps
-            pairs = std::move(*found);
-            if (pairs.empty()) break;
+        Mesh::Property_map<Mesh::Face_index, bool> cut;
+        std::vector<Mesh::Face_index> seeds, grown;
+        // The crossing faces of `pairs` and `rings` rings round them.
+        auto select = [&] {
             cut = mesh.add_property_map<Mesh::Face_index, bool>("f:lobe_cut", false).first;
             seeds = select_faces(mesh, pairs, cut);
             grown = seeds;
             CGAL::expand_face_selection(seeds, mesh, rings, cut, std::back_inserter(grown));
+        };
+        select();
+        if (bisect && rings == 1) {
+            r.bisected_edges = bisect_long_edges(mesh, cut, rung_length(mesh, seeds), split_budget(mesh));
+            if (r.bisected_edges > 0) {
+                // The region is cut finer: what crosses, and the ring round it, again.
+                out.bisected = true;
+                steps = kBisectedSteps;
+                mesh.remove_property_map(cut);
+                auto found = crossing_pairs(to_triangle_mesh(mesh));
+                if (!found) break; // cannot happen (splits keep a 2-manifold surface as it was): stop as if out of steps
+                pairs = std::move(*found);
+                if (pairs.empty()) break;
+                select();
+            }
         }
         CGAL::expand_face_selection_for_removal(grown, mesh, cut);
         std::size_t n = 0;
