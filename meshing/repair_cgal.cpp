@@ -28,6 +28,9 @@
 #ifndef __clang__ // GCC only: Clang has no such warning and would warn about the pragma
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #endif
+#include <CGAL/Constrained_Delaunay_triangulation_2.h>
+#include <CGAL/Delaunay_mesh_face_base_2.h>
+#include <CGAL/Delaunay_mesh_vertex_base_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_2_algorithms.h>
 #include <CGAL/Projection_traits_3.h>
@@ -43,7 +46,6 @@
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <CGAL/Polygon_mesh_processing/refine.h>
 #include <CGAL/Polygon_mesh_processing/repair_polygon_soup.h>
-#include <CGAL/Polygon_mesh_processing/triangulate_faces.h>
 #include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/bounding_box.h>
@@ -178,13 +180,90 @@ std::size_t border_edges(const Mesh& mesh, Mesh::Halfedge_index h)
     }
 }
 
-/// Collects the faces triangulate_face makes (it copies its visitor: a pointer is shared).
-struct CollectFaces {
-    std::vector<Mesh::Face_index>* faces;
-    void before_subface_creations(Mesh::Face_index) {}
-    void after_subface_created(Mesh::Face_index f) { faces->push_back(f); }
-    void after_subface_creations() {}
-};
+/// Triangulates the polygon face `f` by the 2D constrained Delaunay triangulation of its
+/// border seen along `normal` (the triangles CGAL's triangulate_face makes), and appends the
+/// faces to `patch`. Returns false, leaving the mesh as it was, where that triangulation has
+/// other vertices than the border (two border points meet in the plane) or no area.
+///
+/// Written here rather than calling triangulate_face so that the result does not depend on
+/// what ran before in the process: triangulate_face creates the patch's edges in the order of
+/// the triangulation's edge iterator, which reports each edge from the face whose handle
+/// compares smaller, and handles of faces without time stamps compare by address, i.e. by
+/// the heap's history. The same hole then got other halfedge numbers, which refinement,
+/// fairing and the cuts of step 5 follow, so a mesh repaired twice in one process could come
+/// out two ways. Here the triangulation's faces and vertices carry time stamps (the base
+/// classes of CGAL's 2D mesher) and the face is split along the triangulation's inner edges,
+/// one by one, in the order of its faces.
+bool triangulate_in_plane(Mesh& mesh, Mesh::Face_index f, const Kernel::Vector_3& normal,
+                          std::vector<Mesh::Face_index>& patch)
+{
+    using Traits = CGAL::Projection_traits_3<Kernel>;
+    using Vb = CGAL::Triangulation_vertex_base_with_info_2<VertexIndex, Traits, CGAL::Delaunay_mesh_vertex_base_2<Traits>>;
+    using Fb = CGAL::Delaunay_mesh_face_base_2<Traits>; // in_domain: inside the polygon
+    using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
+    using Cdt = CGAL::Constrained_Delaunay_triangulation_2<Traits, Tds, CGAL::Exact_intersections_tag>;
+    Cdt cdt{Traits(normal)};
+    std::size_t corners = 0;
+    Cdt::Vertex_handle first, previous;
+    for (VertexIndex v : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) {
+        const Cdt::Vertex_handle w = cdt.insert(mesh.point(v));
+        w->info() = v;
+        if (first == Cdt::Vertex_handle()) first = w;
+        if (previous != Cdt::Vertex_handle() && previous != w) cdt.insert_constraint(previous, w);
+        previous = w;
+        ++corners;
+    }
+    if (previous != first) cdt.insert_constraint(previous, first);
+    if (cdt.dimension() != 2 || cdt.number_of_vertices() != corners) return false;
+    // Outside: what the infinite faces reach without crossing the border.
+    for (auto g : cdt.all_face_handles()) g->set_in_domain(true);
+    std::vector<Cdt::Face_handle> stack{cdt.infinite_face()};
+    while (!stack.empty()) {
+        const Cdt::Face_handle g = stack.back();
+        stack.pop_back();
+        if (!g->is_in_domain()) continue;
+        g->set_in_domain(false);
+        for (int i = 0; i < 3; ++i)
+            if (!cdt.is_constrained({g, i})) stack.push_back(g->neighbor(i));
+    }
+    // The inner edges, each once (from its face with the smaller time stamp).
+    std::vector<std::array<VertexIndex, 2>> diagonals;
+    for (auto g : cdt.finite_face_handles()) {
+        if (!g->is_in_domain()) continue;
+        for (int i = 0; i < 3; ++i) {
+            const Cdt::Face_handle n = g->neighbor(i);
+            if (cdt.is_constrained({g, i}) || !n->is_in_domain() || n->time_stamp() < g->time_stamp()) continue;
+            diagonals.push_back({g->vertex(Cdt::ccw(i))->info(), g->vertex(Cdt::cw(i))->info()});
+        }
+    }
+    // Splitting the polygon along each diagonal in turn: both ends lie on one face of the
+    // patch, which the diagonal splits in two.
+    std::vector<char> in_patch(mesh.number_of_faces() + mesh.number_of_removed_faces() + diagonals.size() + 1, 0);
+    in_patch[f.idx()] = 1;
+    patch.push_back(f);
+    for (const auto& [a, b] : diagonals) {
+        Mesh::Halfedge_index at_a, at_b;
+        for (Mesh::Halfedge_index h : CGAL::halfedges_around_target(a, mesh)) {
+            const Mesh::Face_index g = mesh.face(h);
+            if (g == Mesh::null_face() || !in_patch[g.idx()]) continue;
+            for (Mesh::Halfedge_index k : CGAL::halfedges_around_face(h, mesh))
+                if (mesh.target(k) == b) at_b = k;
+            if (at_b != Mesh::null_halfedge()) {
+                at_a = h;
+                break;
+            }
+        }
+        // Cannot happen for a triangulation of the polygon; said rather than split wrongly.
+        if (at_a == Mesh::null_halfedge()) throw InvalidInput("repair_mesh: a hole's triangulation does not fit its border");
+        const Mesh::Halfedge_index d = CGAL::Euler::split_face(at_a, at_b, mesh);
+        Mesh::Face_index g = mesh.face(d); // the new one of the two faces
+        if (g.idx() < in_patch.size() && in_patch[g.idx()]) g = mesh.face(mesh.opposite(d));
+        if (g.idx() >= in_patch.size()) in_patch.resize(g.idx() + 1, 0);
+        in_patch[g.idx()] = 1;
+        patch.push_back(g);
+    }
+    return true;
+}
 
 /// Fills a large hole (kLargeHole) and refines the patch, faired unless `unfaired`:
 /// 1. in the plane of its vector area, by a 2D constrained Delaunay triangulation (CGAL's
@@ -211,7 +290,7 @@ bool fill_large_hole(Mesh& mesh, Mesh::Halfedge_index h, bool unfaired, std::vec
     const Kernel::Vector_3 normal = PMP::compute_face_normal(mesh.face(h), mesh);
     const bool simple = normal != CGAL::NULL_VECTOR &&
                         CGAL::is_simple_2(ring.begin(), ring.end(), CGAL::Projection_traits_3<Kernel>(normal));
-    if (!simple || !PMP::triangulate_face(mesh.face(h), mesh, PMP::parameters::visitor(CollectFaces{&patch}))) {
+    if (!simple || !triangulate_in_plane(mesh, mesh.face(h), normal, patch)) {
         patch.clear();
         if (ring.size() <= kSearchedHole) {
             CGAL::Euler::remove_face(h, mesh); // a hole again (a refusing triangulate_face leaves the polygon)
