@@ -52,8 +52,11 @@ struct RepairReport {
 ///    vertex (duplicate_non_manifold_vertices); the copies of a split vertex are moved a
 ///    hair apart (1% towards their own fan) so the surface does not touch itself there;
 /// 3. keeps the largest connected component (by triangle count), noting the others;
-/// 4. fills every hole (triangulate_refine_and_fair_hole; plain triangulate_hole when
-///    that gives nothing); holes of over 200 edges by a constrained Delaunay patch in their
+/// 4. fills every hole as CGAL's triangulate_refine_and_fair_hole does (the best patch
+///    among the faces of the border's 3D Delaunay triangulation, else over all
+///    triangulations; refined, faired), the patch found by our own search with CGAL's
+///    weights and ties broken by vertex order, so that a repair does not depend on what ran
+///    before in the process; holes of over 200 edges by a constrained Delaunay patch in their
 ///    plane where the border is a simple polygon there, else by the Delaunay search without
 ///    its cubic fallback (up to 1,000 edges) or a fan from their centroid, then refined and
 ///    faired (CGAL's full search takes memory and time that grow much faster than the

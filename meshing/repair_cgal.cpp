@@ -31,6 +31,7 @@
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
 #include <CGAL/Delaunay_mesh_face_base_2.h>
 #include <CGAL/Delaunay_mesh_vertex_base_2.h>
+#include <CGAL/Delaunay_triangulation_3.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_2_algorithms.h>
 #include <CGAL/Projection_traits_3.h>
@@ -48,6 +49,7 @@
 #include <CGAL/Polygon_mesh_processing/repair_polygon_soup.h>
 #include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
 #include <CGAL/Surface_mesh.h>
+#include <CGAL/Triangulation_vertex_base_with_info_3.h>
 #include <CGAL/bounding_box.h>
 #pragma GCC diagnostic pop
 
@@ -265,6 +267,244 @@ bool triangulate_in_plane(Mesh& mesh, Mesh::Face_index f, const Kernel::Vector_3
     return true;
 }
 
+/// The patch CGAL's triangulate_hole finds for the hole whose border starts at `h` (a border
+/// halfedge), found the same way but with ties broken by vertex order rather than by memory:
+/// among the triangulations of the border polygon whose triangles are faces of the border
+/// points' 3D Delaunay triangulation, the one with the smallest largest dihedral angle
+/// (between neighbouring patch triangles, and between a triangle on the border and the face
+/// beyond it), then the smallest area; no triangle with collinear corners, and no patch edge
+/// that the surface already has. Dynamic programming over sub-polygons (Liepa 2003, with the
+/// Delaunay restriction of Zou et al. 2013). The weights are computed as CGAL computes them,
+/// so where no two patches tie this is CGAL's patch, triangle for triangle, and the faces are
+/// made in the order CGAL makes them.
+///
+/// Why not CGAL's own: its search starts from the Delaunay edge between the border's first and
+/// last point as the triangulation's edge iterator gives it, which reports each edge from the
+/// cell whose handle compares smaller, by address (CGAL 5.5's cells carry no time stamps), and
+/// of equally good candidates keeps the first it meets going round that edge. A flat or round
+/// border has many ties, so the patch depended on what the process had allocated before.
+///
+/// Where the Delaunay triangulation lacks a border edge, every triangle on that edge, and the
+/// two others such a triangle needs, are candidates too, as in CGAL. Returns the patch's faces;
+/// none where no such patch exists (CGAL then searches all triangulations, when allowed:
+/// `cubic_may_help`) or where the border meets itself at a vertex (CGAL gives up).
+std::vector<Mesh::Face_index> search_hole_patch(Mesh& mesh, Mesh::Halfedge_index h, bool& cubic_may_help)
+{
+    cubic_may_help = false;
+    // The border: P[k] the target of its k-th halfedge, Q[k] the corner opposite the next
+    // border edge in the face beyond it.
+    std::vector<Mesh::Halfedge_index> edges;
+    std::vector<Point> P, Q;
+    std::map<VertexIndex, int> id;
+    for (Mesh::Halfedge_index k : CGAL::halfedges_around_face(h, mesh)) {
+        if (!id.emplace(mesh.target(k), static_cast<int>(P.size())).second) return {};
+        edges.push_back(k);
+        P.push_back(mesh.point(mesh.target(k)));
+        Q.push_back(mesh.point(mesh.target(mesh.next(mesh.opposite(mesh.next(k))))));
+    }
+    const int n = static_cast<int>(P.size());
+    cubic_may_help = true;
+    if (n < 3) return {};
+    // Edges the surface already has between border vertices that are not border neighbours.
+    std::vector<std::pair<int, int>> existing;
+    for (const auto& [v, i] : id)
+        for (Mesh::Halfedge_index k : CGAL::halfedges_around_target(v, mesh)) {
+            const auto other = id.find(mesh.source(k));
+            if (other == id.end()) continue;
+            const int j = other->second;
+            if (j != (i + n - 1) % n && j != (i + 1) % n && i < j) existing.emplace_back(i, j);
+        }
+    std::sort(existing.begin(), existing.end());
+    auto has_edge = [&](int a, int b) { return std::binary_search(existing.begin(), existing.end(), std::make_pair(a, b)); };
+
+    // The Delaunay faces, as the third corners of each edge (i < j), in increasing order.
+    using Vb = CGAL::Triangulation_vertex_base_with_info_3<int, Kernel>;
+    using Tds = CGAL::Triangulation_data_structure_3<Vb, CGAL::Delaunay_triangulation_cell_base_3<Kernel>>;
+    using Delaunay = CGAL::Delaunay_triangulation_3<Kernel, Tds>;
+    std::vector<std::pair<Point, int>> points;
+    for (int i = 0; i < n; ++i) points.emplace_back(P[static_cast<std::size_t>(i)], i);
+    Delaunay dt(points.begin(), points.end());
+    if (dt.dimension() < 2) return {};
+    auto key = [n](int a, int b) { return static_cast<std::int64_t>(std::min(a, b)) * n + std::max(a, b); };
+    std::vector<std::pair<std::int64_t, int>> thirds; // (key(i, j), k)
+    for (auto f = dt.finite_facets_begin(); f != dt.finite_facets_end(); ++f) {
+        std::array<int, 3> c{};
+        int m = 0;
+        for (int k = 0; k < 4; ++k)
+            if (k != f->second) c[static_cast<std::size_t>(m++)] = f->first->vertex(k)->info();
+        thirds.emplace_back(key(c[0], c[1]), c[2]);
+        thirds.emplace_back(key(c[0], c[2]), c[1]);
+        thirds.emplace_back(key(c[1], c[2]), c[0]);
+    }
+    std::sort(thirds.begin(), thirds.end());
+    std::vector<std::pair<int, int>> missing;
+    auto by_edge = [](const std::pair<std::int64_t, int>& x, const std::pair<std::int64_t, int>& y) { return x.first < y.first; };
+    for (int i = 0; i < n; ++i)
+        if (!std::binary_search(thirds.begin(), thirds.end(), std::make_pair(key(i, (i + 1) % n), 0), by_edge))
+            missing.emplace_back(i, (i + 1) % n);
+    for (const auto& [a, b] : missing)
+        for (int k = 0; k < n; ++k) {
+            if (k == a || k == b) continue;
+            thirds.emplace_back(key(a, b), k);
+            thirds.emplace_back(key(k, a), b);
+            thirds.emplace_back(key(k, b), a);
+        }
+    if (!missing.empty()) {
+        std::sort(thirds.begin(), thirds.end());
+        thirds.erase(std::unique(thirds.begin(), thirds.end()), thirds.end());
+    }
+    auto third_range = [&](int a, int b) { return std::equal_range(thirds.begin(), thirds.end(), std::make_pair(key(a, b), 0), by_edge); };
+
+    // W(i, j): the best patch of the polygon i, i+1, …, j (i < j) closed by the edge j → i, as
+    // (largest angle, area); NOT_VALID (-1, -1) where none; lambda: its triangle's third corner.
+    using Weight = std::pair<double, double>;
+    const Weight not_valid(-1.0, -1.0);
+    const std::size_t nn = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
+    std::vector<Weight> W(nn, Weight(0.0, 0.0));
+    std::vector<int> lambda(nn, -1);
+    std::vector<char> done(nn, 0);
+    auto at = [n](int a, int b) { return static_cast<std::size_t>(a) * static_cast<std::size_t>(n) + static_cast<std::size_t>(b); };
+    auto is_border = [n](int a, int b) { return a + 1 == b || (a == n - 1 && b == 0); };
+    // The triangle (i, m, j)'s weight: the largest of 180° less the dihedral angle with the face
+    // beyond each border edge, and with the triangle the sub-polygon beyond (i, m) and (m, j)
+    // chose; the edge (j, i) is weighed by the triangle above it.
+    auto weight = [&](int i, int m, int j) {
+        const std::array<int, 3> v{i, m, j};
+        double largest = 0;
+        for (std::size_t e = 0; e < 3; ++e) {
+            const int a = v[e], b = v[(e + 1) % 3], c = v[(e + 2) % 3];
+            double angle = 0;
+            const auto pa = static_cast<std::size_t>(a), pb = static_cast<std::size_t>(b), pc = static_cast<std::size_t>(c);
+            if (is_border(a, b)) {
+                angle = 180 - std::abs(CGAL::to_double(CGAL::approximate_dihedral_angle(P[pa], P[pb], P[pc], Q[pa])));
+            } else if (e != 2 && lambda[at(a, b)] != -1) {
+                const Point& beyond = P[static_cast<std::size_t>(lambda[at(a, b)])];
+                angle = 180 - std::abs(CGAL::to_double(CGAL::approximate_dihedral_angle(P[pa], P[pb], P[pc], beyond)));
+            }
+            largest = std::max(largest, angle);
+        }
+        const double area = CGAL::to_double(CGAL::approximate_sqrt(CGAL::squared_area(
+            P[static_cast<std::size_t>(i)], P[static_cast<std::size_t>(m)], P[static_cast<std::size_t>(j)])));
+        return Weight(largest, area);
+    };
+    // A candidate triangle: its third corner between i and j, corners not collinear, no edge the
+    // surface has (the edge j → i is checked by the triangle above it).
+    auto usable = [&](int i, int m, int j) {
+        return i < m && m < j &&
+               !CGAL::collinear(P[static_cast<std::size_t>(i)], P[static_cast<std::size_t>(m)], P[static_cast<std::size_t>(j)]) &&
+               (m == i + 1 || !has_edge(i, m)) && (j == m + 1 || !has_edge(m, j));
+    };
+    auto less = [](const Weight& a, const Weight& b) { return a.first == b.first ? a.second < b.second : a.first < b.first; };
+    // Depth-first, without recursion: a border hole has up to kSearchedHole corners.
+    std::vector<std::pair<int, int>> stack{{0, n - 1}};
+    while (!stack.empty()) {
+        const auto [i, j] = stack.back();
+        if (j - i < 2 || done[at(i, j)]) {
+            stack.pop_back();
+            continue;
+        }
+        // Every sub-polygon a candidate needs is solved first.
+        bool ready = true;
+        const auto [lo, hi] = third_range(i, j);
+        for (auto t = lo; t != hi; ++t) {
+            const int m = t->second;
+            if (!usable(i, m, j)) continue;
+            for (const auto& [a, b] : {std::make_pair(i, m), std::make_pair(m, j)})
+                if (b - a >= 2 && !done[at(a, b)]) {
+                    stack.emplace_back(a, b);
+                    ready = false;
+                }
+        }
+        if (!ready) continue;
+        stack.pop_back();
+        Weight best = not_valid;
+        int best_m = -1;
+        for (auto t = lo; t != hi; ++t) {
+            const int m = t->second;
+            if (!usable(i, m, j)) continue;
+            const Weight& left = W[at(i, m)];
+            const Weight& right = W[at(m, j)];
+            if (left == not_valid || right == not_valid) continue;
+            const Weight own = weight(i, m, j);
+            const Weight w(std::max({0.0, left.first, right.first, own.first}), ((0.0 + left.second) + right.second) + own.second);
+            if (best_m == -1 || less(w, best)) {
+                best = w;
+                best_m = m;
+            }
+        }
+        W[at(i, j)] = best;
+        lambda[at(i, j)] = best_m;
+        done[at(i, j)] = 1;
+    }
+    if (lambda[at(0, n - 1)] == -1) return {};
+
+    // The faces, made as CGAL's tracer makes them: each sub-polygon's two halves first, then its
+    // triangle added to the border between them (the last one closes the hole).
+    std::vector<Mesh::Face_index> patch;
+    struct Frame {
+        int i, k;
+        bool last;
+        int stage; ///< 0: halves to make, 1: left made, 2: both made
+        Mesh::Halfedge_index left;
+    };
+    std::vector<Frame> frames{{0, n - 1, true, 0, {}}};
+    Mesh::Halfedge_index result;
+    while (!frames.empty()) {
+        Frame& fr = frames.back();
+        const auto ui = static_cast<std::size_t>(fr.i);
+        if (fr.i + 1 == fr.k) {
+            result = edges[(ui + 1) % static_cast<std::size_t>(n)];
+            frames.pop_back();
+            continue;
+        }
+        Mesh::Halfedge_index made;
+        if (fr.i + 2 == fr.k) {
+            const Mesh::Halfedge_index e1 = edges[ui + 1], e2 = edges[(ui + 2) % static_cast<std::size_t>(n)];
+            if (fr.last) {
+                made = e1;
+                CGAL::Euler::fill_hole(made, mesh);
+            } else {
+                made = CGAL::Euler::add_face_to_border(mesh.prev(e1), e2, mesh);
+            }
+        } else {
+            const int m = lambda[at(fr.i, fr.k)];
+            if (fr.stage == 0) {
+                fr.stage = 1;
+                frames.push_back({fr.i, m, false, 0, {}});
+                continue;
+            }
+            if (fr.stage == 1) {
+                fr.left = result;
+                fr.stage = 2;
+                frames.push_back({m, fr.k, false, 0, {}});
+                continue;
+            }
+            if (fr.last) {
+                made = result;
+                CGAL::Euler::fill_hole(made, mesh);
+            } else {
+                made = CGAL::Euler::add_face_to_border(mesh.prev(fr.left), result, mesh);
+            }
+        }
+        patch.push_back(mesh.face(made));
+        result = mesh.opposite(made);
+        frames.pop_back();
+    }
+    return patch;
+}
+
+/// A hole's patch as CGAL's triangulate_hole makes it (search_hole_patch), with CGAL's search
+/// over all triangulations, cubic in the border, where no Delaunay patch exists and `cubic`
+/// allows it (that search has no ties left to memory: it tries the corners in order).
+std::vector<Mesh::Face_index> triangulate_hole_searched(Mesh& mesh, Mesh::Halfedge_index h, bool cubic)
+{
+    bool cubic_may_help = false;
+    std::vector<Mesh::Face_index> patch = search_hole_patch(mesh, h, cubic_may_help);
+    if (patch.empty() && cubic && cubic_may_help)
+        PMP::triangulate_hole(mesh, h, std::back_inserter(patch), PMP::parameters::use_delaunay_triangulation(false));
+    return patch;
+}
+
 /// Fills a large hole (kLargeHole) and refines the patch, faired unless `unfaired`:
 /// 1. in the plane of its vector area, by a 2D constrained Delaunay triangulation (CGAL's
 ///    triangulate_face on the hole made one polygon), where the border seen in that plane is
@@ -294,9 +534,7 @@ bool fill_large_hole(Mesh& mesh, Mesh::Halfedge_index h, bool unfaired, std::vec
         patch.clear();
         if (ring.size() <= kSearchedHole) {
             CGAL::Euler::remove_face(h, mesh); // a hole again (a refusing triangulate_face leaves the polygon)
-            PMP::triangulate_hole(mesh, h, std::back_inserter(patch),
-                                  PMP::parameters::use_2d_constrained_delaunay_triangulation(false)
-                                      .do_not_use_cubic_algorithm(true));
+            patch = triangulate_hole_searched(mesh, h, false);
             if (patch.empty()) CGAL::Euler::fill_hole(h, mesh);
         }
         if (patch.empty()) {
@@ -341,13 +579,14 @@ FillCounts fill_holes_once(Mesh& mesh, const std::vector<Mesh::Halfedge_index>& 
             bool by_fan = false;
             if (fill_large_hole(mesh, h, unfaired[i] != 0, new_faces, new_vertices, by_fan)) ++n.faired;
             if (by_fan) ++n.fans;
-        } else if (unfaired[i]) {
-            PMP::triangulate_and_refine_hole(mesh, h, std::back_inserter(new_faces), std::back_inserter(new_vertices));
-        } else if (std::get<0>(PMP::triangulate_refine_and_fair_hole(mesh, h, std::back_inserter(new_faces),
-                                                                      std::back_inserter(new_vertices)))) {
-            ++n.faired;
+        } else {
+            // CGAL's triangulate_refine_and_fair_hole (triangulate_and_refine_hole when
+            // unfaired), with the patch found by triangulate_hole_searched.
+            const std::vector<Mesh::Face_index> searched = triangulate_hole_searched(mesh, h, true);
+            new_faces = searched;
+            PMP::refine(mesh, searched, std::back_inserter(new_faces), std::back_inserter(new_vertices));
+            if (!unfaired[i] && PMP::fair(mesh, new_vertices)) ++n.faired;
         }
-        if (new_faces.empty() && !large) PMP::triangulate_hole(mesh, h, std::back_inserter(new_faces));
         if (!new_faces.empty()) ++n.filled;
         for (Mesh::Face_index f : new_faces) patch[f] = i + 1;
     }
