@@ -336,6 +336,12 @@ def hole_fill_seeds():
         "00f3015d8c1400f33e3e3e3e3e3e3e3e3e3e3e3e3e3e3e00f33e3e3e3e3e8c14"))
     put("hole_fill", "slit-300-degrees", slit(300, 40))
     put("hole_fill", "slit-120-degrees-bumped", slit(120, 30, bytes((i * 53) & 255 for i in range(200))))
+    # a 247° slit through 20 bands, 43 vertices moved (random bytes): its border runs over
+    # itself in its plane and gets the searched patch, which CGAL's search chose among equal
+    # ones by memory order (docs/lobes-from-models.md, Limits)
+    put("hole_fill", "slit-247-degrees-searched", bytes.fromhex(
+        "b31e74c0d1c0720f800a86de7b76b568a6d98e98ff6e50f4"
+        "884599902da902f87f52a3e76c1a6bb817e05dde47980c39"))
 
 
 def main():

@@ -562,32 +562,34 @@ TEST(Repair, TheCowKeepsItsTailWhenItsSelfIntersectionsAreCutOut)
     }
 }
 
-TEST(Repair, FoldedDomesTheCowAndTheBunnyRepairToTheSameMeshWhateverWasRepairedBefore)
+TEST(Repair, ADomeASlitTheCowAndTheBunnyRepairToTheSameMeshWhateverWasRepairedBefore)
 {
     // A repair must be a function of its input, or a model imported twice in one session, or
     // a fuzz finding run alone, comes out another way. CGAL's triangulate_face and its search
     // for a hole's patch over the border's 3D Delaunay triangulation both followed where their
     // triangulations' elements lay in memory, so these two seeds repaired to other meshes
     // after other repairs in the same process: dome-400-edges-folding, whose base is
-    // triangulated in its plane, and dome-638-edges-folded-and-shifted, whose cuts' holes get
-    // the searched patch (repair_cgal.cpp now does both itself: triangulate_in_plane,
+    // triangulated in its plane and whose folds are then cut out, and
+    // slit-247-degrees-searched, whose border runs over itself in its plane and gets the
+    // searched patch (repair_cgal.cpp now does both itself: triangulate_in_plane,
     // search_hole_patch). The bunny's holes and the cow's cut go through the search too.
     const TriangleMesh cow = read_mesh(test::shared_path("data/models/cow.obj"));
     const TriangleMesh bunny = read_mesh(test::shared_path("data/models/stanford-bunny.obj"));
-    const TriangleMesh planar = hole_fill_seed("dome-400-edges-folding");
-    const TriangleMesh searched = hole_fill_seed("dome-638-edges-folded-and-shifted");
+    const TriangleMesh dome = hole_fill_seed("dome-400-edges-folding");
+    const TriangleMesh slit = hole_fill_seed("slit-247-degrees-searched");
     RepairReport r;
-    const TriangleMesh planar_first = repair_mesh(planar, &r);
+    const TriangleMesh dome_first = repair_mesh(dome, &r);
     ASSERT_GT(r.bisected_edges, 0u); // the dome went through the cuts and their fills
-    const TriangleMesh searched_first = repair_mesh(searched, &r);
-    ASSERT_GT(r.cut_holes_filled, 0u);
+    const TriangleMesh slit_first = repair_mesh(slit, &r);
+    ASSERT_EQ(r.holes_filled, 1u);
+    ASSERT_EQ(r.holes_fanned, 0u);
     const TriangleMesh cow_first = repair_mesh(cow), bunny_first = repair_mesh(bunny);
-    const TriangleMesh planar_again = repair_mesh(planar), searched_again = repair_mesh(searched);
+    const TriangleMesh dome_again = repair_mesh(dome), slit_again = repair_mesh(slit);
     const TriangleMesh cow_again = repair_mesh(cow), bunny_again = repair_mesh(bunny);
-    EXPECT_TRUE(planar_again.positions == planar_first.positions);
-    EXPECT_TRUE(planar_again.triangles == planar_first.triangles);
-    EXPECT_TRUE(searched_again.positions == searched_first.positions);
-    EXPECT_TRUE(searched_again.triangles == searched_first.triangles);
+    EXPECT_TRUE(dome_again.positions == dome_first.positions);
+    EXPECT_TRUE(dome_again.triangles == dome_first.triangles);
+    EXPECT_TRUE(slit_again.positions == slit_first.positions);
+    EXPECT_TRUE(slit_again.triangles == slit_first.triangles);
     EXPECT_TRUE(cow_again.positions == cow_first.positions);
     EXPECT_TRUE(cow_again.triangles == cow_first.triangles);
     EXPECT_TRUE(bunny_again.positions == bunny_first.positions);
