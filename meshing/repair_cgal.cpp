@@ -505,12 +505,25 @@ std::vector<Mesh::Face_index> triangulate_hole_searched(Mesh& mesh, Mesh::Halfed
     return patch;
 }
 
+/// Refines a hole's patch and fairs the new vertices unless `unfaired`, as CGAL's
+/// triangulate_refine_and_fair_hole does after triangulating; `new_faces` receives the patch
+/// and the faces refining made, `new_vertices` (appended to) the vertices it made. Returns
+/// whether the patch was faired.
+bool refine_and_fair(Mesh& mesh, const std::vector<Mesh::Face_index>& patch, bool unfaired,
+                     std::vector<Mesh::Face_index>& new_faces, std::vector<VertexIndex>& new_vertices)
+{
+    new_faces = patch;
+    PMP::refine(mesh, patch, std::back_inserter(new_faces), std::back_inserter(new_vertices));
+    return !unfaired && PMP::fair(mesh, new_vertices);
+}
+
 /// Fills a large hole (kLargeHole) and refines the patch, faired unless `unfaired`:
-/// 1. in the plane of its vector area, by a 2D constrained Delaunay triangulation (CGAL's
-///    triangulate_face on the hole made one polygon), where the border seen in that plane is
-///    a simple polygon (the wavy base of a scan): O(n log n) time, linear memory;
-/// 2. otherwise, up to kSearchedHole edges, by CGAL's search for the best patch among the
-///    faces of the border's 3D Delaunay triangulation, without its cubic fallback;
+/// 1. in the plane of its vector area, by a 2D constrained Delaunay triangulation
+///    (triangulate_in_plane on the hole made one polygon), where the border seen in that
+///    plane is a simple polygon (the wavy base of a scan): O(n log n) time, linear memory;
+/// 2. otherwise, up to kSearchedHole edges, by the search for the best patch among the
+///    faces of the border's 3D Delaunay triangulation (search_hole_patch), without the cubic
+///    fallback;
 /// 3. otherwise by a fan from the border's centroid, always a manifold patch.
 /// Any of them may cross the surface; the crossing check after filling deals with that.
 /// (CGAL's own planar route in triangulate_hole averages the normals of a fan after turning
@@ -524,16 +537,16 @@ bool fill_large_hole(Mesh& mesh, Mesh::Halfedge_index h, bool unfaired, std::vec
     by_fan = false;
     std::vector<Mesh::Face_index> patch;
     CGAL::Euler::fill_hole(h, mesh);
-    // triangulate_face refuses a polygon that runs over itself in its plane only after
-    // inserting every crossing exactly, which takes minutes on a steep zig-zag: the polygon is
-    // tested first (a sweep), seen along the normal triangulate_face uses.
+    // A constrained triangulation refuses a polygon that runs over itself in its plane only
+    // after inserting every crossing exactly, which took CGAL's triangulate_face minutes on a
+    // steep zig-zag: the polygon is tested first (a sweep), seen along the same normal.
     const Kernel::Vector_3 normal = PMP::compute_face_normal(mesh.face(h), mesh);
     const bool simple = normal != CGAL::NULL_VECTOR &&
                         CGAL::is_simple_2(ring.begin(), ring.end(), CGAL::Projection_traits_3<Kernel>(normal));
     if (!simple || !triangulate_in_plane(mesh, mesh.face(h), normal, patch)) {
         patch.clear();
         if (ring.size() <= kSearchedHole) {
-            CGAL::Euler::remove_face(h, mesh); // a hole again (a refusing triangulate_face leaves the polygon)
+            CGAL::Euler::remove_face(h, mesh); // a hole again (a refusing triangulate_in_plane leaves the polygon)
             patch = triangulate_hole_searched(mesh, h, false);
             if (patch.empty()) CGAL::Euler::fill_hole(h, mesh);
         }
@@ -553,9 +566,7 @@ bool fill_large_hole(Mesh& mesh, Mesh::Halfedge_index h, bool unfaired, std::vec
             for (auto f : CGAL::faces_around_target(spoke, mesh)) patch.push_back(f);
         }
     }
-    new_faces = patch;
-    PMP::refine(mesh, patch, std::back_inserter(new_faces), std::back_inserter(new_vertices));
-    return !unfaired && PMP::fair(mesh, new_vertices);
+    return refine_and_fair(mesh, patch, unfaired, new_faces, new_vertices);
 }
 
 struct FillCounts {
@@ -563,8 +574,8 @@ struct FillCounts {
 };
 
 /// Fills the holes whose boundary cycles start at `borders`, each with a refined, faired
-/// patch unless `unfaired` flags it (a refined patch then, not faired), or a plain
-/// minimal-area one when that gives nothing; large holes (kLargeHole) by fill_large_hole.
+/// patch unless `unfaired` flags it (a refined patch then, not faired); large holes
+/// (kLargeHole) by fill_large_hole.
 /// `patch` receives, per face, 1 + the index of the hole it fills (0: not a patch face).
 FillCounts fill_holes_once(Mesh& mesh, const std::vector<Mesh::Halfedge_index>& borders,
                            const std::vector<char>& unfaired, Mesh::Property_map<Mesh::Face_index, std::size_t> patch)
@@ -579,13 +590,9 @@ FillCounts fill_holes_once(Mesh& mesh, const std::vector<Mesh::Halfedge_index>& 
             bool by_fan = false;
             if (fill_large_hole(mesh, h, unfaired[i] != 0, new_faces, new_vertices, by_fan)) ++n.faired;
             if (by_fan) ++n.fans;
-        } else {
-            // CGAL's triangulate_refine_and_fair_hole (triangulate_and_refine_hole when
-            // unfaired), with the patch found by triangulate_hole_searched.
-            const std::vector<Mesh::Face_index> searched = triangulate_hole_searched(mesh, h, true);
-            new_faces = searched;
-            PMP::refine(mesh, searched, std::back_inserter(new_faces), std::back_inserter(new_vertices));
-            if (!unfaired[i] && PMP::fair(mesh, new_vertices)) ++n.faired;
+        } else if (refine_and_fair(mesh, triangulate_hole_searched(mesh, h, true), unfaired[i] != 0, new_faces,
+                                   new_vertices)) {
+            ++n.faired;
         }
         if (!new_faces.empty()) ++n.filled;
         for (Mesh::Face_index f : new_faces) patch[f] = i + 1;
@@ -620,7 +627,7 @@ std::optional<std::vector<std::array<std::size_t, 2>>> crossing_pairs(const Tria
     }
 }
 
-/// Fills every hole with a refined, faired patch (a plain minimal-area one when that fails).
+/// Fills every hole with a refined, faired patch.
 /// Fairing keeps the patch's interior smooth but not out of the surface's way: over a long,
 /// wavy border (the open base of a scan, say) the faired patch can fold through itself or
 /// the surface. Those holes are filled again with the refined patch alone, which lies on the
