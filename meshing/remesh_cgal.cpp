@@ -9,6 +9,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <unordered_map>
 #include <vector>
 
@@ -50,6 +51,121 @@ struct OmTraits : public OpenMesh::DefaultTraits {
 };
 using OMesh = OpenMesh::TriMesh_ArrayKernelT<OmTraits>;
 using EdgeDescriptor = boost::graph_traits<OMesh>::edge_descriptor;
+
+/// CGAL 5.5's tangential relaxation as PMP::isotropic_remeshing runs it on this file's mesh
+/// type, the same operations in the same order (so the meshes are the same bit for bit), but
+/// for one case. Each move is undone step by step while two faces round the moved vertex,
+/// compared in turn from the first face that is not exactly degenerate, face apart. Where
+/// every face round the vertex is exactly degenerate there is no first face, and CGAL reads
+/// the edge-constraint map at the null halfedge: index −1 of an OpenMesh property array
+/// (found by fuzz/mesh_repair_fuzz.cpp on a thin wedge with integer coordinates; UBSan stops
+/// there, a release build reads four bytes before the array). Here such a vertex does not
+/// move, which is what CGAL's check decides unless those four bytes happen to read as
+/// "constrained".
+///
+/// The remesher calls `tangential_relaxation(vertices(mesh), mesh, named parameters)`
+/// unqualified; OmTraits, a template argument of OMesh, makes this namespace one that
+/// argument-dependent lookup searches, and this overload, taking OMesh itself, is more
+/// specialised than CGAL's template, so the remesher calls it. Test
+/// `Remesh.CGALsRoundsRemeshASmallRepairedModelWhoseRelaxationMeetsOnlyDegenerateFaces` fails
+/// under UBSan (the asan build) should it ever call CGAL's again (another CGAL version).
+template <class VertexRange, class NamedParameters>
+void tangential_relaxation(const VertexRange& range, OMesh& tm, const NamedParameters& np)
+{
+    using CGAL::parameters::choose_parameter;
+    using CGAL::parameters::get_parameter;
+    using GT = typename CGAL::GetGeomTraits<OMesh, NamedParameters>::type;
+    using Vector = typename GT::Vector_3;
+    using Point = typename GT::Point_3;
+    using V = boost::graph_traits<OMesh>::vertex_descriptor;
+    using H = boost::graph_traits<OMesh>::halfedge_descriptor;
+    using E = boost::graph_traits<OMesh>::edge_descriptor;
+    const GT gt = choose_parameter<GT>(get_parameter(np, CGAL::internal_np::geom_traits));
+    const auto vpm = choose_parameter(get_parameter(np, CGAL::internal_np::vertex_point),
+                                      CGAL::get_property_map(CGAL::vertex_point, tm));
+    const auto ecm = choose_parameter(get_parameter(np, CGAL::internal_np::edge_is_constrained),
+                                      CGAL::Static_boolean_property_map<E, false>());
+    const auto vcm = choose_parameter(get_parameter(np, CGAL::internal_np::vertex_is_constrained),
+                                      CGAL::Static_boolean_property_map<V, false>());
+    const auto allowed = choose_parameter(get_parameter(np, CGAL::internal_np::allow_move_functor),
+                                          PMP::internal::Allow_all_moves());
+    const bool relax_constraints = choose_parameter(get_parameter(np, CGAL::internal_np::relax_constraints), false);
+    const unsigned iterations = choose_parameter(get_parameter(np, CGAL::internal_np::number_of_iterations), 1);
+    auto constrained = [&](H h) { return get(ecm, edge(h, tm)); };
+
+    // No two faces round v, taken in turn across free edges (and the last with the first),
+    // face apart; exactly degenerate faces are passed over.
+    auto faces_agree = [&](V v) {
+        bool any = false;
+        Vector first = CGAL::NULL_VECTOR, previous = CGAL::NULL_VECTOR;
+        H first_h = boost::graph_traits<OMesh>::null_halfedge();
+        for (H h : CGAL::halfedges_around_target(v, tm)) {
+            if (CGAL::is_border(h, tm)) continue;
+            const Vector n = PMP::compute_face_normal(face(h, tm), tm, np);
+            if (n == CGAL::NULL_VECTOR) continue;
+            if (!any) {
+                any = true;
+                first = n;
+                first_h = h;
+            } else if (!constrained(h) && CGAL::to_double(n * previous) <= 0) {
+                return false;
+            }
+            previous = n;
+        }
+        if (!any) return false; // every face degenerate: nothing tells the move is safe
+        return constrained(first_h) || !(CGAL::to_double(first * previous) <= 0);
+    };
+
+    std::vector<H> inner, along;
+    std::vector<std::tuple<V, Vector, Point>> targets; // vertex, its normal, where its neighbours pull it
+    for (unsigned round = 0; round < iterations; ++round) {
+        std::unordered_map<V, Vector> normals;
+        PMP::compute_vertex_normals(tm, boost::make_assoc_property_map(normals), np);
+        targets.clear();
+        for (V v : range) {
+            if (get(vcm, v) || CGAL::internal::is_isolated(v, tm)) continue;
+            inner.clear();
+            along.clear();
+            for (H h : CGAL::halfedges_around_target(v, tm))
+                (CGAL::is_border_edge(h, tm) || constrained(h) ? along : inner).push_back(h);
+            const Point p = get(vpm, v);
+            if (along.empty()) {
+                // The mean of the neighbours, as the mean of the edge vectors from v.
+                Vector sum = CGAL::NULL_VECTOR;
+                unsigned count = 0;
+                for (H h : inner) {
+                    sum = sum + Vector(p, get(vpm, source(h, tm)));
+                    ++count;
+                }
+                sum = (1. / static_cast<double>(count)) * sum;
+                targets.emplace_back(v, normals.at(v), p + sum);
+            } else if (relax_constraints && along.size() == 2) {
+                // Along a constrained line, unless it turns by more than 60° there.
+                const Point a = get(vpm, source(along[0], tm)), b = get(vpm, source(along[1], tm));
+                const double dot = CGAL::to_double(Vector(p, a) * Vector(p, b));
+                if (0.25 < dot * dot / (CGAL::squared_distance(a, p) * CGAL::squared_distance(b, p)))
+                    targets.emplace_back(v, Vector(CGAL::NULL_VECTOR), gt.construct_barycenter_3_object()(a, 0.25, b, 0.25, p, 0.5));
+            }
+        }
+        // Every target from the old places first (projected onto the vertex's tangent plane),
+        // then the moves one after another, each halved up to five times while faces round the
+        // vertex face apart, and undone after that.
+        std::vector<std::pair<V, Point>> moves;
+        moves.reserve(targets.size());
+        for (const auto& [v, n, q] : targets) moves.emplace_back(v, q + (n * Vector(q, get(vpm, v))) * n);
+        for (const auto& [v, to] : moves) {
+            const Point from = get(vpm, v);
+            const Vector step(from, to);
+            put(vpm, v, to);
+            double frac = 1.;
+            while (frac > 0.03 && (!faces_agree(v) || !allowed(v, from, get(vpm, v)))) {
+                frac = 0.5 * frac;
+                put(vpm, v, from + frac * step);
+            }
+            if (frac <= 0.02) put(vpm, v, from);
+        }
+    }
+}
 
 /// CGAL's edge_is_constrained_map over an OpenMesh edge property. Edges that remeshing
 /// creates get OpenMesh's default, false; CGAL marks sub-edges of constrained edges itself.

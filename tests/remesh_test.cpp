@@ -773,6 +773,24 @@ TEST(Remesh, OurRoundsRemeshASmallRepairedModelThatCGALsRelaxationCannot)
     EXPECT_GT(lobe.triangles.size(), 100u);
 }
 
+TEST(Remesh, CGALsRoundsRemeshASmallRepairedModelWhoseRelaxationMeetsOnlyDegenerateFaces)
+{
+    // The same input with CGAL's rounds, as lobes from models are remeshed: CGAL 5.5's own
+    // relaxation would read the edge property at index −1 here (UBSan stops the asan build);
+    // the relaxation in remesh_cgal.cpp leaves such a vertex where it is.
+    const TriangleMesh raw = parse_mesh("v 0 0 0\nv 0 0 1\nv 1 1 0\nv 0 1 1\nv 1 0 0\nv 1 0 1\nv 1 1 0\nv 0 0 1\nv 1 1 0\n"
+                                        "f 5 8 7\nf 1 6 5\nf 3 8 4\nf 3 7 8\nf 1 5 7\nf 2 8 6\nf 2 4 8\n",
+                                        "fuzz-finding.obj");
+    RemeshOptions o;
+    o.target_edge_length_m = 0.15;
+    ASSERT_FALSE(o.own_rounds);
+    const TriangleMesh lobe = remesh_isotropic(normalize_to_box(repair_mesh(raw), 1.5), o);
+    const MeshQuality q = measure_quality(lobe);
+    EXPECT_TRUE(q.closed && q.manifold && q.outward);
+    EXPECT_GT(q.signed_volume_m3, 0.01);
+    EXPECT_GT(lobe.triangles.size(), 100u);
+}
+
 TEST(Remesh, FeatureEdgesCanBeIgnored)
 {
     std::vector<int> equator;
