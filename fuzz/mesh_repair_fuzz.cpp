@@ -1,14 +1,15 @@
 // libFuzzer target: OBJ meshes read by parse_mesh, repaired (repair_mesh, the first step of
-// `lobesketch lobes MESH`) and remeshed by our rounds (remesh_isotropic with own_rounds, as
-// every lobe drawn with strokes is remeshed). Repair either returns a closed, 2-manifold,
-// outward-oriented surface, free of self-intersections unless its report says some were
-// left, or refuses with a one-line InvalidInput; so does the remeshing.
+// `lobesketch lobes MESH`) and remeshed twice: by CGAL's rounds (remesh_isotropic's default,
+// as lobes from models are remeshed) and by our rounds (own_rounds, as every lobe drawn with
+// strokes is remeshed). Repair either returns a closed, 2-manifold, outward-oriented surface,
+// free of self-intersections unless its report says some were left, or refuses with a
+// one-line InvalidInput; so does each remeshing.
 //
 // The remeshing runs at 15 cm instead of 3 cm so that one input takes milliseconds; its code
-// paths are the same. It does not run CGAL's own rounds, which lobes from models use: CGAL
-// 5.5's tangential relaxation reads an edge property at a null halfedge (index −1) when every
-// face around a vertex is exactly degenerate, which this target reaches within seconds on
-// integer-coordinate slivers (docs/fuzzing.md, "Findings").
+// paths are the same. This target once found CGAL 5.5's tangential relaxation reading an edge
+// property at a null halfedge (index −1) where every face around a vertex is exactly
+// degenerate, on integer-coordinate slivers; remesh_cgal.cpp now runs its own relaxation in
+// CGAL's rounds (docs/fuzzing.md, "Findings").
 #include <cstdint>
 
 #include "fuzz/fuzz_common.h"
@@ -28,13 +29,17 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         const lobe::TriangleMesh repaired = lobe::repair_mesh(in, &report);
         lobe::fuzz::check_repaired(repaired, report);
 
-        lobe::RemeshOptions options;
-        options.target_edge_length_m = 0.15;
-        options.iterations = 3;
-        options.own_rounds = true;
-        const lobe::TriangleMesh lobe = lobe::remesh_isotropic(lobe::normalize_to_box(repaired, 1.5), options);
-        const lobe::MeshQuality l = lobe::measure_quality(lobe);
-        lobe::check_encloses_volume(lobe, l, "the remeshed lobe"); // a flattened sliver is refused
-        lobe::fuzz::require(l.closed && l.manifold && l.outward, "a remeshed lobe that is not closed, 2-manifold and outward");
+        const lobe::TriangleMesh boxed = lobe::normalize_to_box(repaired, 1.5);
+        for (const bool own_rounds : {false, true}) {
+            lobe::RemeshOptions options;
+            options.target_edge_length_m = 0.15;
+            options.iterations = 3;
+            options.own_rounds = own_rounds;
+            const lobe::TriangleMesh lobe = lobe::remesh_isotropic(boxed, options);
+            const lobe::MeshQuality l = lobe::measure_quality(lobe);
+            lobe::check_encloses_volume(lobe, l, "the remeshed lobe"); // a flattened sliver is refused
+            lobe::fuzz::require(l.closed && l.manifold && l.outward,
+                                "a remeshed lobe that is not closed, 2-manifold and outward");
+        }
     });
 }
