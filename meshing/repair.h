@@ -16,6 +16,11 @@ namespace lobe {
 
 /// What repair_mesh() did, for the import report.
 struct RepairReport {
+    /// Triangles of the mesh as read, where lobe_from_mesh simplified it before repair
+    /// (cluster_vertices, model_import.h); 0 where it did not. The counts below are then the
+    /// simplified mesh's.
+    std::size_t simplified_from_triangles = 0;
+    double simplify_cell_m = 0;              ///< the clustering's cube side, at the lobe's size
     std::size_t input_vertices = 0;
     std::size_t input_triangles = 0;
     std::size_t merged_vertices = 0;         ///< duplicate points merged or unused points dropped

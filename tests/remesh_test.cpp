@@ -911,6 +911,74 @@ TEST(LobeFromModel, SpotThroughTheOneCall)
     EXPECT_NEAR(q.edge_mean_m, 0.03, 0.008);
 }
 
+TEST(LobeFromModel, ClusterVerticesMergesEachCubeAndDropsCollapsedFoldedAndPinchedTriangles)
+{
+    TriangleMesh m;
+    // A quad of two triangles, its corners in four cubes of side 1, one corner doubled by a
+    // nearby point of a sliver that collapses into one cube.
+    m.positions = {{0.1f, 0.1f, 0.1f}, {1.1f, 0.1f, 0.1f}, {1.1f, 1.1f, 0.1f}, {0.1f, 1.1f, 0.1f}, {0.3f, 0.3f, 0.3f},
+                   {0.2f, 0.2f, 0.2f}};
+    m.triangles = {{0, 1, 2}, {0, 2, 3}, {0, 4, 5}};
+    TriangleMesh out = cluster_vertices(m, 1.0);
+    ASSERT_EQ(out.positions.size(), 4u);
+    EXPECT_EQ(out.triangles.size(), 2u); // the sliver lies in one cube
+    // Vertices in order of their cubes' keys; the first cube's vertex is its three points' mean.
+    EXPECT_NEAR(out.positions[0].x, 0.2f, 1e-6f);
+    EXPECT_NEAR(out.positions[0].z, 0.2f, 1e-6f);
+    EXPECT_TRUE(measure_quality(out).triangles == 2);
+
+    // The same triangle twice (either way round) is a fold the grid flattened: both go.
+    m.positions = {{0.1f, 0.1f, 0.1f}, {1.1f, 0.1f, 0.1f}, {1.1f, 1.1f, 0.1f}, {0.1f, 1.1f, 0.1f}};
+    m.triangles = {{0, 1, 2}, {0, 2, 1}, {0, 2, 3}};
+    out = cluster_vertices(m, 1.0);
+    ASSERT_EQ(out.triangles.size(), 1u);
+
+    // Three triangles on one edge (sheets pinched together), and two running round an edge
+    // the same way: all of them go, the triangle elsewhere stays.
+    m.positions = {{0.1f, 0.1f, 0.1f}, {1.1f, 0.1f, 0.1f}, {0.1f, 1.1f, 0.1f}, {0.1f, 0.1f, 1.1f},
+                   {0.1f, -0.9f, 0.1f}, {3.1f, 3.1f, 3.1f}, {4.1f, 3.1f, 3.1f}, {3.1f, 4.1f, 3.1f}};
+    m.triangles = {{0, 1, 2}, {0, 1, 3}, {1, 0, 4}, {5, 6, 7}};
+    out = cluster_vertices(m, 1.0);
+    ASSERT_EQ(out.triangles.size(), 1u);
+    m.triangles = {{0, 1, 2}, {0, 1, 3}, {5, 6, 7}};
+    EXPECT_EQ(cluster_vertices(m, 1.0).triangles.size(), 1u);
+}
+
+TEST(LobeFromModel, AMeshOverTheTriangleLimitIsSimplifiedBeforeRepairAndKeepsItsShape)
+{
+    // A unit sphere of 159,200 triangles (edges of about 8 mm at the lobe's 1.5 m), over a
+    // limit of 100,000: its vertices are merged in 18 mm cubes before repair, and the lobe
+    // still lies on the sphere.
+    std::vector<int> equator;
+    TriangleMesh sphere = uv_sphere(200, 400, 1.0, equator);
+    sphere.feature_edges.clear();
+    LobeFromModelOptions o;
+    o.simplify_above_triangles = 100000;
+    o.simplify_cell_fraction = 0.6;
+    RepairReport report;
+    const TriangleMesh lobe = lobe_from_mesh(sphere, o, &report);
+    EXPECT_EQ(report.simplified_from_triangles, sphere.triangles.size());
+    EXPECT_DOUBLE_EQ(report.simplify_cell_m, 0.018);
+    EXPECT_LT(report.input_triangles, sphere.triangles.size() / 3);
+    ASSERT_FALSE(report.notes.empty());
+    const std::string note = "simplified " + std::to_string(sphere.triangles.size()) + " triangles to ";
+    EXPECT_EQ(report.notes.front().rfind(note, 0), 0u) << report.notes.front();
+    const MeshQuality q = measure_quality(lobe);
+    EXPECT_TRUE(q.closed && q.manifold && q.outward);
+    EXPECT_NEAR(q.edge_mean_m, 0.03, 0.008);
+    double worst = 0;
+    for (const glm::vec3& p : lobe.positions)
+        worst = std::max(worst, std::abs(glm::length(glm::dvec3(p) - glm::dvec3(0, 0.75, 0)) - 0.75));
+    EXPECT_LT(worst, 0.001);
+
+    // Under the limit nothing is simplified.
+    o.simplify_above_triangles = sphere.triangles.size();
+    RepairReport whole;
+    lobe_from_mesh(uv_sphere(20, 40, 1.0, equator), o, &whole);
+    EXPECT_EQ(whole.simplified_from_triangles, 0u);
+    EXPECT_EQ(LobeFromModelOptions{}.simplify_above_triangles, 1000000u);
+}
+
 TEST(LobeFromModel, BadFilesNameTheFile)
 {
     const std::string path = test::temp_dir("lobe_from_model") + "/flat.obj";
