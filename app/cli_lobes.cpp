@@ -1,6 +1,7 @@
 // `lobesketch lobes INPUT --out DIR`: lobe meshes from a recording, a session or a mesh.
 #include <algorithm>
 #include <cctype>
+#include <cstddef>
 #include <filesystem>
 #include <memory>
 
@@ -23,6 +24,7 @@ void add_lobes_command(CLI::App& app, int& exit_code)
     struct Args {
         std::string input, out, settings;
         double size_m = 1.5;
+        std::size_t simplify_above = LobeFromModelOptions{}.simplify_above_triangles;
     };
     auto a = std::make_shared<Args>();
     cmd->add_option("INPUT", a->input, "Recording, session document or mesh")->required();
@@ -31,6 +33,10 @@ void add_lobes_command(CLI::App& app, int& exit_code)
     cmd->add_option("--size", a->size_m, "A mesh input is scaled so its bounding box's largest side is this (metres)")
         ->capture_default_str()
         ->check(CLI::Range(0.01, 100.0));
+    cmd->add_option("--simplify-above", a->simplify_above,
+                    "A mesh of more triangles than this is simplified in cubes of a fifth of the spacing before "
+                    "repair (0: never)")
+        ->capture_default_str();
     cmd->callback([a, &exit_code] {
         const std::string ext = lower_extension(a->input);
         std::error_code ec;
@@ -43,6 +49,7 @@ void add_lobes_command(CLI::App& app, int& exit_code)
             if (!a->settings.empty()) doc.settings = load_settings_file(a->settings);
             LobeFromModelOptions options;
             options.size_m = a->size_m;
+            options.simplify_above_triangles = a->simplify_above;
             options.target_edge_length_m = doc.settings.lobes.edge_length_m;
             options.iterations = static_cast<unsigned>(doc.settings.lobes.remesh_iterations);
             RepairReport report;

@@ -119,6 +119,12 @@ TEST(Cli, LobesCommandBuildsLobesFromARecordingASessionAndAMesh)
     const TriangleMesh again = read_mesh(dir + "/mesh-again/lobes/lobe_1.ply");
     EXPECT_EQ(again.positions, spot.positions);
     EXPECT_EQ(again.triangles, spot.triangles);
+    // --simplify-above: a mesh of more triangles is clustered before repair, and says so.
+    r = run("lobes " + test::shared_path("data/models/spot.obj") + " --simplify-above 1000 --out " + dir + "/simplified");
+    ASSERT_EQ(r.code, 0) << r.out;
+    EXPECT_NE(r.out.find("repaired: simplified 5856 triangles to "), std::string::npos) << r.out;
+    const MeshQuality simplified = measure_quality(read_mesh(dir + "/simplified/lobes/lobe_1.ply"));
+    EXPECT_TRUE(simplified.closed && simplified.manifold && simplified.outward);
     // A malformed mesh: one line naming the file, exit 1, nothing written.
     const std::string bad = dir + "/bad.obj";
     {
