@@ -4,9 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdio>
-
-#include <glm/vec3.hpp>
+#include <vector>
 
 #include "core/errors.h"
 #include "meshing/mesh_io.h"
@@ -15,6 +15,38 @@
 
 namespace lobe {
 
+namespace {
+
+/// The largest side of the box that holds the middle 99 % of the vertices triangles use
+/// (0.5 % cut off at each end of each axis): the extent the lobe will be scaled from, unmoved
+/// by a few stray points or specks far away, which repair drops (unused vertices, smaller
+/// components). 0 when it has no extent; not finite when a coordinate is not.
+double robust_extent(const TriangleMesh& mesh)
+{
+    std::vector<char> used(mesh.positions.size(), 0);
+    for (const auto& t : mesh.triangles)
+        for (int v : t)
+            if (v >= 0 && static_cast<std::size_t>(v) < used.size()) used[static_cast<std::size_t>(v)] = 1;
+    std::vector<float> c;
+    double largest = 0;
+    for (int axis = 0; axis < 3; ++axis) {
+        c.clear();
+        for (std::size_t v = 0; v < used.size(); ++v)
+            if (used[v]) c.push_back(mesh.positions[v][axis]);
+        if (c.empty()) return 0;
+        for (float x : c)
+            if (!std::isfinite(x)) return x;
+        const std::size_t cut = c.size() / 200;
+        std::nth_element(c.begin(), c.begin() + static_cast<std::ptrdiff_t>(cut), c.end());
+        const double lo = c[cut];
+        std::nth_element(c.begin(), c.end() - 1 - static_cast<std::ptrdiff_t>(cut), c.end());
+        largest = std::max(largest, static_cast<double>(c[c.size() - 1 - cut]) - lo);
+    }
+    return largest;
+}
+
+} // namespace
+
 TriangleMesh lobe_from_mesh(const TriangleMesh& mesh, const LobeFromModelOptions& options, RepairReport* report)
 {
     // A mesh far finer than the lobe's spacing is simplified first (LobeFromModelOptions).
@@ -22,11 +54,8 @@ TriangleMesh lobe_from_mesh(const TriangleMesh& mesh, const LobeFromModelOptions
     double cell_m = 0;
     if (options.simplify_above_triangles > 0 && mesh.triangles.size() > options.simplify_above_triangles &&
         options.simplify_cell_fraction > 0) {
-        glm::dvec3 lo, hi;
-        bounding_box(mesh, lo, hi);
-        const double largest = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
         cell_m = options.simplify_cell_fraction * options.target_edge_length_m;
-        const double cell = cell_m * largest / options.size_m; // in the mesh's own units
+        const double cell = cell_m * robust_extent(mesh) / options.size_m; // in the mesh's own units
         if (std::isfinite(cell) && cell > 0) simplified = cluster_vertices(mesh, cell);
         else cell_m = 0; // no extent or not finite: repair and scaling refuse it as it is
     }

@@ -948,10 +948,18 @@ TEST(LobeFromModel, AMeshOverTheTriangleLimitIsSimplifiedBeforeRepairAndKeepsIts
 {
     // A unit sphere of 159,200 triangles (edges of about 8 mm at the lobe's 1.5 m), over a
     // limit of 100,000: its vertices are merged in 18 mm cubes before repair, and the lobe
-    // still lies on the sphere.
+    // still lies on the sphere. A speck 100 units away (a tetrahedron; repair keeps the
+    // largest part) does not make the cubes coarser: they follow the extent of the middle
+    // 99 % of the vertices, as the lobe's size does the part repair keeps.
     std::vector<int> equator;
     TriangleMesh sphere = uv_sphere(200, 400, 1.0, equator);
     sphere.feature_edges.clear();
+    const int speck = static_cast<int>(sphere.positions.size());
+    for (const glm::vec3 p : {glm::vec3(100, 100, 100), glm::vec3(100.1f, 100, 100), glm::vec3(100, 100.1f, 100),
+                              glm::vec3(100, 100, 100.1f)})
+        sphere.positions.push_back(p);
+    for (const std::array<int, 3> t : {std::array<int, 3>{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}})
+        sphere.triangles.push_back({speck + t[0], speck + t[1], speck + t[2]});
     LobeFromModelOptions o;
     o.simplify_above_triangles = 100000;
     o.simplify_cell_fraction = 0.6;
