@@ -21,10 +21,12 @@ TriangleMesh normalize_to_box(const TriangleMesh& mesh, double size_m = 1.5);
 /// grouped by the cube of a grid of side `cell` (from the bounding box's lowest corner) they
 /// lie in, each group becomes one vertex at its members' mean, and every triangle whose
 /// corners fall into three different cubes is kept, on those vertices, unless another
-/// triangle falls into the same three (a thin part flattened into coincident triangles: all
-/// such are dropped). The result may still be non-manifold or open where the grid pinches the
-/// surface; repair_mesh handles that. Time O(V log V + F log F), memory about 24 bytes per
-/// vertex and 32 per triangle besides the result.
+/// triangle falls into the same three (a thin part flattened into coincident triangles), it
+/// has an edge that more than two such triangles share (sheets the grid pinched together), or
+/// it runs round an edge the same way as its neighbour there: all such are dropped. The result
+/// is 2-manifold along its edges, but may be open where triangles were dropped and pinched at
+/// vertices; repair_mesh handles both. Time O(V log V + F log F); memory about 24 bytes per
+/// vertex read and 80 per triangle on three cubes, besides the result.
 /// \pre finite positions; cell > 0.
 /// \throw InvalidInput when a triangle's index is out of range.
 TriangleMesh cluster_vertices(const TriangleMesh& mesh, double cell);
