@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdio>
+#include <optional>
 #include <vector>
 
 #include "core/errors.h"
@@ -49,38 +50,33 @@ double robust_extent(const TriangleMesh& mesh)
 
 TriangleMesh lobe_from_mesh(const TriangleMesh& mesh, const LobeFromModelOptions& options, RepairReport* report)
 {
-    // A mesh far finer than the lobe's spacing is simplified first (LobeFromModelOptions).
-    TriangleMesh simplified;
-    double cell_m = 0;
+    // A mesh far finer than the lobe's spacing is simplified first (LobeFromModelOptions);
+    // where repair refuses the simplified mesh, or none was made, the mesh as read is repaired.
+    std::optional<TriangleMesh> repaired;
     if (options.simplify_above_triangles > 0 && mesh.triangles.size() > options.simplify_above_triangles &&
         options.simplify_cell_fraction > 0) {
-        cell_m = options.simplify_cell_fraction * options.target_edge_length_m;
+        const double cell_m = options.simplify_cell_fraction * options.target_edge_length_m;
         const double cell = cell_m * robust_extent(mesh) / options.size_m; // in the mesh's own units
-        if (std::isfinite(cell) && cell > 0) simplified = cluster_vertices(mesh, cell);
-        else cell_m = 0; // no extent or not finite: repair and scaling refuse it as it is
-    }
-    TriangleMesh repaired;
-    if (cell_m > 0) {
-        try {
-            repaired = repair_mesh(simplified, report);
-        } catch (const InvalidInput&) {
-            cell_m = 0; // the simplified mesh is beyond repair: the mesh as it was, as below
+        if (std::isfinite(cell) && cell > 0) { // else no extent or not finite: refused below
+            const TriangleMesh simplified = cluster_vertices(mesh, cell);
+            try {
+                repaired = repair_mesh(simplified, report);
+            } catch (const InvalidInput&) {
+                // beyond repair once simplified: the mesh as read, below
+            }
+            if (repaired && report) {
+                report->simplified_from_triangles = mesh.triangles.size();
+                report->simplify_cell_m = cell_m;
+                char note[200];
+                std::snprintf(note, sizeof note,
+                              "simplified %zu triangles to %zu by merging the vertices within each %.3g mm cube",
+                              mesh.triangles.size(), simplified.triangles.size(), cell_m * 1000.0);
+                report->notes.insert(report->notes.begin(), note);
+            }
         }
     }
-    if (cell_m > 0) {
-        if (report) {
-            report->simplified_from_triangles = mesh.triangles.size();
-            report->simplify_cell_m = cell_m;
-            char note[200];
-            std::snprintf(note, sizeof note,
-                          "simplified %zu triangles to %zu by merging the vertices within each %.3g mm cube",
-                          mesh.triangles.size(), simplified.triangles.size(), cell_m * 1000.0);
-            report->notes.insert(report->notes.begin(), note);
-        }
-    } else {
-        repaired = repair_mesh(mesh, report);
-    }
-    const TriangleMesh scaled = normalize_to_box(repaired, options.size_m);
+    if (!repaired) repaired = repair_mesh(mesh, report);
+    const TriangleMesh scaled = normalize_to_box(*repaired, options.size_m);
     RemeshOptions ro;
     ro.target_edge_length_m = options.target_edge_length_m;
     ro.iterations = options.iterations;
