@@ -160,6 +160,8 @@ LobeOptions lobe_options_from(const Settings& settings)
     o.closure.max_gap_fraction = settings.lobes.closed_gap_fraction;
     o.closure.max_gap_m = settings.lobes.closed_gap_max_m;
     o.surface.fill_edge_m = settings.lobes.edge_length_m;
+    // Without remeshing the fill is the lobe's attractors: laid at the spacing itself.
+    if (settings.lobes.remesh_iterations <= 0) o.surface.fill_coarseness = 1.0;
     o.sampling.seed = 0;
     return o;
 }

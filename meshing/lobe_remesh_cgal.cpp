@@ -337,6 +337,7 @@ TriangleMesh remesh_whole(const LobeSurface& surface, const RemeshOptions& optio
     o.protect_feature_edges = true;
     o.relax_feature_edges = true;
     o.faces.clear();
+    o.radial_centre = surface.centre;
     return remesh_isotropic(surface.mesh, o);
 }
 
@@ -436,6 +437,7 @@ TriangleMesh remesh_lobe_surface(const LobeSurface& surface, const RemeshOptions
     region_options.protect_feature_edges = true;
     region_options.relax_feature_edges = false;
     region_options.own_rounds = true; // with the small-angle repairs
+    region_options.radial_centre = surface.centre;
 
     std::map<std::vector<float>, TriangleMesh> now;
     std::vector<const TriangleMesh*> remeshed(input.size(), nullptr);

@@ -44,6 +44,13 @@ struct LobeSurfaceOptions {
     double fill_sagitta_m = 0.0015;
     /// … and at most the angle of this edge length (the attractor spacing).
     double fill_edge_m = 0.03;
+    /// The fill is laid this many times coarser than the two bounds above (in angle; 1 to
+    /// 4). Remeshing puts the attractors at the target spacing and lifts every vertex it makes
+    /// along its ray from the centre to the distance interpolated across the fill's triangles
+    /// (RemeshOptions::radial_centre), so the remeshed lobe keeps its curvature between fill
+    /// vertices. At 2 a stroke is added in about 0.7 of the time (docs/lobes.md, "Measured").
+    /// A lobe that is not remeshed (remesh_iterations 0) keeps 1: its fill is its attractors.
+    double fill_coarseness = 2.0;
     /// A stroke sample closer than this fraction of its stroke's median spacing to a
     /// crossing with another stroke is dropped in favour of the crossing vertex (no
     /// sliver triangles at crossings). Stroke end points are never dropped.

@@ -1444,7 +1444,8 @@ void Builder::refine()
     const double r = std::max(options_.reference_radius_m > 0 ? options_.reference_radius_m : mean_radius_, 1e-6);
     const double by_sagitta = std::acos(std::clamp(1.0 - options_.fill_sagitta_m / r, -1.0, 1.0));
     const double by_edge = options_.fill_edge_m / r;
-    const double max_angle = std::max(1e-3, std::min(by_sagitta, by_edge));
+    const double coarseness = std::isfinite(options_.fill_coarseness) ? std::clamp(options_.fill_coarseness, 1.0, 4.0) : 1.0;
+    const double max_angle = std::max(1e-3, std::min(by_sagitta, by_edge) * coarseness);
     const double max_edge = std::sqrt(3.0) * max_angle;
     // A side whose chord is below this spans less than max_edge (with a margin far above
     // rounding), so most triangles are passed without an arcsine.

@@ -4,7 +4,10 @@
 /// constraints (the attractors of growth are the lobe's vertices). CGAL works behind
 /// this plain interface (remesh_cgal.cpp). See docs/lobes-from-models.md.
 
+#include <optional>
 #include <vector>
+
+#include <glm/vec3.hpp>
 
 #include "core/mesh.h"
 
@@ -40,6 +43,14 @@ struct RemeshOptions {
     /// The region's border edges are constrained too (split first when longer than the
     /// target), so every vertex outside the region keeps its position.
     std::vector<int> faces;
+    /// A stroke lobe's centre (the input is star-shaped around it: every triangle covers its
+    /// own piece of the sphere of directions and faces away from it). Then free vertices go,
+    /// instead of to the nearest point of the input, to the point on the ray from the centre
+    /// through them whose distance from the centre is interpolated linearly across the
+    /// input triangle the ray passes through. The lobe keeps its curvature between the
+    /// input's vertices (a sphere stays a sphere) where the nearest point lies on a flat
+    /// facet. Only the own rounds (own_rounds, relax_feature_edges) use it.
+    std::optional<glm::dvec3> radial_centre;
 };
 
 /// Most triangles a remeshing may make, estimated before it starts from the area it remeshes

@@ -297,7 +297,8 @@ private:
 /// alone cost as much as every query of a remeshing.
 class SurfaceProjector {
 public:
-    explicit SurfaceProjector(const TriangleMesh& surface) : surface_(surface), stamp_(surface.triangles.size(), 0)
+    explicit SurfaceProjector(const TriangleMesh& surface, std::optional<glm::dvec3> centre = std::nullopt)
+        : surface_(surface), centre_(centre), stamp_(surface.triangles.size(), 0)
     {
         offsets_.assign(surface.positions.size() + 1, 0);
         for (const auto& t : surface.triangles)
@@ -354,7 +355,68 @@ public:
         return best_point;
     }
 
+    /// Where a free vertex at x goes: with a centre (RemeshOptions::radial_centre), the
+    /// point on the ray from the centre through x at the distance interpolated across the
+    /// triangle the ray passes through, looked for among the triangles round the nearest one
+    /// (a vertex moves a fraction of the target length, its nearest triangle is the ray's or
+    /// one beside it); without a centre, or where no triangle nearby holds the ray (at the
+    /// input's border), the nearest point. `start` becomes the triangle used.
+    glm::dvec3 place(const glm::dvec3& x, int& start)
+    {
+        const glm::dvec3 nearest = project(x, start);
+        if (!centre_ || start < 0) return nearest;
+        const glm::dvec3 d = x - *centre_;
+        if (!(glm::dot(d, d) > 0.0)) return nearest;
+        // The nearest triangle, then those sharing a corner with it, then with those.
+        if (++generation_ == 0) {
+            std::fill(stamp_.begin(), stamp_.end(), 0u);
+            generation_ = 1;
+        }
+        ring_.clear();
+        ring_.push_back(start);
+        stamp_[static_cast<std::size_t>(start)] = generation_;
+        for (std::size_t i = 0; i < ring_.size() && i < kRadialSearch; ++i) {
+            const int f = ring_[i];
+            glm::dvec3 at;
+            if (radial_point(d, f, at)) {
+                start = f;
+                return at;
+            }
+            for (int v : surface_.triangles[static_cast<std::size_t>(f)])
+                for (int k = offsets_[static_cast<std::size_t>(v)]; k < offsets_[static_cast<std::size_t>(v) + 1]; ++k) {
+                    const int g = triangles_of_[static_cast<std::size_t>(k)];
+                    if (stamp_[static_cast<std::size_t>(g)] == generation_) continue;
+                    stamp_[static_cast<std::size_t>(g)] = generation_;
+                    ring_.push_back(g);
+                }
+        }
+        return nearest;
+    }
+
 private:
+    /// Triangles looked at for the ray before the nearest point is taken instead.
+    static constexpr std::size_t kRadialSearch = 64;
+
+    /// Whether the ray from the centre along d passes through triangle f (corners A, B, C
+    /// from the centre: d = αA + βB + γC with α, β, γ ≥ 0, by Cramer's rule); then `at` is the
+    /// point on it at the distance interpolated with the weights where it meets the triangle.
+    bool radial_point(const glm::dvec3& d, int f, glm::dvec3& at) const
+    {
+        const auto& t = surface_.triangles[static_cast<std::size_t>(f)];
+        const glm::dvec3 a = glm::dvec3(surface_.positions[static_cast<std::size_t>(t[0])]) - *centre_;
+        const glm::dvec3 b = glm::dvec3(surface_.positions[static_cast<std::size_t>(t[1])]) - *centre_;
+        const glm::dvec3 c = glm::dvec3(surface_.positions[static_cast<std::size_t>(t[2])]) - *centre_;
+        const double det = glm::dot(a, glm::cross(b, c));
+        if (!(det > 0.0)) return false; // degenerate, or facing the centre
+        const double alpha = glm::dot(glm::cross(b, c), d), beta = glm::dot(glm::cross(c, a), d), gamma = glm::dot(glm::cross(a, b), d);
+        if (alpha < 0.0 || beta < 0.0 || gamma < 0.0) return false;
+        const double sum = alpha + beta + gamma;
+        if (!(sum > 0.0)) return false;
+        const double r = (alpha * glm::length(a) + beta * glm::length(b) + gamma * glm::length(c)) / sum;
+        at = *centre_ + d * (r / glm::length(d));
+        return true;
+    }
+
     glm::dvec3 closest(const glm::dvec3& x, int f) const
     {
         const auto& t = surface_.triangles[static_cast<std::size_t>(f)];
@@ -363,10 +425,11 @@ private:
     }
 
     const TriangleMesh& surface_;
+    std::optional<glm::dvec3> centre_;
     std::vector<int> offsets_, triangles_of_; ///< triangles around each vertex
     std::vector<unsigned> stamp_;
     unsigned generation_ = 0;
-    std::vector<int> stack_;
+    std::vector<int> stack_, ring_;
 };
 
 /// The smallest angle of the triangle (a, b, c), radians.
@@ -615,9 +678,10 @@ void relax_tangentially(OMesh& om, OpenMesh::EPropHandleT<bool> constrained, con
 /// splits left them, and the triangles along strokes (above all where strokes run one target
 /// length apart) stay poorly shaped.
 void remesh_relaxing_features(OMesh& om, const TriangleMesh& input, double target, unsigned iterations,
-                              OpenMesh::EPropHandleT<bool> constrained, bool slide_features)
+                              OpenMesh::EPropHandleT<bool> constrained, bool slide_features,
+                              const std::optional<glm::dvec3>& radial_centre)
 {
-    SurfaceProjector surface(input);
+    SurfaceProjector surface(input, radial_centre);
     std::optional<FeatureSegments> strokes; // where slid stroke vertices are put back
     if (slide_features) strokes.emplace(om, constrained, target);
     // The triangle of the input surface each vertex was last projected to (at first one at
@@ -635,7 +699,7 @@ void remesh_relaxing_features(OMesh& om, const TriangleMesh& input, double targe
         int& start = om.property(hint, v).triangle;
         for (OMesh::ConstVertexVertexIter w = om.cvv_iter(v); start < 0 && w.is_valid(); ++w)
             start = om.property(hint, *w).triangle;
-        const glm::dvec3 q = surface.project(FeatureSegments::to_glm(om.point(v)), start);
+        const glm::dvec3 q = surface.place(FeatureSegments::to_glm(om.point(v)), start);
         return OMesh::Point(q.x, q.y, q.z);
     };
     auto stay = [&](OMesh::VertexHandle v) {
@@ -794,7 +858,8 @@ TriangleMesh remesh_isotropic(const TriangleMesh& mesh, const RemeshOptions& opt
     }
 
     if (options.protect_feature_edges && (options.relax_feature_edges || options.own_rounds) && whole) {
-        remesh_relaxing_features(om, mesh, target, options.iterations, constrained, options.relax_feature_edges);
+        remesh_relaxing_features(om, mesh, target, options.iterations, constrained, options.relax_feature_edges,
+                                 options.radial_centre);
     } else {
         std::vector<OMesh::FaceHandle> region;
         for (auto f : om.faces())

@@ -753,6 +753,44 @@ TEST(Remesh, RelaxedStrokeVerticesStayOnTheirStrokeAndEveryVertexLiesOnTheInputS
     EXPECT_FALSE(self_intersects(out));
 }
 
+TEST(Remesh, ARadialCentreLiftsNewVerticesOntoTheSphereTheCoarseInputApproximates)
+{
+    // An icosphere of 80 triangles of about 19 cm, r = 30 cm: its flat triangles lie up to
+    // 1.7 cm inside the sphere. Projected onto them (the nearest point), the remeshed vertices
+    // stay that far inside; lifted along their rays from the centre to the distance
+    // interpolated across the triangle the ray passes through, they lie on the sphere.
+    const glm::dvec3 c(0.1, 1.2, -0.3);
+    const double r = 0.3;
+    const TriangleMesh in = icosphere(1, r, c);
+    auto inside = [&](const TriangleMesh& m) {
+        double worst = 0.0, outside = 0.0;
+        for (const glm::vec3& p : m.positions) {
+            const double d = glm::distance(glm::dvec3(p), c) - r;
+            worst = std::max(worst, -d);
+            outside = std::max(outside, d);
+        }
+        return std::make_pair(worst, outside);
+    };
+    RemeshOptions o;
+    o.own_rounds = true;
+    o.iterations = 3;
+    const TriangleMesh nearest = remesh_isotropic(in, o);
+    o.radial_centre = c;
+    const TriangleMesh radial = remesh_isotropic(in, o);
+    for (const TriangleMesh* m : {&nearest, &radial}) {
+        const MeshQuality q = measure_quality(*m);
+        EXPECT_TRUE(q.closed && q.manifold && q.outward);
+        EXPECT_NEAR(q.edge_mean_m, 0.03, 0.005);
+        EXPECT_GE(q.share_all_angles_ge_30, 0.95);
+        EXPECT_FALSE(self_intersects(*m));
+    }
+    EXPECT_GT(inside(nearest).first, 0.008);
+    EXPECT_LT(inside(radial).first, 1e-5);
+    EXPECT_LT(inside(radial).second, 1e-5);
+    EXPECT_NEAR(static_cast<double>(radial.triangles.size()), static_cast<double>(nearest.triangles.size()),
+                0.1 * static_cast<double>(nearest.triangles.size()));
+}
+
 TEST(Remesh, OurRoundsRemeshASmallRepairedModelThatCGALsRelaxationCannot)
 {
     // fuzz/mesh_repair_fuzz.cpp found this OBJ: repaired, it is a closed 6-vertex solid with
