@@ -11,7 +11,9 @@
 //   keep_unchanged_regions), though it builds only the changed regions and follows the
 //   previous build's searches. The whole build may refuse what the continued one made only
 //   where the continued one kept regions (their fill, refitted, can fall under its limit);
-//   a lobe whose centre moved although its centroid stayed was refused round that centre.
+//   a lobe whose centre moved although its centroid stayed was refused round that centre;
+// - the last lobe, remeshed as the apps remesh it (lobe_remesh.h), is one closed,
+//   2-manifold, outward-oriented piece, or refused in one line.
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -22,6 +24,7 @@
 #include "fuzz/fuzz_common.h"
 #include "meshing/lobe.h"
 #include "meshing/lobe_regions.h"
+#include "meshing/lobe_remesh.h"
 #include "meshing/lobe_surface.h"
 #include "meshing/mesh_quality.h"
 #include "meshing/repair.h"
@@ -176,6 +179,23 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         keep_unchanged_regions(before, before_regions, whole, whole_regions);
         fuzz::require(same_surface(now, whole), "a continued lobe differs from the whole build with the unchanged regions kept");
         fuzz::require(whole_regions.edges == lobe.regions().edges, "the regions handed on differ from the whole build's");
+    }
+    // The last lobe remeshed as the apps remesh it (region by region, vertices lifted along
+    // their rays from the centre onto the coarse fill): a valid lobe, or a one-line refusal.
+    if (!lobe.empty()) {
+        try {
+            RemeshOptions o;
+            o.relax_feature_edges = true;
+            o.iterations = 4;
+            const TriangleMesh remeshed = remesh_lobe_surface(lobe.surface(), o);
+            const MeshQuality q = measure_quality(remeshed);
+            fuzz::require(q.closed && q.manifold && q.outward && q.components == 1,
+                          "a remeshed lobe that is not one closed, 2-manifold, outward-oriented piece");
+            for (const glm::vec3& p : remeshed.positions)
+                fuzz::require(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z), "a remeshed vertex not finite");
+        } catch (const InvalidInput& e) {
+            fuzz::check_one_line(e.what());
+        }
     }
     return 0;
 }

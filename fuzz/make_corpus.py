@@ -306,6 +306,12 @@ def lobe_strokes_seeds():
     odd = loops[:2] + [stroke(3 << 3, 0, 0, 0, 0, 0, extra=1), stroke(plain | 4, 90, 90, 60, 128, 80, shift=[255, 0, 255]),
                        stroke(0 << 3, 30, 30, 150, 128, 50), stroke(4 << 3, 128, 128, 150, 128, 100, extra=7)]
     put("lobe_strokes", "a-loop-again-a-far-one-a-fold-and-a-nan", bytes([6] + sum(odd, [])))
+    # Found by the target once it remeshed its lobes (docs/fuzzing.md): a NaN and a fold
+    # refused, then a wobbly loop and an arc drawn back over it; a region of the lobe lay on
+    # one line of its remeshing chart.
+    put("lobe_strokes", "a-loop-and-an-arc-back-over-it-a-region-on-one-chart-line",
+        bytes([3, 160, 162, 32, 0, 128, 96, 0, 0, 56, 128, 0, 150, 128, 120, 40, 5, 57, 64] + [251] * 15 +
+              [0, 150, 100] + [251] * 6 + [10, 150, 180, 60, 110, 40, 5]))
 
 
 def hole_fill_seeds():

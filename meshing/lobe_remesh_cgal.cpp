@@ -281,6 +281,9 @@ TriangleMesh triangulate_region(const LobeSurface& surface, const RegionInput& r
     for (const auto& c : constraints) cdt.insert_constraint(handle[static_cast<Index>(c[0])], handle[static_cast<Index>(c[1])]);
     // A piece crossing another (or an inner vertex on a piece) made a vertex of its own.
     if (cdt.number_of_vertices() != out.positions.size()) return {};
+    // Every point on one line of the chart: no faces (a 1-dimensional triangulation's have
+    // no neighbours to walk), nothing to triangulate.
+    if (cdt.dimension() < 2) return {};
 
     // Inside: reached from outside across an odd number of border constraints.
     for (auto f = cdt.all_faces_begin(); f != cdt.all_faces_end(); ++f) f->info() = -1;

@@ -314,6 +314,53 @@ TEST(Lobes, RegionByRegionRemeshingGivesValidLobesForEveryKindOfDrawingAndFallsB
     }
 }
 
+TEST(Lobes, AnArcRetracingALoopIsRemeshedThoughARegionLiesOnOneLineOfItsChart)
+{
+    // Found by fuzz/lobe_strokes_fuzz.cpp once it remeshed its lobes: a wobbly loop and an arc
+    // drawn backwards over it, without the wobble (the lobe's first strokes). A region
+    // of that lobe lay on one line of its chart, and its triangulation (one-dimensional, faces
+    // without neighbours) was walked as if it had faces: a null dereference (UBSan stops the
+    // ASan build there). Now such a region is not charted and the lobe is remeshed whole,
+    // like every region that cannot be.
+    const glm::dvec3 c(0.0, 1.3, -0.4);
+    auto stroke = [&](double tilt, double turn, double r, double h, int n, double sweep, double wobble, int frequency,
+                      bool reverse) {
+        const glm::dvec3 axis(std::sin(tilt) * std::cos(turn), std::cos(tilt), std::sin(tilt) * std::sin(turn));
+        glm::dvec3 u = glm::cross(axis, glm::dvec3(0.3, 0.1, 0.9));
+        u = glm::length(u) > 1e-9 ? glm::normalize(u) : glm::dvec3(1, 0, 0);
+        const glm::dvec3 v = glm::cross(axis, u);
+        const double rr = std::sqrt(std::max(0.0, r * r - h * h));
+        std::vector<glm::vec3> raw;
+        for (int i = 0; i < n; ++i) {
+            const double t = sweep * 2.0 * kPi * (reverse ? n - 1 - i : i) / n;
+            const double w = wobble * std::sin(frequency * t);
+            raw.emplace_back(c + h * axis + (rr + w) * (std::cos(t) * u + std::sin(t) * v));
+        }
+        return raw;
+    };
+    Lobe lobe;
+    const double b = 251.0 / 255.0; // the fuzzer's input byte 251
+    const double r = 0.2 * (0.2 + 1.3 * b);
+    // Its strokes 3 and 4 (1 and 2 were refused: a NaN, a path and back along it); a
+    // stroke's sampling starts where its id says.
+    lobe.add_stroke(3, stroke(kPi * b, 2.0 * kPi * b, r, (b - 0.5) * 1.6 * r, 95, 1.0, 0.005 * b, 11, false));
+    lobe.add_stroke(4, stroke(kPi * b, 2.0 * kPi * b, r, (b - 0.5) * 1.6 * r, 95, 0.1 + 0.9 * b, 0.005 * b, 0, true));
+    ASSERT_EQ(lobe.strokes().size(), 2u);
+    LobeRemeshStats stats;
+    RemeshOptions o;
+    o.relax_feature_edges = true;
+    o.iterations = 4;
+    const TriangleMesh remeshed = remesh_lobe_surface(lobe.surface(), o, nullptr, &stats);
+    EXPECT_TRUE(stats.whole);
+    // One closed, 2-manifold, outward piece. The arc runs within 5 mm of the loop (its
+    // wobble), a sliver of a region that 3 cm triangles cannot follow without crossing
+    // themselves (the nearest-point projection of before gives the same).
+    const MeshQuality q = measure_quality(remeshed);
+    EXPECT_TRUE(q.closed && q.manifold && q.outward);
+    EXPECT_EQ(q.components, 1u);
+    EXPECT_GT(q.signed_volume_m3, 0.0);
+}
+
 TEST(Lobes, ALobeThatIsNotRemeshedKeepsItsFillAtTheAttractorSpacing)
 {
     // Remeshed lobes get a fill twice as coarse (remeshing lays the attractors); without
