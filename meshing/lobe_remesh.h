@@ -50,7 +50,8 @@ struct LobeRemeshStats {
 /// (it wraps nearly all the way round the centre, or its resampled pieces cross another
 /// piece), the whole surface is remeshed with remesh_isotropic and relaxed stroke vertices
 /// instead. The output's feature_edges are the resampled stroke pieces.
-/// \throw InvalidInput as remesh_isotropic.
+/// \throw InvalidInput as remesh_isotropic, and when the whole-lobe remeshing leaves no closed,
+/// outward surface of one piece (a lobe not much larger than the spacing collapses).
 TriangleMesh remesh_lobe_surface(const LobeSurface& surface, const RemeshOptions& options,
                                  LobeRemeshCache* cache = nullptr, LobeRemeshStats* stats = nullptr);
 

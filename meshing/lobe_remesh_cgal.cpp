@@ -341,7 +341,17 @@ TriangleMesh remesh_whole(const LobeSurface& surface, const RemeshOptions& optio
     o.relax_feature_edges = true;
     o.faces.clear();
     o.radial_centre = surface.centre;
-    return remesh_isotropic(surface.mesh, o);
+    TriangleMesh out = remesh_isotropic(surface.mesh, o);
+    // A lobe not much larger than the spacing collapses (CGAL collapses every edge under 4/5
+    // of the target): two triangles back to back are no lobe to grow a tree in.
+    const MeshQuality q = measure_quality(out);
+    if (!q.closed || !q.manifold || !q.outward || q.components != 1 || !(q.signed_volume_m3 > 0.0)) {
+        char buf[160];
+        std::snprintf(buf, sizeof buf, "remeshing at %g cm leaves no closed surface of this lobe (too small for the attractor spacing)",
+                      100.0 * options.target_edge_length_m);
+        throw InvalidInput(buf);
+    }
+    return out;
 }
 
 } // namespace

@@ -314,6 +314,27 @@ TEST(Lobes, RegionByRegionRemeshingGivesValidLobesForEveryKindOfDrawingAndFallsB
     }
 }
 
+/// A stroke as fuzz/lobe_strokes_fuzz.cpp draws it round (0, 1.3, −0.4): a loop or, with
+/// sweep < 1, an arc of the circle at height h on the sphere of radius r about the axis of
+/// the given tilt and turn, with a wobble of the radius.
+std::vector<glm::vec3> fuzz_stroke(double tilt, double turn, double r, double h, int n, double sweep, double wobble,
+                                   int frequency, bool reverse)
+{
+    const glm::dvec3 c(0.0, 1.3, -0.4);
+    const glm::dvec3 axis(std::sin(tilt) * std::cos(turn), std::cos(tilt), std::sin(tilt) * std::sin(turn));
+    glm::dvec3 u = glm::cross(axis, glm::dvec3(0.3, 0.1, 0.9));
+    u = glm::length(u) > 1e-9 ? glm::normalize(u) : glm::dvec3(1, 0, 0);
+    const glm::dvec3 v = glm::cross(axis, u);
+    const double rr = std::sqrt(std::max(0.0, r * r - h * h));
+    std::vector<glm::vec3> raw;
+    for (int i = 0; i < n; ++i) {
+        const double t = sweep * 2.0 * kPi * (reverse ? n - 1 - i : i) / n;
+        const double w = wobble * std::sin(frequency * t);
+        raw.emplace_back(c + h * axis + (rr + w) * (std::cos(t) * u + std::sin(t) * v));
+    }
+    return raw;
+}
+
 TEST(Lobes, AnArcRetracingALoopIsRemeshedThoughARegionLiesOnOneLineOfItsChart)
 {
     // Found by fuzz/lobe_strokes_fuzz.cpp once it remeshed its lobes: a wobbly loop and an arc
@@ -322,29 +343,13 @@ TEST(Lobes, AnArcRetracingALoopIsRemeshedThoughARegionLiesOnOneLineOfItsChart)
     // without neighbours) was walked as if it had faces: a null dereference (UBSan stops the
     // ASan build there). Now such a region is not charted and the lobe is remeshed whole,
     // like every region that cannot be.
-    const glm::dvec3 c(0.0, 1.3, -0.4);
-    auto stroke = [&](double tilt, double turn, double r, double h, int n, double sweep, double wobble, int frequency,
-                      bool reverse) {
-        const glm::dvec3 axis(std::sin(tilt) * std::cos(turn), std::cos(tilt), std::sin(tilt) * std::sin(turn));
-        glm::dvec3 u = glm::cross(axis, glm::dvec3(0.3, 0.1, 0.9));
-        u = glm::length(u) > 1e-9 ? glm::normalize(u) : glm::dvec3(1, 0, 0);
-        const glm::dvec3 v = glm::cross(axis, u);
-        const double rr = std::sqrt(std::max(0.0, r * r - h * h));
-        std::vector<glm::vec3> raw;
-        for (int i = 0; i < n; ++i) {
-            const double t = sweep * 2.0 * kPi * (reverse ? n - 1 - i : i) / n;
-            const double w = wobble * std::sin(frequency * t);
-            raw.emplace_back(c + h * axis + (rr + w) * (std::cos(t) * u + std::sin(t) * v));
-        }
-        return raw;
-    };
     Lobe lobe;
     const double b = 251.0 / 255.0; // the fuzzer's input byte 251
     const double r = 0.2 * (0.2 + 1.3 * b);
     // Its strokes 3 and 4 (1 and 2 were refused: a NaN, a path and back along it); a
     // stroke's sampling starts where its id says.
-    lobe.add_stroke(3, stroke(kPi * b, 2.0 * kPi * b, r, (b - 0.5) * 1.6 * r, 95, 1.0, 0.005 * b, 11, false));
-    lobe.add_stroke(4, stroke(kPi * b, 2.0 * kPi * b, r, (b - 0.5) * 1.6 * r, 95, 0.1 + 0.9 * b, 0.005 * b, 0, true));
+    lobe.add_stroke(3, fuzz_stroke(kPi * b, 2.0 * kPi * b, r, (b - 0.5) * 1.6 * r, 95, 1.0, 0.005 * b, 11, false));
+    lobe.add_stroke(4, fuzz_stroke(kPi * b, 2.0 * kPi * b, r, (b - 0.5) * 1.6 * r, 95, 0.1 + 0.9 * b, 0.005 * b, 0, true));
     ASSERT_EQ(lobe.strokes().size(), 2u);
     LobeRemeshStats stats;
     RemeshOptions o;
@@ -359,6 +364,32 @@ TEST(Lobes, AnArcRetracingALoopIsRemeshedThoughARegionLiesOnOneLineOfItsChart)
     EXPECT_TRUE(q.closed && q.manifold && q.outward);
     EXPECT_EQ(q.components, 1u);
     EXPECT_GT(q.signed_volume_m3, 0.0);
+}
+
+TEST(Lobes, ALobeThatRemeshingWouldCollapseIsRefusedInOneLine)
+{
+    // A lobe of one open arc 6 cm across (found by fuzz/lobe_strokes_fuzz.cpp): its one region
+    // cannot be charted, and the whole-lobe remeshing at 5 cm collapsed it to two triangles
+    // back to back (CGAL collapses every edge under 4/5 of the target). Now remeshing refuses
+    // it in one line; a lobe list leaves it out with a warning. At 1 cm it is remeshed.
+    const double r = 0.2 * (0.2 + 1.3 * 9.0 / 255.0);
+    Lobe lobe;
+    lobe.add_stroke(1, fuzz_stroke(0.0, 2.0 * kPi * 64.0 / 255.0, r, (1.0 / 255.0 - 0.5) * 1.6 * r, 100,
+                                   0.1 + 0.9 * 96.0 / 255.0, 0.0, 0, true));
+    RemeshOptions o;
+    o.relax_feature_edges = true;
+    o.target_edge_length_m = 0.05;
+    try {
+        remesh_lobe_surface(lobe.surface(), o);
+        ADD_FAILURE() << "a collapsed lobe was not refused";
+    } catch (const InvalidInput& e) {
+        const std::string what = e.what();
+        EXPECT_EQ(what.find('\n'), std::string::npos);
+        EXPECT_NE(what.find("too small"), std::string::npos) << what;
+    }
+    o.target_edge_length_m = 0.01;
+    const MeshQuality q = measure_quality(remesh_lobe_surface(lobe.surface(), o));
+    EXPECT_TRUE(q.closed && q.manifold && q.outward);
 }
 
 TEST(Lobes, ALobeThatIsNotRemeshedKeepsItsFillAtTheAttractorSpacing)
