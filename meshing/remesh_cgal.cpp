@@ -406,9 +406,9 @@ private:
         const glm::dvec3 a = glm::dvec3(surface_.positions[static_cast<std::size_t>(t[0])]) - *centre_;
         const glm::dvec3 b = glm::dvec3(surface_.positions[static_cast<std::size_t>(t[1])]) - *centre_;
         const glm::dvec3 c = glm::dvec3(surface_.positions[static_cast<std::size_t>(t[2])]) - *centre_;
-        const double det = glm::dot(a, glm::cross(b, c));
-        if (!(det > 0.0)) return false; // degenerate, or facing the centre
-        const double alpha = glm::dot(glm::cross(b, c), d), beta = glm::dot(glm::cross(c, a), d), gamma = glm::dot(glm::cross(a, b), d);
+        const glm::dvec3 bc = glm::cross(b, c);
+        if (!(glm::dot(a, bc) > 0.0)) return false; // degenerate, or facing the centre
+        const double alpha = glm::dot(bc, d), beta = glm::dot(glm::cross(c, a), d), gamma = glm::dot(glm::cross(a, b), d);
         if (alpha < 0.0 || beta < 0.0 || gamma < 0.0) return false;
         const double sum = alpha + beta + gamma;
         if (!(sum > 0.0)) return false;
