@@ -9,6 +9,7 @@
 #include <nanoflann.hpp>
 
 #include "core/errors.h"
+#include "core/random.h"
 #include "growth/mesh_raycast.h"
 
 namespace lobe {
@@ -19,25 +20,17 @@ constexpr double kPi = std::numbers::pi;
 // A subtree segment that would leave the lobe ends at this fraction of the way to the surface.
 constexpr float kClipFraction = 0.8f;
 
-// SplitMix64 (Steele et al. 2014): a counter-based stream, so each node's random choices
-// depend only on its key, never on how many numbers other nodes drew. Written here because
-// the standard distributions differ between standard libraries and replays must not.
-std::uint64_t mix(std::uint64_t x)
-{
-    x += 0x9E3779B97F4A7C15ull;
-    x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-    x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-    return x ^ (x >> 31);
-}
-
+// Each node's random choices come from a stream keyed by (seed, lobe, node, growth, piece)
+// with the SplitMix64 hash (core/random.h), so they depend only on that key, never on how
+// many numbers other nodes drew.
 class Stream {
 public:
     Stream(std::uint64_t seed, std::int64_t lobe, std::size_t node, int growth, std::size_t piece)
-        : state_(mix(mix(mix(mix(seed) ^ static_cast<std::uint64_t>(lobe)) ^ node) ^
+        : state_(splitmix64(splitmix64(splitmix64(splitmix64(seed) ^ static_cast<std::uint64_t>(lobe)) ^ node) ^
                      (static_cast<std::uint64_t>(growth) << 32 | piece)))
     {
     }
-    double uniform() { return static_cast<double>(mix(state_++) >> 11) * 0x1.0p-53; } // [0, 1)
+    double uniform() { return unit_interval(splitmix64(state_++)); } // [0, 1)
 
 private:
     std::uint64_t state_;

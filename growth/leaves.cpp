@@ -7,35 +7,20 @@
 #include <glm/geometric.hpp>
 
 #include "core/errors.h"
+#include "core/random.h"
 
 namespace lobe {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-/// splitmix64 (Steele, Lea and Flood 2014): tiny, fast, and the same bits on every platform,
-/// unlike the standard library's distributions.
-std::uint64_t mix64(std::uint64_t z)
-{
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-
-struct SplitMix64 {
-    std::uint64_t state;
-    std::uint64_t next() { return mix64(state += 0x9E3779B97F4A7C15ull); }
-    /// Uniform in [0, 1) with 53 random bits.
-    double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
-};
-
 /// The leaf stream of one node: keyed by the lobe and the node's ordinal inside it, never by
 /// its global index.
 SplitMix64 leaf_stream(std::uint64_t seed, int lobe, std::uint64_t ordinal)
 {
-    std::uint64_t s = mix64(seed ^ 0x6C6F6265u /* "lobe" */);
-    s = mix64(s ^ (static_cast<std::uint64_t>(static_cast<std::int64_t>(lobe)) * 0xD1B54A32D192ED03ull));
-    s = mix64(s ^ (ordinal * 0x8CB92BA72F3D8DD7ull + 0x632BE59BD9B4E019ull));
+    std::uint64_t s = splitmix64_finalize(seed ^ 0x6C6F6265u /* "lobe" */);
+    s = splitmix64_finalize(s ^ (static_cast<std::uint64_t>(static_cast<std::int64_t>(lobe)) * 0xD1B54A32D192ED03ull));
+    s = splitmix64_finalize(s ^ (ordinal * 0x8CB92BA72F3D8DD7ull + 0x632BE59BD9B4E019ull));
     return SplitMix64{s};
 }
 
@@ -102,7 +87,7 @@ double value_noise(double x, double y, int cells, std::uint64_t salt)
     const double ix = std::floor(fx), iy = std::floor(fy);
     const double tx = fx - ix, ty = fy - iy;
     auto lattice = [&](double cx, double cy) {
-        const auto h = mix64(salt ^ (static_cast<std::uint64_t>(static_cast<std::int64_t>(cx)) * 0x9E3779B97F4A7C15ull) ^
+        const auto h = splitmix64_finalize(salt ^ (static_cast<std::uint64_t>(static_cast<std::int64_t>(cx)) * 0x9E3779B97F4A7C15ull) ^
                              (static_cast<std::uint64_t>(static_cast<std::int64_t>(cy)) * 0xC2B2AE3D27D4EB4Full));
         return static_cast<double>(h >> 11) * 0x1.0p-53;
     };

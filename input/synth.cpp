@@ -16,6 +16,7 @@
 
 #include "core/atomic_file.h"
 #include "core/errors.h"
+#include "core/random.h"
 #include "input/hand_model.h"
 #include "input/tools.h"
 
@@ -55,37 +56,18 @@ constexpr const char* kScenarioFormat = "lobesketch-scenario";
 constexpr const char* kTruthFormat = "lobesketch-ground-truth";
 
 // ---------------------------------------------------------------------------------------
-// Randomness: SplitMix64 and Box–Muller written here, so every platform and standard
-// library gives the same numbers.
+// Randomness: the project's SplitMix64 stream (core/random.h), the same numbers on every
+// platform and standard library.
 // ---------------------------------------------------------------------------------------
 
-class Rng {
+/// The scenario's random numbers (core/random.h), with the two distributions only the
+/// synthesizer uses.
+class Rng : public SplitMix64 {
 public:
-    explicit Rng(std::uint64_t seed) : state_(seed) {}
-
-    std::uint64_t next()
-    {
-        std::uint64_t z = (state_ += 0x9E3779B97F4A7C15ull);
-        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-        return z ^ (z >> 31);
-    }
-    /// [0, 1)
-    double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
-    double uniform(double a, double b) { return a + (b - a) * uniform(); }
-    /// Standard normal, one Box–Muller value per call.
-    double normal()
-    {
-        double u1 = 1.0 - uniform(); // (0, 1]
-        double u2 = uniform();
-        return std::sqrt(-2.0 * std::log(u1)) * std::cos(kTwoPi * u2);
-    }
+    using SplitMix64::SplitMix64;
     /// Normal truncated at ±k (tracking noise has no far outliers once fitted to a hand model).
     double normal_clamped(double k) { return std::clamp(normal(), -k, k); }
     double exponential(double mean) { return -mean * std::log(1.0 - uniform()); }
-
-private:
-    std::uint64_t state_;
 };
 
 /// An independent stream for one purpose, derived from the scenario seed.

@@ -8,21 +8,12 @@
 #include <glm/geometric.hpp>
 
 #include "core/errors.h"
+#include "core/random.h"
 #include "meshing/polyline.h"
 
 namespace lobe {
 
 namespace {
-
-/// SplitMix64 (Steele, Lea, Flood 2014): one well-mixed 64-bit value from the seed, the same
-/// on every platform (unlike the standard distributions).
-std::uint64_t splitmix64(std::uint64_t x)
-{
-    std::uint64_t z = x + 0x9e3779b97f4a7c15ull;
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-}
 
 void check_options(const SamplingOptions& o, const std::string& who)
 {

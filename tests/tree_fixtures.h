@@ -12,6 +12,7 @@
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
+#include "core/random.h"
 #include "core/tree.h"
 #include "growth/radii.h"
 
@@ -31,16 +32,10 @@ struct TreeShape {
     std::uint64_t seed = 1;
 };
 
-/// Deterministic uniform numbers in [0, 1) (splitmix64).
+/// Deterministic uniform numbers in [0, 1) (core/random.h).
 struct FixtureRng {
-    std::uint64_t s;
-    double next()
-    {
-        std::uint64_t z = (s += 0x9E3779B97F4A7C15ull);
-        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-        return static_cast<double>((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
-    }
+    SplitMix64 stream;
+    double next() { return stream.uniform(); }
 };
 
 inline glm::dvec3 rotate_about(const glm::dvec3& v, const glm::dvec3& axis, double angle)
@@ -52,7 +47,7 @@ inline glm::dvec3 rotate_about(const glm::dvec3& v, const glm::dvec3& axis, doub
 inline TreeGraph make_fixture_tree(const TreeShape& shape)
 {
     constexpr double deg = 3.14159265358979323846 / 180.0;
-    FixtureRng rng{shape.seed};
+    FixtureRng rng{SplitMix64(shape.seed)};
     TreeGraph g;
     TreeNode root;
     root.kind = TreeNodeKind::Root;
