@@ -1,12 +1,12 @@
 // libFuzzer target: desktop scripts (`lobesketch desktop --script FILE`). The CLI reads the file
-// (size-limited) and parses it with parse_desktop_script (app/desktop_script.h); the steps it
+// (size-limited) and parses it with parse_desktop_script (app/desktop/desktop_script.h); the steps it
 // returns must keep the header's promises: at most 200,000, sorted by frame, frames in
 // 0..10^7, finite coordinates and values that fit the floats of the input events.
 #include <cmath>
 #include <cstdint>
 #include <limits>
 
-#include "app/desktop_script.h"
+#include "app/desktop/desktop_script.h"
 #include "fuzz/fuzz_common.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)

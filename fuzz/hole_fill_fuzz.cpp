@@ -2,7 +2,7 @@
 // holes are triangulated in their plane or fanned from their centre instead of CGAL's search
 // for the best patch; docs/lobes-from-models.md, step 4). A text mesh small enough for the
 // other mesh targets cannot hold such a hole, so the bytes choose a shape and bend it
-// (tests/hole_meshes.h, hole_fill_mesh, which the repair tests use for the findings too):
+// (tests/support/hole_meshes.h, hole_fill_mesh, which the repair tests use for the findings too):
 //   byte 0      shape: even a dome whose open base runs up and down in waves, odd a sphere
 //               with a slit along its equator;
 //   bytes 1–2   border edges (dome: 201–700) or the slit's length (sphere: 60°–330°);
@@ -21,7 +21,7 @@
 #include "fuzz/fuzz_common.h"
 #include "fuzz/repair_checks.h"
 #include "meshing/repair.h"
-#include "tests/hole_meshes.h"
+#include "tests/support/hole_meshes.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
 {

@@ -1,4 +1,4 @@
-// libFuzzer target: settings files (--settings). The CLI's load_settings_file (app/cli_common.cpp)
+// libFuzzer target: settings files (--settings). The CLI's load_settings_file (app/cli/cli_common.cpp)
 // reads the file (size-limited) and does exactly this: parse the JSON without exceptions and
 // read a bare settings object or a session document's "settings" with settings_from_json_checked.
 // validate_settings, which every command runs before using them, runs too.

@@ -2,7 +2,7 @@
 /// \file tree_geometry.h
 /// Renderable and exportable geometry of a tree: branch and leaf meshes per level of detail,
 /// plus the leaf texture. Plain data; made by growth/branch_geometry.h and growth/leaves.h,
-/// consumed by the exporters (app/export_gltf.h, app/export_obj.h) and the renderer.
+/// consumed by the exporters (app/export/export_gltf.h, app/export/export_obj.h) and the renderer.
 
 #include <array>
 #include <cstdint>

@@ -41,7 +41,7 @@ if ((${#missing[@]})); then
   $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
 
-# The Khronos glTF validator, pinned; tests/gltf_validate.mjs and the export tests use it.
+# The Khronos glTF validator, pinned; tests/support/gltf_validate.mjs and the export tests use it.
 GLTF_VALIDATOR_VERSION="2.0.0-dev.3.10"
 GLTF_VALIDATOR_DIR="build/tools/gltf-validator"
 installed="$(node -p "require('./$GLTF_VALIDATOR_DIR/node_modules/gltf-validator/package.json').version" 2>/dev/null || true)"

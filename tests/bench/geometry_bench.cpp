@@ -6,7 +6,7 @@
 
 #include "growth/branch_geometry.h"
 #include "growth/leaves.h"
-#include "tests/tree_fixtures.h"
+#include "tests/support/tree_fixtures.h"
 
 using namespace lobe;
 

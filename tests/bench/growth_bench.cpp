@@ -10,10 +10,10 @@
 #include <glm/geometric.hpp>
 #include <nanoflann.hpp>
 
-#include "app/tree_output.h"
-#include "app/tree_pipeline.h"
+#include "app/export/tree_output.h"
+#include "app/session/tree_pipeline.h"
 #include "growth/branch_geometry.h"
-#include "tests/replay_fixture.h"
+#include "tests/support/replay_fixture.h"
 
 using namespace lobe;
 

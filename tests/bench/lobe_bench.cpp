@@ -9,15 +9,15 @@
 
 #include <glm/geometric.hpp>
 
-#include "meshing/edit_ops.h"
+#include "app/session/edit_ops.h"
 #include "meshing/lobe.h"
-#include "meshing/lobe_cache.h"
-#include "meshing/lobe_document.h"
+#include "app/session/lobe_cache.h"
+#include "app/session/lobe_document.h"
 #include "meshing/lobe_remesh.h"
 #include "meshing/mesh_quality.h"
 #include "meshing/remesh.h"
 #include "tests/bench/cgal_surface_mesh.h"
-#include "tests/replay_fixture.h"
+#include "tests/support/replay_fixture.h"
 
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wconversion"
@@ -136,7 +136,7 @@ BENCHMARK(BM_AddRingBetweenTwoOfTenStackedRings)->Unit(benchmark::kMillisecond);
 /// What a regrowth does with the lobes after the person drew one more lobe stroke: every lobe
 /// of table1-4lobes-22strokes (4 lobes, 22 strokes) built from its strokes and remeshed.
 /// Arg 0: from scratch (replay, the CLI); arg 1: with the regrowth worker's kept build
-/// (meshing/lobe_cache.h), which joins the one stroke to its lobe and remeshes that lobe.
+/// (app/session/lobe_cache.h), which joins the one stroke to its lobe and remeshes that lobe.
 void BM_LobesAfterOneMoreStroke(benchmark::State& state)
 {
     const Document full = test::replay_document("table1-4lobes-22strokes");
@@ -308,7 +308,7 @@ EditOperation bend_operation(const Stroke& stroke, float lift)
     return op;
 }
 
-/// A stroke bend shown live (app/live_stroke_edit.h, as the desktop and VR sessions run it
+/// A stroke bend shown live (app/live/live_stroke_edit.h, as the desktop and VR sessions run it
 /// every frame while the fingertip moves): the document's effective strokes with the drag's
 /// operation appended, on table1-4lobes-22strokes (22 strokes, 4 lobes); the bend picks a
 /// point of its first stroke and pulls it up to 4 cm out and back.
@@ -335,7 +335,7 @@ void BM_LiveStrokeEditFrame(benchmark::State& state)
 BENCHMARK(BM_LiveStrokeEditFrame)->Unit(benchmark::kMillisecond);
 
 /// What the regrowth thread does with the lobes for each preview of a stroke bend
-/// (app/drag_preview.h): table1-4lobes-22strokes with a bend of one lobe stroke that changes
+/// (app/live/drag_preview.h): table1-4lobes-22strokes with a bend of one lobe stroke that changes
 /// from one preview to the next, built with the kept build of the previews before it. Arg 0:
 /// the first stroke of its lobe (the lobe joined again from its first stroke); arg 1: the
 /// last (only that stroke joined again).

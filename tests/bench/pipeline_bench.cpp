@@ -4,7 +4,7 @@
 
 #include "input/pipeline.h"
 #include "input/synth.h"
-#include "tests/test_paths.h"
+#include "tests/support/test_paths.h"
 
 using namespace lobe;
 

@@ -11,15 +11,15 @@
 #include <memory>
 #include <string>
 
-#include "app/edit_hooks.h"
-#include "app/render_scene.h"
-#include "app/renderer.h"
-#include "app/tree_output.h"
-#include "app/tree_pipeline.h"
+#include "app/session/edit_hooks.h"
+#include "app/render/render_scene.h"
+#include "app/render/renderer.h"
+#include "app/export/tree_output.h"
+#include "app/session/tree_pipeline.h"
 #include "input/pipeline.h"
 #include "input/recording.h"
-#include "input/session_builder.h"
-#include "tests/test_paths.h"
+#include "app/session/session_builder.h"
+#include "tests/support/test_paths.h"
 
 using namespace lobe;
 

@@ -10,9 +10,9 @@
 
 #include <benchmark/benchmark.h>
 
-#include "app/vr_session.h"
+#include "app/vr/vr_session.h"
 #include "input/recording.h"
-#include "tests/test_paths.h"
+#include "tests/support/test_paths.h"
 
 using namespace lobe;
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Writes the degenerate-input corpus (tests/data/degenerate/): one file per case and the
 manifest cases.json. Run it from anywhere after changing a case; the files are committed so
-the tests need no Python. tests/degenerate_input_test.cpp reads every case (README.md)."""
+the tests need no Python. tests/app/degenerate_input_test.cpp reads every case (README.md)."""
 
 import json
 import math

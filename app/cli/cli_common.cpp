@@ -1,0 +1,181 @@
+#include "app/cli/cli_common.h"
+
+#include <algorithm>
+#include <cctype>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "app/session/edit_hooks.h"
+#include "core/atomic_file.h"
+#include "core/document.h"
+#include "core/errors.h"
+#include "growth/species.h"
+#include "input/pipeline.h"
+#include "app/session/session_builder.h"
+#include "meshing/mesh_io.h"
+
+namespace lobe::cli {
+
+namespace {
+bool g_quiet = false;
+}
+
+void set_quiet(bool quiet) { g_quiet = quiet; }
+void warn(const std::string& line) { std::cerr << "lobesketch: warning: " << line << '\n'; }
+void error(const std::string& line) { std::cerr << "lobesketch: error: " << line << '\n'; }
+void progress(const std::string& line)
+{
+    if (!g_quiet) std::cerr << line << '\n';
+}
+
+void print_report(const std::string& path, const ReadReport& report)
+{
+    for (const std::string& p : report.problems) warn(path + ": " + p);
+    if (report.frames_dropped > 0)
+        warn(path + ": dropped " + std::to_string(report.frames_dropped) + " frame(s), kept " +
+             std::to_string(report.frames_read));
+}
+
+Recording load_recording_verbose(const std::string& path)
+{
+    ReadReport report;
+    Recording rec;
+    try {
+        rec = read_recording(path, &report);
+    } catch (const FileError& e) {
+        // Captures of other programs are a common mix-up: say which command converts them.
+        std::string head;
+        if (std::ifstream in{path, std::ios::binary}) {
+            head.resize(16);
+            in.read(head.data(), 16);
+            head.resize(static_cast<std::size_t>(in.gcount()));
+        }
+        const std::string what = e.what();
+        if (head.rfind("{", 0) == 0 && what.find("magic") != std::string::npos)
+            throw Error(what + " (a Leap Motion JSON capture? convert it with 'lobesketch import-leap')");
+        if (head.rfind("var ", 0) == 0 && what.find("magic") != std::string::npos)
+            throw Error(what + " (a WebXR capture? convert it with 'lobesketch import-webxr')");
+        throw;
+    }
+    print_report(path, report);
+    return rec;
+}
+
+Settings load_settings_file(const std::string& path)
+{
+    const std::string text = read_file_limited(path, 16u << 20);
+    nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
+    if (j.is_discarded()) throw FileError(path, "not valid JSON");
+    try {
+        // Accept a bare settings object or a whole session document's "settings".
+        if (j.is_object() && j.contains("format") && j.contains("settings")) return settings_from_json_checked(j["settings"]);
+        return settings_from_json_checked(j);
+    } catch (const InvalidInput& e) {
+        throw FileError(path, e.what());
+    }
+}
+
+void add_tree_input_options(CLI::App* cmd, TreeInputOptions& o)
+{
+    cmd->add_option("--settings", o.settings, "Settings JSON (a settings object or a session document)");
+    cmd->add_option("--species", o.species,
+                    "Species preset: broadleaf, conifer, willow, birch, or a preset .json file");
+    cmd->add_option("--seed", o.seed, "Seed of every random choice of growth (default: the session's)");
+    cmd->add_option("--split-angle", o.split_angle, "Split angle t in degrees (smaller: denser branching)")
+        ->check(CLI::Range(5.0, 180.0));
+    cmd->add_option("--attractor-spacing", o.spacing, "Attractor spacing in metres: lobes are remeshed to it")
+        ->check(CLI::Range(0.005, 0.5));
+}
+
+void apply_tree_input_options(Settings& s, const TreeInputOptions& o)
+{
+    if (!o.species.empty()) apply_species(s, load_species(o.species));
+    if (o.split_angle) s.growth.split_angle_deg = *o.split_angle;
+    if (o.spacing) s.lobes.edge_length_m = *o.spacing;
+    validate_settings(s);
+}
+
+std::string lower_extension(const std::string& path)
+{
+    std::string ext = std::filesystem::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return ext;
+}
+
+std::string timestamp()
+{
+    const std::time_t now = std::time(nullptr);
+    std::tm tm{};
+    localtime_r(&now, &tm);
+    char buf[32];
+    std::strftime(buf, sizeof buf, "%Y%m%d-%H%M%S", &tm);
+    return buf;
+}
+
+std::string beside(const std::string& session, const std::string& suffix)
+{
+    const std::filesystem::path p(session);
+    return (p.parent_path() / (p.stem().string() + suffix)).string();
+}
+
+Document replay_into_document(const std::string& path, Document doc, std::size_t* drags)
+{
+    const Recording rec = load_recording_verbose(path);
+    const double duration = rec.frames.empty() ? 0.0 : rec.frames.back().time - rec.frames.front().time;
+    progress("replaying " + std::to_string(rec.frames.size()) + " frames (" + std::to_string(duration).substr(0, 6) +
+             " s) of " + path);
+    const InputResult result = run_input_pipeline(rec, doc.settings.input);
+    for (const std::string& m : result.messages) warn(path + ": " + m);
+    if (drags) *drags = result.drags.size();
+    doc.source_recording = std::filesystem::absolute(path).lexically_normal().string();
+    EditHooks hooks = meshing_edit_hooks();
+    // Meshes imported during the session lie beside the recording (import_mesh_path).
+    hooks.import_model = [path](int n) {
+        const std::string file = import_mesh_path(path, n);
+        return std::make_shared<const LobeModel>(
+            LobeModel{std::filesystem::path(file).filename().string(), read_mesh(file)});
+    };
+    SessionBuilder builder(std::move(doc), EditPickOptions{}, std::move(hooks));
+    builder.apply(result.actions);
+    for (const std::string& m : builder.messages()) warn(path + ": " + m);
+    return builder.take_document();
+}
+
+bool is_mesh_file(const std::string& path)
+{
+    const std::string ext = lower_extension(path);
+    return ext == ".obj" || ext == ".ply" || ext == ".off";
+}
+
+GrownInput grow_input_tree(const std::string& input, const TreeInputOptions& o)
+{
+    GrownInput out;
+    Document& doc = out.doc;
+    if (!o.settings.empty()) doc.settings = load_settings_file(o.settings);
+    const std::string ext = lower_extension(input);
+    if (ext == ".json") {
+        doc = load_document(input);
+        if (!o.settings.empty()) doc.settings = load_settings_file(o.settings);
+    }
+    apply_tree_input_options(doc.settings, o);
+    if (o.seed) doc.seed = *o.seed;
+    if (is_mesh_file(input)) {
+        const BuiltLobe lobe = model_lobe(input, doc.settings, o.mesh_size);
+        LobeRecord rec;
+        rec.id = 1;
+        rec.model = std::make_shared<const LobeModel>(LobeModel{input, lobe.mesh});
+        doc.lobes.push_back(std::move(rec));
+        out.tree = grow_document_tree(doc, {lobe});
+        return out;
+    }
+    if (ext != ".json") doc = replay_into_document(input, std::move(doc));
+    out.tree = build_document_tree(doc);
+    return out;
+}
+
+} // namespace lobe::cli

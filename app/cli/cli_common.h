@@ -1,0 +1,90 @@
+#pragma once
+/// \file cli_common.h
+/// Shared helpers of the CLI subcommands: messages, settings files, recording input.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "app/session/tree_pipeline.h"
+#include "core/document.h"
+#include "core/settings.h"
+#include "input/recording.h"
+
+namespace CLI {
+class App;
+}
+
+namespace lobe::cli {
+
+void warn(const std::string& line);  ///< "lobesketch: warning: …" on stderr
+void error(const std::string& line); ///< "lobesketch: error: …" on stderr
+void progress(const std::string& line); ///< a progress line on stderr (suppressed by --quiet)
+void set_quiet(bool quiet);
+
+/// Prints the reader's report as warnings, one line each, naming the file.
+void print_report(const std::string& path, const ReadReport& report);
+
+/// Reads a recording and prints what had to be dropped. \throw FileError
+Recording load_recording_verbose(const std::string& path);
+
+/// Loads a settings JSON file (the "settings" object of a session document).
+/// \throw FileError naming the file and the bad key.
+Settings load_settings_file(const std::string& path);
+
+/// The options that say how a tree is grown from an input (`grow`, `export`, `render`).
+struct TreeInputOptions {
+    std::string settings; ///< settings JSON file (empty: none)
+    std::string species;  ///< preset name or .json file (empty: the settings')
+    std::optional<std::uint64_t> seed;
+    std::optional<double> split_angle, spacing;
+    double mesh_size = 1.5; ///< a mesh input's largest side (metres)
+};
+
+/// Registers --settings, --species, --seed, --split-angle and --attractor-spacing.
+void add_tree_input_options(CLI::App* cmd, TreeInputOptions& o);
+
+/// Applies, in the order a person expects, the species and then the single options to `s`,
+/// and validates the result. \throw InvalidInput
+void apply_tree_input_options(Settings& s, const TreeInputOptions& o);
+
+/// The local time as "YYYYMMDD-HHMMSS", for default file names.
+std::string timestamp();
+/// "tree.json" → "tree<suffix>" beside it.
+std::string beside(const std::string& session, const std::string& suffix);
+
+/// Replays the recording at `path` into `doc` (its settings and seed are used): the input
+/// pipeline, then the session builder with the meshing edit hooks, as `replay` does. Warnings
+/// of both go to stderr naming the file; `drags` (when given) receives the number of drags.
+/// \throw FileError for an unreadable recording.
+Document replay_into_document(const std::string& path, Document doc, std::size_t* drags = nullptr);
+
+/// Lower-case extension of `path` (".json").
+std::string lower_extension(const std::string& path);
+/// An .obj, .ply or .off file.
+bool is_mesh_file(const std::string& path);
+
+/// A document and its grown tree.
+struct GrownInput {
+    Document doc;
+    BuiltTree tree;
+};
+
+/// Grows the tree of `input`: a session document (.json), a mesh (.obj/.ply/.off, one lobe
+/// of `mesh_size`) or a recording (run through the input pipeline and the session builder,
+/// warnings printed naming the file), with the options applied.
+/// \throw FileError, InvalidInput
+GrownInput grow_input_tree(const std::string& input, const TreeInputOptions& o);
+
+// Subcommand registration; each sets `exit_code` when it runs.
+void add_info_command(CLI::App& app, int& exit_code);
+void add_replay_command(CLI::App& app, int& exit_code);
+void add_import_commands(CLI::App& app, int& exit_code);
+void add_synth_command(CLI::App& app, int& exit_code);
+void add_lobes_command(CLI::App& app, int& exit_code);
+void add_grow_command(CLI::App& app, int& exit_code);
+void add_export_command(CLI::App& app, int& exit_code);
+void add_render_command(CLI::App& app, int& exit_code);
+void add_desktop_command(CLI::App& app, int& exit_code);
+
+} // namespace lobe::cli

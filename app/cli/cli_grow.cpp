@@ -1,0 +1,102 @@
+// `lobesketch grow INPUT --out tree.glb` and `lobesketch export SESSION --out FILE`: a tree
+// from a recording, a session or a mesh, written as glTF binary or OBJ.
+#include <chrono>
+#include <memory>
+
+#include <CLI/CLI.hpp>
+
+#include "app/cli/cli.h"
+#include "app/cli/cli_common.h"
+#include "app/export/tree_output.h"
+#include "app/session/tree_pipeline.h"
+#include "core/errors.h"
+
+namespace lobe::cli {
+
+namespace {
+
+struct TreeArgs {
+    TreeInputOptions in;
+    std::string input, out, lod = "all";
+    double height = 0.0;
+    bool lobes = false, strokes = false;
+};
+
+void add_tree_options(CLI::App* cmd, TreeArgs& a)
+{
+    add_tree_input_options(cmd, a.in);
+    cmd->add_option("--lod", a.lod, "LODs to write: all, or indices such as 0 or 0,2")->capture_default_str();
+    cmd->add_option("--height", a.height, "Scale the exported tree to this height in metres (0 keeps the sketch's)")
+        ->check(CLI::Range(0.0, 1000.0));
+    cmd->add_flag("--lobes", a.lobes, "Also write the lobes as extra nodes");
+    cmd->add_flag("--strokes", a.strokes, "Also write the strokes as extra nodes");
+}
+
+void report_and_write(const TreeArgs& a, const Document& doc, const BuiltTree& tree, const std::string& input,
+                      int& exit_code)
+{
+    for (const std::string& w : tree.warnings) warn(input + ": " + w);
+    if (tree.lobes.empty() || tree.growth.tree.size() <= tree.growth.skeleton_nodes) {
+        error(input + ": no tree could be grown (no lobe could be built)");
+        exit_code = kExitFailure;
+        return;
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    const TreeGeometry geometry = document_tree_geometry(doc, tree);
+    const double geometry_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    ExportOptions options;
+    options.target_height_m = a.height;
+    options.lods = parse_lod_list(a.lod, static_cast<int>(geometry.lods.size()));
+    options.include_lobes = a.lobes;
+    options.include_strokes = a.strokes;
+    write_tree_file(a.out, doc, tree, geometry, options);
+    std::size_t attractors = 0, reached = 0;
+    for (const LobeGrowthStats& l : tree.growth.lobes) {
+        attractors += l.attractors;
+        reached += l.reached;
+    }
+    progress("grew " + std::to_string(tree.growth.tree.size()) + " nodes in " + std::to_string(tree.lobes.size()) +
+             " lobe(s), " + std::to_string(reached) + " of " + std::to_string(attractors) + " attractors reached");
+    progress("geometry in " + std::to_string(static_cast<int>(geometry_ms)) + " ms, triangles " + lod_triangle_summary(geometry));
+    progress("wrote " + a.out);
+    exit_code = kExitOk;
+}
+
+} // namespace
+
+void add_grow_command(CLI::App& app, int& exit_code)
+{
+    auto* cmd = app.add_subcommand(
+        "grow", "Grow a tree from a recording, a session document (.json) or a mesh (.obj, .ply, .off) and export it");
+    auto a = std::make_shared<TreeArgs>();
+    cmd->add_option("INPUT", a->input, "Recording, session document or mesh")->required();
+    cmd->add_option("-o,--out", a->out, "Output file: tree.glb (glTF binary) or tree.obj (with .mtl and PNG)")
+        ->required();
+    add_tree_options(cmd, *a);
+    cmd->add_option("--size", a->in.mesh_size, "A mesh input is scaled so its bounding box's largest side is this (metres)")
+        ->capture_default_str()
+        ->check(CLI::Range(0.01, 100.0));
+    cmd->callback([a, &exit_code] {
+        const GrownInput grown = grow_input_tree(a->input, a->in);
+        report_and_write(*a, grown.doc, grown.tree, a->input, exit_code);
+    });
+}
+
+void add_export_command(CLI::App& app, int& exit_code)
+{
+    auto* cmd = app.add_subcommand("export", "Export the tree of a session document as .glb or .obj");
+    auto a = std::make_shared<TreeArgs>();
+    cmd->add_option("SESSION", a->input, "Session document (.json)")->required();
+    cmd->add_option("-o,--out", a->out, "Output file: tree.glb (glTF binary) or tree.obj (with .mtl and PNG)")
+        ->required();
+    add_tree_options(cmd, *a);
+    cmd->callback([a, &exit_code] {
+        Document doc = load_document(a->input);
+        if (!a->in.settings.empty()) doc.settings = load_settings_file(a->in.settings);
+        apply_tree_input_options(doc.settings, a->in);
+        if (a->in.seed) doc.seed = *a->in.seed;
+        report_and_write(*a, doc, build_document_tree(doc), a->input, exit_code);
+    });
+}
+
+} // namespace lobe::cli

@@ -1,0 +1,76 @@
+// `lobesketch replay REC --out DIR`: the whole pipeline from a recording.
+#include <filesystem>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "app/cli/cli.h"
+#include "app/cli/cli_common.h"
+#include "app/cli/outputs.h"
+#include "app/export/tree_output.h"
+#include "core/errors.h"
+
+namespace lobe::cli {
+
+void add_replay_command(CLI::App& app, int& exit_code)
+{
+    auto* cmd = app.add_subcommand("replay", "Replay a recording through the pipeline and write its results");
+    struct Args {
+        std::string rec, out, settings;
+        std::uint64_t seed = 1;
+    };
+    auto a = std::make_shared<Args>();
+    cmd->add_option("REC", a->rec, "Recording (binary or text form)")->required();
+    cmd->add_option("-o,--out", a->out, "Output folder (created): strokes.json, session.json, lobes/lobe_N.ply, tree.glb")
+        ->required();
+    cmd->add_option("--settings", a->settings, "Settings JSON (a settings object or a session document)");
+    cmd->add_option("--seed", a->seed, "Seed of every random choice downstream")->capture_default_str();
+    cmd->callback([a, &exit_code] {
+        Document doc;
+        doc.seed = a->seed;
+        if (!a->settings.empty()) doc.settings = load_settings_file(a->settings);
+        std::size_t drags = 0;
+        Document out_doc = replay_into_document(a->rec, std::move(doc), &drags);
+
+        std::error_code ec;
+        std::filesystem::create_directories(a->out, ec);
+        if (ec) throw FileError(a->out, "cannot create output folder: " + ec.message());
+        write_strokes_json(a->out + "/strokes.json", out_doc.strokes, a->rec);
+        // The session first (every stroke is safe even if meshing fails), then the lobes, then
+        // the session again with their files.
+        save_document(a->out + "/session.json", out_doc);
+        std::vector<std::string> warnings;
+        std::vector<BuiltLobe> lobes;
+        const std::size_t lobe_files = write_document_lobes(out_doc, a->out, warnings, &lobes);
+        for (const std::string& w : warnings) warn(a->rec + ": " + w);
+        save_document(a->out + "/session.json", out_doc);
+        // Then the tree grown in those lobes (docs/growth.md, docs/export.md).
+        bool tree_written = false;
+        if (!lobes.empty()) {
+            const BuiltTree tree = grow_document_tree(out_doc, std::move(lobes));
+            for (const std::string& w : tree.warnings) warn(a->rec + ": " + w);
+            const TreeGeometry geometry = document_tree_geometry(out_doc, tree);
+            write_tree_file(a->out + "/tree.glb", out_doc, tree, geometry, ExportOptions{});
+            tree_written = true;
+            progress("grew a tree of " + std::to_string(tree.growth.tree.size()) + " nodes (triangles " +
+                     lod_triangle_summary(geometry) + ")");
+        }
+        std::size_t lobe_strokes = 0, trunk_strokes = 0;
+        for (const Stroke& s : out_doc.strokes) (s.kind == StrokeKind::Lobe ? lobe_strokes : trunk_strokes)++;
+        progress("derived " + std::to_string(out_doc.strokes.size()) + " strokes (" + std::to_string(lobe_strokes) +
+                 " lobe, " + std::to_string(trunk_strokes) + " trunk) in " + std::to_string(out_doc.lobes.size()) +
+                 " lobe group(s), " + std::to_string(out_doc.edits.size()) + " edit(s) from " +
+                 std::to_string(drags) + " drag(s)");
+        progress("wrote " + a->out + "/strokes.json, " + a->out + "/session.json, " + std::to_string(lobe_files) +
+                 " lobe mesh(es) in " + a->out + "/lobes" + (tree_written ? " and " + a->out + "/tree.glb" : ""));
+        if (out_doc.strokes.empty() && drags == 0 && out_doc.lobes.empty()) {
+            error(a->rec + ": no strokes in this recording");
+            exit_code = kExitFailure;
+            return;
+        }
+        exit_code = kExitOk;
+    });
+}
+
+} // namespace lobe::cli

@@ -1,0 +1,324 @@
+#include "app/export/export_gltf.h"
+
+#include <algorithm>
+#include <cstring>
+#include <limits>
+#include <sstream>
+#include <string_view>
+
+#include <glm/common.hpp>
+#include <tiny_gltf.h>
+
+#include "core/atomic_file.h"
+#include "core/errors.h"
+
+namespace lobe {
+
+namespace {
+
+constexpr int kArrayBuffer = TINYGLTF_TARGET_ARRAY_BUFFER;
+constexpr int kElementArrayBuffer = TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER;
+
+/// Builds a one-buffer glTF model: every buffer view starts on a 4-byte boundary.
+class GlbBuilder {
+public:
+    GlbBuilder()
+    {
+        model_.asset.version = "2.0";
+        model_.asset.generator = "Lobesketch";
+        model_.buffers.emplace_back();
+    }
+
+    tinygltf::Model& model() { return model_; }
+
+    int add_view(const void* data, std::size_t bytes, int target)
+    {
+        std::vector<unsigned char>& bin = model_.buffers[0].data;
+        pad_to_4();
+        tinygltf::BufferView view;
+        view.buffer = 0;
+        view.byteOffset = bin.size();
+        view.byteLength = bytes;
+        view.target = target;
+        const auto* p = static_cast<const unsigned char*>(data);
+        bin.insert(bin.end(), p, p + bytes);
+        model_.bufferViews.push_back(view);
+        return static_cast<int>(model_.bufferViews.size() - 1);
+    }
+
+    /// VEC3 float accessor; with min/max when `bounds` (required for POSITION).
+    int add_vec3(const std::vector<glm::vec3>& v, bool bounds)
+    {
+        std::vector<float> flat;
+        flat.reserve(v.size() * 3);
+        for (const glm::vec3& p : v) flat.insert(flat.end(), {p.x, p.y, p.z});
+        tinygltf::Accessor a = accessor(add_view(flat.data(), flat.size() * sizeof(float), kArrayBuffer),
+                                        TINYGLTF_COMPONENT_TYPE_FLOAT, v.size(), TINYGLTF_TYPE_VEC3);
+        if (bounds) {
+            glm::vec3 lo(std::numeric_limits<float>::max()), hi(std::numeric_limits<float>::lowest());
+            for (const glm::vec3& p : v) {
+                lo = glm::min(lo, p);
+                hi = glm::max(hi, p);
+            }
+            a.minValues = {double(lo.x), double(lo.y), double(lo.z)};
+            a.maxValues = {double(hi.x), double(hi.y), double(hi.z)};
+        }
+        return push(a);
+    }
+
+    int add_vec2(const std::vector<glm::vec2>& v)
+    {
+        std::vector<float> flat;
+        flat.reserve(v.size() * 2);
+        for (const glm::vec2& p : v) flat.insert(flat.end(), {p.x, p.y});
+        return push(accessor(add_view(flat.data(), flat.size() * sizeof(float), kArrayBuffer),
+                             TINYGLTF_COMPONENT_TYPE_FLOAT, v.size(), TINYGLTF_TYPE_VEC2));
+    }
+
+    /// Triangle indices as UNSIGNED_SHORT when every index fits below the 16-bit restart
+    /// value (65535, which glTF forbids as an index), else UNSIGNED_INT.
+    int add_indices(const std::vector<std::array<std::uint32_t, 3>>& triangles, std::size_t vertex_count)
+    {
+        const std::size_t count = triangles.size() * 3;
+        if (vertex_count <= 65535) {
+            std::vector<std::uint16_t> idx;
+            idx.reserve(count);
+            for (const auto& t : triangles)
+                for (std::uint32_t i : t) idx.push_back(static_cast<std::uint16_t>(i));
+            return push(accessor(add_view(idx.data(), idx.size() * sizeof(std::uint16_t), kElementArrayBuffer),
+                                 TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, count, TINYGLTF_TYPE_SCALAR));
+        }
+        std::vector<std::uint32_t> idx;
+        idx.reserve(count);
+        for (const auto& t : triangles) idx.insert(idx.end(), t.begin(), t.end());
+        return push(accessor(add_view(idx.data(), idx.size() * sizeof(std::uint32_t), kElementArrayBuffer),
+                             TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, count, TINYGLTF_TYPE_SCALAR));
+    }
+
+    int add_material(tinygltf::Material m)
+    {
+        model_.materials.push_back(std::move(m));
+        return static_cast<int>(model_.materials.size() - 1);
+    }
+
+    int add_mesh_node(const std::string& name, tinygltf::Primitive primitive)
+    {
+        tinygltf::Mesh mesh;
+        mesh.name = name;
+        mesh.primitives.push_back(std::move(primitive));
+        model_.meshes.push_back(std::move(mesh));
+        tinygltf::Node node;
+        node.name = name;
+        node.mesh = static_cast<int>(model_.meshes.size() - 1);
+        return add_node(std::move(node));
+    }
+
+    int add_node(tinygltf::Node node)
+    {
+        model_.nodes.push_back(std::move(node));
+        return static_cast<int>(model_.nodes.size() - 1);
+    }
+
+    void pad_to_4()
+    {
+        std::vector<unsigned char>& bin = model_.buffers[0].data;
+        bin.resize((bin.size() + 3) / 4 * 4, 0);
+    }
+
+private:
+    static tinygltf::Accessor accessor(int view, int component, std::size_t count, int type)
+    {
+        tinygltf::Accessor a;
+        a.bufferView = view;
+        a.byteOffset = 0;
+        a.componentType = component;
+        a.count = count;
+        a.type = type;
+        return a;
+    }
+
+    int push(tinygltf::Accessor a)
+    {
+        model_.accessors.push_back(std::move(a));
+        return static_cast<int>(model_.accessors.size() - 1);
+    }
+
+    tinygltf::Model model_;
+};
+
+std::vector<double> rgba(const std::array<float, 3>& rgb, double alpha)
+{
+    return {double(rgb[0]), double(rgb[1]), double(rgb[2]), alpha};
+}
+
+/// Embeds `image` as a PNG in the binary chunk with its own sampler; returns the texture index.
+int embed_texture(GlbBuilder& b, const RgbaImage& image, const std::string& name, int wrap)
+{
+    const std::vector<std::uint8_t> png = encode_png(image);
+    tinygltf::Model& model = b.model();
+    tinygltf::Image img;
+    img.name = name;
+    img.mimeType = "image/png";
+    img.bufferView = b.add_view(png.data(), png.size(), 0);
+    model.images.push_back(std::move(img));
+    tinygltf::Sampler sampler;
+    sampler.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
+    sampler.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
+    sampler.wrapS = wrap;
+    sampler.wrapT = wrap;
+    model.samplers.push_back(sampler);
+    tinygltf::Texture texture;
+    texture.source = static_cast<int>(model.images.size() - 1);
+    texture.sampler = static_cast<int>(model.samplers.size() - 1);
+    model.textures.push_back(texture);
+    return static_cast<int>(model.textures.size() - 1);
+}
+
+/// The bark material; embeds the tiling bark texture (PNG, REPEAT) when the tree has one.
+tinygltf::Material bark_material(const PreparedExport& e, GlbBuilder& b)
+{
+    tinygltf::Material m;
+    m.name = "bark";
+    m.pbrMetallicRoughness.baseColorFactor = rgba(e.bark_color, 1.0);
+    m.pbrMetallicRoughness.metallicFactor = 0.0;
+    m.pbrMetallicRoughness.roughnessFactor = 0.9;
+    if (e.bark_texture != nullptr) {
+        m.pbrMetallicRoughness.baseColorTexture.index =
+            embed_texture(b, *e.bark_texture, e.name + "_bark", TINYGLTF_TEXTURE_WRAP_REPEAT);
+        m.pbrMetallicRoughness.baseColorTexture.texCoord = 0;
+    }
+    return m;
+}
+
+/// The leaf material; embeds the leaf texture (PNG) when the tree has one.
+tinygltf::Material leaf_material(const PreparedExport& e, GlbBuilder& b)
+{
+    tinygltf::Material m;
+    m.name = "leaf";
+    m.pbrMetallicRoughness.baseColorFactor = rgba(e.leaf_color, 1.0);
+    m.pbrMetallicRoughness.metallicFactor = 0.0;
+    m.pbrMetallicRoughness.roughnessFactor = 0.8;
+    m.alphaMode = "MASK";
+    m.alphaCutoff = 0.5;
+    m.doubleSided = true;
+    if (e.leaf_texture != nullptr) {
+        // Clamped: the leaf is one picture, and its transparent border must not wrap round.
+        m.pbrMetallicRoughness.baseColorTexture.index =
+            embed_texture(b, *e.leaf_texture, e.name + "_leaf", TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE);
+        m.pbrMetallicRoughness.baseColorTexture.texCoord = 0;
+    }
+    return m;
+}
+
+tinygltf::Material lobe_material()
+{
+    tinygltf::Material m;
+    m.name = "lobe";
+    m.pbrMetallicRoughness.baseColorFactor = {0.45, 0.75, 0.35, 0.25};
+    m.pbrMetallicRoughness.metallicFactor = 0.0;
+    m.pbrMetallicRoughness.roughnessFactor = 1.0;
+    m.alphaMode = "BLEND";
+    m.doubleSided = true;
+    return m;
+}
+
+tinygltf::Material stroke_material(tinygltf::Model& model)
+{
+    tinygltf::Material m;
+    m.name = "stroke";
+    m.pbrMetallicRoughness.baseColorFactor = {1.0, 0.55, 0.1, 1.0};
+    m.pbrMetallicRoughness.metallicFactor = 0.0;
+    m.pbrMetallicRoughness.roughnessFactor = 1.0;
+    m.extensions["KHR_materials_unlit"] = tinygltf::Value(tinygltf::Value::Object());
+    model.extensionsUsed.push_back("KHR_materials_unlit");
+    return m;
+}
+
+tinygltf::Model build_model(const PreparedExport& e)
+{
+    GlbBuilder b;
+    int bark = -1, leaf = -1;
+    tinygltf::Node root;
+    root.name = e.name;
+    if (!e.species.empty()) {
+        tinygltf::Value::Object extras;
+        extras["species"] = tinygltf::Value(e.species);
+        root.extras = tinygltf::Value(extras);
+    }
+    for (const ExportPart& part : e.parts) {
+        const bool is_leaves = part.kind == ExportPart::Kind::Leaves;
+        int& material = is_leaves ? leaf : bark;
+        if (material < 0) material = b.add_material(is_leaves ? leaf_material(e, b) : bark_material(e, b));
+        const SurfaceGeometry& g = part.geometry;
+        tinygltf::Primitive prim;
+        prim.mode = TINYGLTF_MODE_TRIANGLES;
+        prim.material = material;
+        prim.attributes["POSITION"] = b.add_vec3(g.positions, true);
+        prim.attributes["NORMAL"] = b.add_vec3(g.normals, false);
+        prim.attributes["TEXCOORD_0"] = b.add_vec2(g.uvs);
+        prim.indices = b.add_indices(g.triangles, g.vertex_count());
+        root.children.push_back(b.add_mesh_node(part.name, std::move(prim)));
+    }
+
+    tinygltf::Node sketch;
+    sketch.name = e.name + "_sketch";
+    if (!e.lobes.empty()) {
+        const int material = b.add_material(lobe_material());
+        for (const ExportLobe& lobe : e.lobes) {
+            tinygltf::Primitive prim;
+            prim.mode = TINYGLTF_MODE_TRIANGLES;
+            prim.material = material;
+            prim.attributes["POSITION"] = b.add_vec3(lobe.positions, true);
+            prim.indices = b.add_indices(lobe.triangles, lobe.positions.size());
+            sketch.children.push_back(b.add_mesh_node(lobe.name, std::move(prim)));
+        }
+    }
+    if (!e.strokes.empty()) {
+        const int material = b.add_material(stroke_material(b.model()));
+        for (const ExportPolyline& line : e.strokes) {
+            tinygltf::Primitive prim;
+            prim.mode = TINYGLTF_MODE_LINE_STRIP;
+            prim.material = material;
+            prim.attributes["POSITION"] = b.add_vec3(line.points, true);
+            sketch.children.push_back(b.add_mesh_node(line.name, std::move(prim)));
+        }
+    }
+
+    tinygltf::Scene scene;
+    scene.name = e.name;
+    scene.nodes.push_back(b.add_node(std::move(root)));
+    if (!sketch.children.empty()) scene.nodes.push_back(b.add_node(std::move(sketch)));
+    b.pad_to_4();
+    tinygltf::Model& model = b.model();
+    model.scenes.push_back(std::move(scene));
+    model.defaultScene = 0;
+    if (model.buffers[0].data.empty()) model.buffers.clear(); // a tree with nothing to draw
+    return std::move(model);
+}
+
+} // namespace
+
+std::vector<std::uint8_t> encode_glb(const ExportScene& scene, const ExportOptions& options)
+{
+    const PreparedExport prepared = prepare_export(scene, options);
+    tinygltf::Model model = build_model(prepared);
+    // A .glb states its total length in 32 bits; leave room for the JSON chunk.
+    constexpr std::size_t kMaxBinary = std::numeric_limits<std::uint32_t>::max() - (std::size_t(64) << 20);
+    if (!model.buffers.empty() && model.buffers[0].data.size() > kMaxBinary)
+        throw InvalidInput("export: " + std::to_string(model.buffers[0].data.size()) +
+                           " bytes of geometry do not fit a .glb (4 GiB)");
+    std::ostringstream out(std::ios::binary);
+    tinygltf::TinyGLTF writer;
+    if (!writer.WriteGltfSceneToStream(&model, out, false, true) || !out)
+        throw InvalidInput("export: tinygltf could not serialise the model");
+    const std::string bytes = std::move(out).str();
+    return std::vector<std::uint8_t>(bytes.begin(), bytes.end());
+}
+
+void write_glb(const std::string& path, const ExportScene& scene, const ExportOptions& options)
+{
+    const std::vector<std::uint8_t> bytes = encode_glb(scene, options);
+    write_file_atomic(path, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+}
+
+} // namespace lobe

@@ -1,0 +1,197 @@
+#include "app/export/export_scene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <glm/geometric.hpp>
+
+#include "core/errors.h"
+
+namespace lobe {
+
+namespace {
+
+[[noreturn]] void fail(const std::string& what) { throw InvalidInput("export: " + what); }
+
+bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool finite(const glm::vec2& v) { return std::isfinite(v.x) && std::isfinite(v.y); }
+
+void check_name(const std::string& name)
+{
+    if (name.empty()) fail("the scene name is empty");
+    for (unsigned char c : name)
+        if (c < 0x20 || c == 0x7f) fail("the scene name contains a control character");
+}
+
+/// Checks one mesh of one LOD; `what` names it in messages ("LOD 1 leaves").
+void check_surface(const SurfaceGeometry& g, const std::string& what)
+{
+    const std::size_t n = g.positions.size();
+    if (g.normals.size() != n)
+        fail(what + ": " + std::to_string(g.normals.size()) + " normals for " + std::to_string(n) + " positions");
+    if (g.uvs.size() != n)
+        fail(what + ": " + std::to_string(g.uvs.size()) + " uvs for " + std::to_string(n) + " positions");
+    if (n > std::numeric_limits<std::uint32_t>::max()) fail(what + ": too many vertices");
+    for (std::size_t i = 0; i < n; ++i) {
+        if (!finite(g.positions[i])) fail(what + ": position " + std::to_string(i) + " is not finite");
+        if (!finite(g.normals[i])) fail(what + ": normal " + std::to_string(i) + " is not finite");
+        if (!finite(g.uvs[i])) fail(what + ": uv " + std::to_string(i) + " is not finite");
+        if (glm::length(g.normals[i]) < 1e-6f) fail(what + ": normal " + std::to_string(i) + " is zero");
+    }
+    for (std::size_t t = 0; t < g.triangles.size(); ++t)
+        for (std::uint32_t v : g.triangles[t])
+            if (v >= n)
+                fail(what + ": triangle " + std::to_string(t) + " uses vertex " + std::to_string(v) + " of " +
+                     std::to_string(n));
+}
+
+std::vector<int> chosen_lods(const TreeGeometry& tree, const std::vector<int>& requested)
+{
+    const int count = static_cast<int>(tree.lods.size());
+    std::vector<int> lods;
+    if (requested.empty()) {
+        for (int i = 0; i < count; ++i) lods.push_back(i);
+        return lods;
+    }
+    lods = requested;
+    std::sort(lods.begin(), lods.end());
+    for (std::size_t i = 0; i < lods.size(); ++i) {
+        if (lods[i] < 0 || lods[i] >= count)
+            fail("LOD " + std::to_string(lods[i]) + " requested, the tree has " + std::to_string(count));
+        if (i > 0 && lods[i] == lods[i - 1]) fail("LOD " + std::to_string(lods[i]) + " requested twice");
+    }
+    return lods;
+}
+
+/// Height of the tallest vertex of LOD0 (the tree itself; coarser LODs' larger leaves may
+/// reach a little higher) above the base, so that exporting any subset of LODs scales
+/// exactly like exporting all of them.
+double tree_height(const TreeGeometry& tree, const glm::vec3& base)
+{
+    double top = -std::numeric_limits<double>::infinity();
+    if (tree.lods.empty()) return top;
+    for (const SurfaceGeometry* g : {&tree.lods[0].branches, &tree.lods[0].leaves})
+        for (const glm::vec3& p : g->positions) top = std::max(top, double(p.y) - double(base.y));
+    return top;
+}
+
+glm::vec3 to_export(const glm::vec3& p, const glm::vec3& base, float scale) { return (p - base) * scale; }
+
+ExportPart make_part(const SurfaceGeometry& g, ExportPart::Kind kind, int lod, const std::string& name,
+                     const glm::vec3& base, float scale)
+{
+    ExportPart part;
+    part.kind = kind;
+    part.lod = lod;
+    part.name = name + (kind == ExportPart::Kind::Branches ? "_branches_LOD" : "_leaves_LOD") + std::to_string(lod);
+    part.geometry.positions.reserve(g.positions.size());
+    for (const glm::vec3& p : g.positions) part.geometry.positions.push_back(to_export(p, base, scale));
+    part.geometry.normals.reserve(g.normals.size());
+    for (const glm::vec3& n : g.normals) part.geometry.normals.push_back(glm::normalize(n));
+    part.geometry.uvs = g.uvs;
+    part.geometry.triangles = g.triangles;
+    return part;
+}
+
+} // namespace
+
+bool PreparedExport::has_leaves() const
+{
+    return std::any_of(parts.begin(), parts.end(), [](const ExportPart& p) { return p.kind == ExportPart::Kind::Leaves; });
+}
+
+bool PreparedExport::has_branches() const
+{
+    return std::any_of(parts.begin(), parts.end(), [](const ExportPart& p) { return p.kind == ExportPart::Kind::Branches; });
+}
+
+PreparedExport prepare_export(const ExportScene& scene, const ExportOptions& options)
+{
+    if (scene.tree == nullptr) fail("no tree given");
+    const TreeGeometry& tree = *scene.tree;
+    check_name(scene.name);
+    if (!finite(scene.base)) fail("the base is not finite");
+    if (!std::isfinite(options.target_height_m) || options.target_height_m < 0.0)
+        fail("target height " + std::to_string(options.target_height_m) + " m is not a positive number");
+
+    const std::vector<int> lods = chosen_lods(tree, options.lods);
+    // Every LOD is checked, exported or not: the height used for scaling reads them all.
+    for (std::size_t i = 0; i < tree.lods.size(); ++i) {
+        check_surface(tree.lods[i].branches, "LOD " + std::to_string(i) + " branches");
+        check_surface(tree.lods[i].leaves, "LOD " + std::to_string(i) + " leaves");
+    }
+    const RgbaImage& tex = tree.leaf_texture;
+    const RgbaImage& bark = tree.bark_texture;
+    for (const auto& [image, what] : {std::pair{&tex, "leaf"}, std::pair{&bark, "bark"}})
+        if (image->width < 0 || image->height < 0 ||
+            image->pixels.size() != std::size_t(image->width) * std::size_t(image->height) * 4u)
+            fail(std::string(what) + " texture of " + std::to_string(image->width) + "x" +
+                 std::to_string(image->height) + " has " + std::to_string(image->pixels.size()) + " bytes");
+
+    float scale = 1.0f;
+    if (options.target_height_m > 0.0) {
+        const double height = tree_height(tree, scene.base);
+        if (!(height > 1e-9)) fail("the tree has no height above its base to scale");
+        scale = static_cast<float>(options.target_height_m / height);
+    }
+
+    PreparedExport out;
+    out.name = scene.name;
+    out.scale = scale;
+    out.bark_color = tree.bark_color;
+    out.leaf_color = tree.leaf_color;
+    out.species = tree.species;
+    out.leaf_texture = (tex.width > 0 && tex.height > 0) ? &tex : nullptr;
+    out.bark_texture = (bark.width > 0 && bark.height > 0) ? &bark : nullptr;
+    for (int lod : lods) {
+        const TreeLod& l = tree.lods[std::size_t(lod)];
+        if (!l.branches.empty())
+            out.parts.push_back(make_part(l.branches, ExportPart::Kind::Branches, lod, scene.name, scene.base, scale));
+        if (!l.leaves.empty())
+            out.parts.push_back(make_part(l.leaves, ExportPart::Kind::Leaves, lod, scene.name, scene.base, scale));
+    }
+
+    if (options.include_lobes) {
+        for (std::size_t i = 0; i < scene.lobes.size(); ++i) {
+            const TriangleMesh& m = scene.lobes[i];
+            const std::string what = "lobe " + std::to_string(i);
+            if (m.triangles.empty()) continue;
+            ExportLobe lobe;
+            lobe.name = "lobe_" + std::to_string(i);
+            for (std::size_t v = 0; v < m.positions.size(); ++v) {
+                if (!finite(m.positions[v])) fail(what + ": position " + std::to_string(v) + " is not finite");
+                lobe.positions.push_back(to_export(m.positions[v], scene.base, scale));
+            }
+            for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+                std::array<std::uint32_t, 3> tri{};
+                for (int k = 0; k < 3; ++k) {
+                    const int v = m.triangles[t][std::size_t(k)];
+                    if (v < 0 || std::size_t(v) >= m.positions.size())
+                        fail(what + ": triangle " + std::to_string(t) + " uses vertex " + std::to_string(v) + " of " +
+                             std::to_string(m.positions.size()));
+                    tri[std::size_t(k)] = static_cast<std::uint32_t>(v);
+                }
+                lobe.triangles.push_back(tri);
+            }
+            out.lobes.push_back(std::move(lobe));
+        }
+    }
+
+    if (options.include_strokes) {
+        for (const Stroke& s : scene.strokes) {
+            if (s.points.size() < 2) continue;
+            ExportPolyline line;
+            line.name = "stroke_" + std::to_string(s.id);
+            for (std::size_t i = 0; i < s.points.size(); ++i) {
+                if (!finite(s.points[i].position))
+                    fail("stroke " + std::to_string(s.id) + ": point " + std::to_string(i) + " is not finite");
+                line.points.push_back(to_export(s.points[i].position, scene.base, scale));
+            }
+            out.strokes.push_back(std::move(line));
+        }
+    }
+    return out;
+}
+
+} // namespace lobe

@@ -1,0 +1,96 @@
+#pragma once
+/// \file export_scene.h
+/// What the exporters (app/export/export_gltf.h, app/export/export_obj.h) write, and the preparation they
+/// share: checking the input, choosing LODs, moving the trunk base to the origin and scaling
+/// to a target height. Units stay metres, +Y up, right-handed (the glTF frame): nothing is
+/// converted. The layout of the written files is described in docs/export.md.
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "core/mesh.h"
+#include "core/stroke.h"
+#include "growth/tree_geometry.h"
+
+namespace lobe {
+
+/// A tree and, optionally, the sketch it grew from.
+struct ExportScene {
+    std::string name = "tree";          ///< prefix of every node/object name; non-empty, printable
+    const TreeGeometry* tree = nullptr; ///< required; not owned
+    glm::vec3 base{0.0f};               ///< trunk base on the ground (metres): becomes the origin
+    std::vector<TriangleMesh> lobes;    ///< optional, written as `lobe_<i>` (index in this list)
+    std::vector<Stroke> strokes;        ///< optional, written as `stroke_<id>` line strips
+};
+
+struct ExportOptions {
+    /// > 0: scale uniformly (about the base) so the tallest vertex of LOD0 (branches and
+    /// leaves) lies this many metres above the base; every written LOD gets that scale.
+    /// 0: keep the size.
+    double target_height_m = 0.0;
+    /// Indices of the LODs to write (any order, no repeats); empty = all.
+    std::vector<int> lods;
+    bool include_lobes = false;   ///< write ExportScene::lobes
+    bool include_strokes = false; ///< write ExportScene::strokes (those with two points or more)
+};
+
+/// One non-empty mesh of one LOD, in export space.
+struct ExportPart {
+    enum class Kind { Branches, Leaves };
+    std::string name; ///< `<scene name>_branches_LOD<k>` or `<scene name>_leaves_LOD<k>`
+    Kind kind = Kind::Branches;
+    int lod = 0;               ///< index into TreeGeometry::lods
+    SurfaceGeometry geometry;  ///< base subtracted, scaled; normals renormalised
+};
+
+/// A lobe in export space (positions only: flat shaded).
+struct ExportLobe {
+    std::string name; ///< `lobe_<i>`
+    std::vector<glm::vec3> positions;
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+};
+
+/// A stroke in export space.
+struct ExportPolyline {
+    std::string name; ///< `stroke_<id>`
+    std::vector<glm::vec3> points;
+};
+
+/// Everything an exporter writes, already checked and transformed.
+struct PreparedExport {
+    std::string name;
+    std::vector<ExportPart> parts;      ///< by LOD ascending, branches before leaves; empty meshes left out
+    std::vector<ExportLobe> lobes;      ///< empty unless include_lobes
+    std::vector<ExportPolyline> strokes; ///< empty unless include_strokes
+    const RgbaImage* leaf_texture = nullptr; ///< null when the tree has no texture (width or height 0)
+    const RgbaImage* bark_texture = nullptr; ///< null when the tree has no bark texture
+    std::array<float, 3> bark_color{};
+    std::array<float, 3> leaf_color{};
+    std::string species;
+    float scale = 1.0f; ///< the uniform scale applied after subtracting the base
+    bool has_leaves() const;
+    bool has_branches() const;
+};
+
+/// Checks `scene` and `options` and transforms the geometry: x' = (x − base) · scale.
+/// \throw InvalidInput (one line) for a missing tree, a bad name, an unknown or repeated LOD
+/// index, a non-finite or negative target height, a tree with no height to scale, array
+/// sizes that disagree, non-finite positions/normals/uvs, zero normals, out-of-range or
+/// negative triangle indices, or a leaf texture whose pixel count does not match its size.
+PreparedExport prepare_export(const ExportScene& scene, const ExportOptions& options);
+
+/// Reads a PNG or JPEG picture (a reference photo) as RGBA8, scaled down (box filter) so that
+/// neither side exceeds `max_side`. Untrusted: files over 64 MB or pictures over 16384 pixels
+/// a side are refused before decoding.
+/// \throw FileError (one line naming the file) when it cannot be read or decoded.
+RgbaImage read_picture_file(const std::string& path, int max_side = 1024);
+
+/// PNG encoding of an RGBA8 image (stb_image_write, deterministic: same pixels, same bytes).
+/// \throw InvalidInput for an empty image or a pixel count that does not match.
+std::vector<std::uint8_t> encode_png(const RgbaImage& image);
+
+} // namespace lobe

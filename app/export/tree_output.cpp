@@ -1,0 +1,85 @@
+#include "app/export/tree_output.h"
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <sstream>
+
+#include "app/export/export_gltf.h"
+#include "app/export/export_obj.h"
+#include "core/errors.h"
+#include "growth/branch_geometry.h"
+#include "app/session/edit_ops.h"
+
+namespace lobe {
+
+LobeLeafOverrides document_lobe_leaves(const Document& doc, const BuiltTree& tree)
+{
+    LobeLeafOverrides out(tree.lobes.size());
+    bool any = false;
+    for (std::size_t i = 0; i < tree.lobes.size(); ++i)
+        for (const LobeRecord& r : doc.lobes) {
+            if (r.id != tree.lobes[i].lobe_id) continue;
+            out[i] = {r.leaf_length_m, r.leaves_per_node, r.seed};
+            any = any || r.leaf_length_m || r.leaves_per_node || r.seed;
+        }
+    if (!any) out.clear();
+    return out;
+}
+
+TreeGeometry document_tree_geometry(const Document& doc, const BuiltTree& tree)
+{
+    return build_tree_geometry(tree.growth.tree, doc.settings.branches, doc.settings.leaves, doc.seed,
+                               doc.settings.growth.species, document_lobe_leaves(doc, tree));
+}
+
+std::size_t lod_triangles(const TreeLod& lod) { return lod.branches.triangle_count() + lod.leaves.triangle_count(); }
+
+std::string lod_triangle_summary(const TreeGeometry& geometry)
+{
+    std::string out;
+    for (std::size_t i = 0; i < geometry.lods.size(); ++i)
+        out += (i ? ", LOD" : "LOD") + std::to_string(i) + " " + std::to_string(lod_triangles(geometry.lods[i]));
+    return out;
+}
+
+void write_tree_file(const std::string& path, const Document& doc, const BuiltTree& tree,
+                     const TreeGeometry& geometry, const ExportOptions& options)
+{
+    std::string ext = std::filesystem::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    ExportScene scene;
+    scene.name = "tree";
+    scene.tree = &geometry;
+    if (!tree.growth.tree.empty()) scene.base = tree.growth.tree.nodes[0].position;
+    if (options.include_lobes)
+        for (const BuiltLobe& l : tree.lobes) scene.lobes.push_back(l.mesh);
+    if (options.include_strokes) scene.strokes = effective_strokes(doc);
+    if (ext == ".glb")
+        write_glb(path, scene, options);
+    else if (ext == ".obj")
+        write_obj(path, scene, options);
+    else
+        throw InvalidInput(path + ": the tree is written as .glb (glTF binary) or .obj (with .mtl and a PNG)");
+}
+
+std::vector<int> parse_lod_list(const std::string& text, int lod_count)
+{
+    if (text.empty() || text == "all") return {};
+    std::vector<int> out;
+    std::stringstream ss(text);
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+        if (item.empty() || item.size() > 2 || !std::all_of(item.begin(), item.end(), [](unsigned char c) { return std::isdigit(c); }))
+            throw InvalidInput("--lod: expected \"all\" or LOD indices such as 0 or 0,2 (got '" + text + "')");
+        const int lod = std::stoi(item);
+        if (lod >= lod_count)
+            throw InvalidInput("--lod: LOD " + item + " does not exist (the tree has LOD0 to LOD" +
+                               std::to_string(lod_count - 1) + "; settings.branches.lod_count)");
+        if (std::find(out.begin(), out.end(), lod) != out.end()) throw InvalidInput("--lod: LOD " + item + " given twice");
+        out.push_back(lod);
+    }
+    return out;
+}
+
+} // namespace lobe

@@ -1,0 +1,87 @@
+#include "app/session/tree_pipeline.h"
+
+#include <algorithm>
+#include <limits>
+
+#include "growth/radii.h"
+#include "growth/species.h"
+#include "app/session/edit_ops.h"
+#include "meshing/model_import.h"
+
+namespace lobe {
+
+std::vector<GrowthLobe> growth_lobes(const Document& doc, const std::vector<BuiltLobe>& lobes)
+{
+    const SubtreeLibrary& library = default_subtree_library();
+    const std::vector<double> tree_weights = subtree_weights(library, doc.settings.growth.subtree_weights);
+    std::vector<GrowthLobe> out;
+    for (const BuiltLobe& b : lobes) {
+        GrowthLobe g;
+        g.id = b.lobe_id;
+        g.mesh = b.mesh;
+        g.split_angle_deg = doc.settings.growth.split_angle_deg;
+        g.subtree_weights = tree_weights;
+        for (const LobeRecord& r : doc.lobes) {
+            if (r.id != b.lobe_id) continue;
+            if (!r.species.empty()) {
+                // The lobe's species brings its own split angle and subtree mix.
+                Settings s = doc.settings;
+                apply_species(s, load_species(r.species));
+                g.split_angle_deg = s.growth.split_angle_deg;
+                g.subtree_weights = subtree_weights(library, s.growth.subtree_weights);
+            }
+            if (r.split_angle_deg) g.split_angle_deg = *r.split_angle_deg;
+            g.seed = r.seed;
+        }
+        out.push_back(std::move(g));
+    }
+    return out;
+}
+
+BuiltTree grow_document_tree(const Document& doc, std::vector<BuiltLobe> lobes)
+{
+    BuiltTree t;
+    t.lobes = std::move(lobes);
+    std::vector<std::vector<glm::vec3>> trunk;
+    for (const Stroke& s : effective_strokes(doc)) {
+        if (s.kind != StrokeKind::Trunk) continue;
+        std::vector<glm::vec3> pts;
+        pts.reserve(s.points.size());
+        for (const StrokePoint& p : s.points) pts.push_back(p.position);
+        trunk.push_back(std::move(pts));
+    }
+    t.growth = grow_tree(trunk, growth_lobes(doc, t.lobes), doc.settings.growth, default_subtree_library(), doc.seed);
+    assign_pipe_radii(t.growth.tree, doc.settings.branches.pipe_exponent, doc.settings.branches.tip_radius_m);
+    for (const std::string& m : t.growth.messages) t.warnings.push_back("growth: " + m);
+    return t;
+}
+
+BuiltTree build_document_tree(const Document& doc)
+{
+    std::vector<std::string> warnings;
+    std::vector<BuiltLobe> lobes = build_document_lobes(doc, &warnings);
+    BuiltTree t = grow_document_tree(doc, std::move(lobes));
+    warnings.insert(warnings.end(), t.warnings.begin(), t.warnings.end());
+    t.warnings = std::move(warnings);
+    return t;
+}
+
+BuiltLobe model_lobe(const std::string& path, const Settings& settings, double size_m, std::int64_t id)
+{
+    LobeFromModelOptions mo;
+    mo.size_m = size_m;
+    mo.target_edge_length_m = settings.lobes.edge_length_m;
+    mo.iterations = static_cast<unsigned>(settings.lobes.remesh_iterations);
+    BuiltLobe lobe;
+    lobe.lobe_id = id;
+    lobe.mesh = lobe_from_model(path, mo);
+    float lo = std::numeric_limits<float>::max(), hi = -lo;
+    for (const glm::vec3& p : lobe.mesh.positions) {
+        lo = std::min(lo, p.y);
+        hi = std::max(hi, p.y);
+    }
+    for (glm::vec3& p : lobe.mesh.positions) p.y += 0.5f * (hi - lo) - lo;
+    return lobe;
+}
+
+} // namespace lobe

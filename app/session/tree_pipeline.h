@@ -1,0 +1,40 @@
+#pragma once
+/// \file tree_pipeline.h
+/// From a session document to a tree: its lobes (app/session/lobe_document.h), the trunk
+/// strokes as drawn and edited, growth inside the lobes with per-lobe overrides
+/// (growth/grow.h), pipe-model radii (growth/radii.h). Shared by `replay`, `grow`, `export`
+/// and the interactive apps, which run it off the thread that draws.
+
+#include <string>
+#include <vector>
+
+#include "core/document.h"
+#include "growth/grow.h"
+#include "app/session/lobe_document.h"
+
+namespace lobe {
+
+struct BuiltTree {
+    std::vector<BuiltLobe> lobes;      ///< as grown in, stage space
+    GrowthResult growth;               ///< tree graph with radii assigned
+    std::vector<std::string> warnings; ///< one line each: lobe and growth messages
+};
+
+/// The growth inputs of built lobes: each lobe's mesh, its id, and its effective split angle
+/// and subtree weights (the lobe's `split_angle_deg` / `species` overrides, else the tree's).
+/// \throw InvalidInput for an unknown species or subtree name.
+std::vector<GrowthLobe> growth_lobes(const Document& doc, const std::vector<BuiltLobe>& lobes);
+
+/// Grows the document's tree in `lobes` (already built) from its trunk strokes.
+BuiltTree grow_document_tree(const Document& doc, std::vector<BuiltLobe> lobes);
+
+/// Builds the document's lobes, then grows its tree in them.
+BuiltTree build_document_tree(const Document& doc);
+
+/// A mesh file as a lobe (meshing/model_import.h: repaired, scaled so its bounding box's
+/// largest side is `size_m`, remeshed to settings.lobes.edge_length_m), then raised so its
+/// lowest point is half its height above the ground: the default trunk has room below it.
+/// \throw FileError, InvalidInput as lobe_from_model.
+BuiltLobe model_lobe(const std::string& path, const Settings& settings, double size_m = 1.5, std::int64_t id = 1);
+
+} // namespace lobe
