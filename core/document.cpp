@@ -1,11 +1,13 @@
 #include "core/document.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <limits>
 #include <type_traits>
 #include <unordered_set>
+#include <variant>
 
 #include "core/atomic_file.h"
 #include "core/errors.h"
@@ -525,6 +527,76 @@ void validate_lobe_model(const LobeModel& m, const std::string& w)
     }
 }
 
+namespace {
+
+json grower_to_json(const GrowerChoice& g)
+{
+    json params = json::object();
+    for (const auto& [key, value] : g.params)
+        std::visit([&, k = &key](const auto& v) { params[*k] = v; }, value);
+    return json{{"name", g.name}, {"version", g.version}, {"params", std::move(params)}};
+}
+
+/// `{"name": NAME, "version": N, "params": {KEY: flag, number or text, …}}`; the growers
+/// themselves check the name and the parameters (app/session/session_file.h).
+GrowerChoice grower_from_json(const json& j, const std::string& w)
+{
+    if (!j.is_object()) throw InvalidInput(w + ": expected an object");
+    check_keys(j, {"name", "version", "params"}, w);
+    GrowerChoice g;
+    const auto name = j.find("name");
+    if (name == j.end() || !name->is_string()) throw InvalidInput(w + ".name: expected a grower's name");
+    g.name = name->get<std::string>();
+    const bool well_formed = !g.name.empty() && g.name.size() <= kMaxGrowerNameLength &&
+                             std::all_of(g.name.begin(), g.name.end(), [](char c) {
+                                 return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-';
+                             });
+    if (!well_formed)
+        throw InvalidInput(w + ".name: expected lower-case letters, digits and '-' (at most " +
+                           std::to_string(kMaxGrowerNameLength) + ")");
+    if (const auto v = j.find("version"); v != j.end()) {
+        if (!v->is_number_integer() || v->get<std::int64_t>() < 1 || v->get<std::int64_t>() > 1000000)
+            throw InvalidInput(w + ".version: expected an integer in [1, 1000000]");
+        g.version = v->get<int>();
+    }
+    if (const auto p = j.find("params"); p != j.end()) {
+        if (!p->is_object()) throw InvalidInput(w + ".params: expected an object");
+        if (p->size() > kMaxGrowerParams)
+            throw InvalidInput(w + ".params: more than " + std::to_string(kMaxGrowerParams) + " parameters");
+        for (auto it = p->begin(); it != p->end(); ++it) {
+            const std::string wk = w + ".params." + it.key();
+            if (it.key().empty() || it.key().size() > kMaxGrowerNameLength)
+                throw InvalidInput(w + ".params: a parameter name is empty or longer than " +
+                                   std::to_string(kMaxGrowerNameLength) + " characters");
+            const json& v = it.value();
+            if (v.is_boolean()) g.params[it.key()] = v.get<bool>();
+            else if (v.is_number_integer()) {
+                if (v.is_number_unsigned() && v.get<std::uint64_t>() > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max()))
+                    throw InvalidInput(wk + ": a whole number beyond 2^63");
+                g.params[it.key()] = v.get<std::int64_t>();
+            } else if (v.is_number_float()) {
+                if (!std::isfinite(v.get<double>())) throw InvalidInput(wk + ": not a finite number");
+                g.params[it.key()] = v.get<double>();
+            } else if (v.is_string()) {
+                if (v.get_ref<const std::string&>().size() > kMaxGrowerParamTextBytes)
+                    throw InvalidInput(wk + ": a text longer than " + std::to_string(kMaxGrowerParamTextBytes) + " bytes");
+                g.params[it.key()] = v.get<std::string>();
+            } else {
+                throw InvalidInput(wk + ": expected true, false, a number or a text");
+            }
+        }
+    }
+    return g;
+}
+
+} // namespace
+
+const GrowerChoice& scene_grower(const Document& doc)
+{
+    static const GrowerChoice kDefault;
+    return doc.trees.empty() ? kDefault : doc.trees.front().grower;
+}
+
 json document_to_json(const Document& doc)
 {
     json strokes = json::array();
@@ -549,7 +621,8 @@ json document_to_json(const Document& doc)
         json m = json::array();
         for (int c = 0; c < 4; ++c)
             for (int r = 0; r < 4; ++r) m.push_back(t.transform[c][r]);
-        trees.push_back({{"id", t.id}, {"transform", m}, {"seed", t.seed}, {"lobes", t.lobe_ids}});
+        trees.push_back({{"id", t.id}, {"transform", m}, {"seed", t.seed}, {"lobes", t.lobe_ids},
+                         {"grower", grower_to_json(t.grower)}});
     }
     json out{{"format", "lobesketch-session"},
              {"version", doc.version},
@@ -691,6 +764,7 @@ Document document_from_json(const json& j)
             const json& t = (*a)[i];
             const std::string w = "trees[" + std::to_string(i) + "]";
             if (!t.is_object()) throw InvalidInput(w + ": expected an object");
+            check_keys(t, {"id", "transform", "seed", "lobes", "grower"}, w);
             TreeInstance ti;
             ti.id = read_id(t, "id", w);
             if (auto m = t.find("transform"); m != t.end()) {
@@ -715,6 +789,8 @@ Document document_from_json(const json& j)
                     ti.lobe_ids.push_back(id.get<std::int64_t>());
                 }
             }
+            // Written before trees named their grower: the default grower.
+            if (auto g = t.find("grower"); g != t.end()) ti.grower = grower_from_json(*g, w + ".grower");
             doc.trees.push_back(std::move(ti));
         }
     }

@@ -13,6 +13,7 @@
 #include <glm/mat4x4.hpp>
 #include <nlohmann/json.hpp>
 
+#include "core/grower_choice.h"
 #include "core/mesh.h"
 #include "core/settings.h"
 #include "core/stroke.h"
@@ -78,7 +79,9 @@ struct TreeInstance {
     glm::mat4 transform{1.0f};
     std::uint64_t seed = 1;
     std::vector<std::int64_t> lobe_ids; ///< empty = all lobes
+    GrowerChoice grower;                ///< the growth model and its parameters
 };
+
 
 struct Document {
     int version = kDocumentVersion;
@@ -99,6 +102,10 @@ struct Document {
     std::vector<EditOperation> edits;
     std::vector<TreeInstance> trees;
 };
+
+/// The grower of the scene's tree: the first tree's, else the default (kDefaultGrowerName).
+/// Today the scene holds one tree grown from every lobe; forests will grow one per entry.
+const GrowerChoice& scene_grower(const Document& doc);
 
 /// \throw InvalidInput naming the first setting out of its range.
 void validate_settings(const Settings& s);

@@ -1,3 +1,4 @@
+#include "app/session/session_file.h"
 #include "app/cli/cli_common.h"
 
 #include <algorithm>
@@ -11,12 +12,14 @@
 #include <nlohmann/json.hpp>
 
 #include "app/session/edit_hooks.h"
+#include "app/session/session_builder.h"
 #include "core/atomic_file.h"
 #include "core/document.h"
 #include "core/errors.h"
+#include "growth/grower.h"
 #include "growth/species.h"
 #include "input/pipeline.h"
-#include "app/session/session_builder.h"
+
 #include "meshing/mesh_io.h"
 
 namespace lobe::cli {
@@ -85,6 +88,11 @@ void add_tree_input_options(CLI::App* cmd, TreeInputOptions& o)
     cmd->add_option("--settings", o.settings, "Settings JSON (a settings object or a session document)");
     cmd->add_option("--species", o.species,
                     "Species preset: broadleaf, conifer, willow, birch, or a preset .json file");
+    std::vector<std::string> names;
+    for (const Grower* g : growers()) names.emplace_back(g->name());
+    cmd->add_option("--grower", o.grower, "Growth model: " + grower_names() + " (default: the session's, else " +
+                                              std::string(kDefaultGrowerName) + ")")
+        ->check(CLI::IsMember(names));
     cmd->add_option("--seed", o.seed, "Seed of every random choice of growth (default: the session's)");
     cmd->add_option("--split-angle", o.split_angle, "Split angle t in degrees (smaller: denser branching)")
         ->check(CLI::Range(5.0, 180.0));
@@ -152,6 +160,17 @@ bool is_mesh_file(const std::string& path)
     return ext == ".obj" || ext == ".ply" || ext == ".off";
 }
 
+void apply_document_options(Document& doc, const TreeInputOptions& o)
+{
+    if (o.seed) doc.seed = *o.seed;
+    if (!o.grower.empty()) {
+        GrowerChoice choice;
+        choice.name = o.grower;
+        if (const Grower* g = find_grower(o.grower)) choice.version = g->version();
+        set_scene_grower(doc, std::move(choice));
+    }
+}
+
 GrownInput grow_input_tree(const std::string& input, const TreeInputOptions& o)
 {
     GrownInput out;
@@ -159,11 +178,11 @@ GrownInput grow_input_tree(const std::string& input, const TreeInputOptions& o)
     if (!o.settings.empty()) doc.settings = load_settings_file(o.settings);
     const std::string ext = lower_extension(input);
     if (ext == ".json") {
-        doc = load_document(input);
+        doc = load_session(input);
         if (!o.settings.empty()) doc.settings = load_settings_file(o.settings);
     }
     apply_tree_input_options(doc.settings, o);
-    if (o.seed) doc.seed = *o.seed;
+    apply_document_options(doc, o);
     if (is_mesh_file(input)) {
         const BuiltLobe lobe = model_lobe(input, doc.settings, o.mesh_size);
         LobeRecord rec;

@@ -36,17 +36,22 @@ Settings load_settings_file(const std::string& path);
 struct TreeInputOptions {
     std::string settings; ///< settings JSON file (empty: none)
     std::string species;  ///< preset name or .json file (empty: the settings')
+    std::string grower;   ///< growth model (growth/grower.h; empty: the session's)
     std::optional<std::uint64_t> seed;
     std::optional<double> split_angle, spacing;
     double mesh_size = 1.5; ///< a mesh input's largest side (metres)
 };
 
-/// Registers --settings, --species, --seed, --split-angle and --attractor-spacing.
+/// Registers --settings, --species, --grower, --seed, --split-angle and --attractor-spacing.
 void add_tree_input_options(CLI::App* cmd, TreeInputOptions& o);
 
 /// Applies, in the order a person expects, the species and then the single options to `s`,
 /// and validates the result. \throw InvalidInput
 void apply_tree_input_options(Settings& s, const TreeInputOptions& o);
+
+/// Applies the options that are the document's rather than its settings': --seed and
+/// --grower (the scene's tree grows with that grower and its default parameters).
+void apply_document_options(Document& doc, const TreeInputOptions& o);
 
 /// The local time as "YYYYMMDD-HHMMSS", for default file names.
 std::string timestamp();

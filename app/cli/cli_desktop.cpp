@@ -17,6 +17,7 @@
 #include <imgui.h>
 #include <nlohmann/json.hpp>
 
+#include "app/session/session_file.h"
 #include "app/cli/cli.h"
 #include "app/cli/cli_common.h"
 #include "app/desktop/desktop_script.h"
@@ -321,13 +322,13 @@ void add_desktop_command(CLI::App& app, int& exit_code)
         std::error_code ec;
         if (a->recover) {
             if (!fs::exists(autosave, ec)) throw FileError(autosave, "there is no autosave to recover");
-            doc = load_document(autosave);
+            doc = load_session(autosave);
             // The damaged or older session file stays as it is: saves go beside it.
             if (fs::exists(session, ec)) options.session_path = beside(session, ".recovered.json");
             progress("recovered " + autosave + "; Save writes " + options.session_path);
         } else if (fs::exists(session, ec)) {
             try {
-                doc = load_document(session);
+                doc = load_session(session);
             } catch (const Error& e) {
                 std::string offer = fs::exists(autosave, ec)
                                         ? " The autosave " + autosave + " holds your last work: open it with "

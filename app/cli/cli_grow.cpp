@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "app/session/session_file.h"
 #include "app/cli/cli.h"
 #include "app/cli/cli_common.h"
 #include "app/export/tree_output.h"
@@ -91,10 +92,10 @@ void add_export_command(CLI::App& app, int& exit_code)
         ->required();
     add_tree_options(cmd, *a);
     cmd->callback([a, &exit_code] {
-        Document doc = load_document(a->input);
+        Document doc = load_session(a->input);
         if (!a->in.settings.empty()) doc.settings = load_settings_file(a->in.settings);
         apply_tree_input_options(doc.settings, a->in);
-        if (a->in.seed) doc.seed = *a->in.seed;
+        apply_document_options(doc, a->in);
         report_and_write(*a, doc, build_document_tree(doc), a->input, exit_code);
     });
 }

@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "app/session/session_file.h"
 #include "app/cli/cli.h"
 #include "app/cli/cli_common.h"
 #include "app/cli/outputs.h"
@@ -75,7 +76,7 @@ void add_lobes_command(CLI::App& app, int& exit_code)
             return;
         }
         if (ext == ".json") {
-            doc = load_document(a->input);
+            doc = load_session(a->input);
             if (!a->settings.empty()) doc.settings = load_settings_file(a->settings);
         } else {
             if (!a->settings.empty()) doc.settings = load_settings_file(a->settings);

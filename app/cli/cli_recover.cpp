@@ -8,6 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "app/session/session_file.h"
 #include "app/cli/cli.h"
 #include "app/cli/cli_common.h"
 #include "app/session/edit_hooks.h"
@@ -37,7 +38,7 @@ Document load_newest_autosave(const std::string& autosave, std::string& used)
     std::string first_problem;
     try {
         used = autosave;
-        return load_document(autosave);
+        return load_session(autosave);
     } catch (const FileError& e) {
         first_problem = e.what();
     }
@@ -48,7 +49,7 @@ Document load_newest_autosave(const std::string& autosave, std::string& used)
     warn(first_problem + "; using the previous generation " + previous);
     try {
         used = previous;
-        return load_document(previous);
+        return load_session(previous);
     } catch (const FileError& e) {
         throw FileError(autosave, "no good autosave (" + first_problem + "; " + e.what() + ")");
     }

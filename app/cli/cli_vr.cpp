@@ -8,6 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "app/session/session_file.h"
 #include "app/cli/cli.h"
 #include "app/cli/cli_common.h"
 #include "app/cli/outputs.h"
@@ -114,7 +115,7 @@ void add_vr_command(CLI::App& app, int& exit_code)
         std::error_code ec;
         if (fs::exists(session, ec)) {
             try {
-                doc = load_document(session);
+                doc = load_session(session);
             } catch (const Error& e) {
                 throw Error(std::string(e.what()) + "; nothing was changed. Its autosave, if any, is " +
                             options.autosave_path);

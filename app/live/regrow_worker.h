@@ -28,6 +28,7 @@ struct RegrowResult {
     /// What the app draws of this result, when the worker was given a prepare hook: made on
     /// the worker's thread with the rest, so that taking a result costs a frame nothing.
     RenderScene scene;
+    int scene_lod = -1; ///< the tree's level of detail `scene` was made for (-1: none made)
 };
 
 class RegrowWorker {

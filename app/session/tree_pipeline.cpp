@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <limits>
 
+#include "growth/grower.h"
 #include "growth/radii.h"
 #include "growth/species.h"
 #include "app/session/edit_ops.h"
@@ -50,7 +51,13 @@ BuiltTree grow_document_tree(const Document& doc, std::vector<BuiltLobe> lobes)
         for (const StrokePoint& p : s.points) pts.push_back(p.position);
         trunk.push_back(std::move(pts));
     }
-    t.growth = grow_tree(trunk, growth_lobes(doc, t.lobes), doc.settings.growth, default_subtree_library(), doc.seed);
+    GrowerInput in;
+    in.trunk_strokes = std::move(trunk);
+    in.lobes = growth_lobes(doc, t.lobes);
+    in.settings = doc.settings;
+    in.seed = doc.seed;
+    in.choice = scene_grower(doc);
+    t.growth = checked_grower(in.choice, "trees[0].grower").grow(in);
     assign_pipe_radii(t.growth.tree, doc.settings.branches.pipe_exponent, doc.settings.branches.tip_radius_m);
     for (const std::string& m : t.growth.messages) t.warnings.push_back("growth: " + m);
     return t;

@@ -1,8 +1,9 @@
 #pragma once
 /// \file tree_pipeline.h
 /// From a session document to a tree: its lobes (app/session/lobe_document.h), the trunk
-/// strokes as drawn and edited, growth inside the lobes with per-lobe overrides
-/// (growth/grow.h), pipe-model radii (growth/radii.h). Shared by `replay`, `grow`, `export`
+/// strokes as drawn and edited, the tree grown by the document's grower (growth/grower.h:
+/// scene_grower, the paper's subtree growth by default) with per-lobe overrides, pipe-model
+/// radii (growth/radii.h). Shared by `replay`, `grow`, `export`
 /// and the interactive apps, which run it off the thread that draws.
 
 #include <string>
@@ -25,7 +26,9 @@ struct BuiltTree {
 /// \throw InvalidInput for an unknown species or subtree name.
 std::vector<GrowthLobe> growth_lobes(const Document& doc, const std::vector<BuiltLobe>& lobes);
 
-/// Grows the document's tree in `lobes` (already built) from its trunk strokes.
+/// Grows the document's tree in `lobes` (already built) from its trunk strokes, with its
+/// grower. \throw InvalidInput when the document names a grower or parameters no grower
+/// takes (documents loaded with load_session are checked already).
 BuiltTree grow_document_tree(const Document& doc, std::vector<BuiltLobe> lobes);
 
 /// Builds the document's lobes, then grows its tree in them.

@@ -227,8 +227,8 @@ TEST(SessionDelete, LastStrokeOfALobeTakesTheLobeItsOperationsAndItsTreeWithIt)
 {
     SessionBuilder start = scene();
     Document doc = start.take_document();
-    doc.trees = {TreeInstance{1, glm::mat4(1.0f), 1, {2}}, TreeInstance{2, glm::mat4(1.0f), 2, {1, 2}},
-                 TreeInstance{3, glm::mat4(1.0f), 3, {}}};
+    doc.trees = {TreeInstance{1, glm::mat4(1.0f), 1, {2}, {}}, TreeInstance{2, glm::mat4(1.0f), 2, {1, 2}, {}},
+                 TreeInstance{3, glm::mat4(1.0f), 3, {}, {}}};
     SessionBuilder b(doc, EditPickOptions{}, hooks());
     ASSERT_TRUE(b.apply(drag_action(Tool::MoveLobe, kSecond, kSecond + glm::dvec3(0, 0.05, 0))));
     const glm::dvec3 top = kSecond + glm::dvec3(0.1, 0.05, 0); // on the moved loop

@@ -1,0 +1,81 @@
+// Opening a session for use (app/session/session_file.h): the growers a document names are
+// checked at load, and `--grower` picks the scene's grower.
+#include <fstream>
+#include <iterator>
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "app/session/session_file.h"
+#include "core/errors.h"
+#include "tests/support/cli_run.h"
+#include "tests/support/test_paths.h"
+
+namespace lobe {
+namespace {
+
+std::string bytes(const std::string& path)
+{
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+TEST(SessionFile, AGrowerNoGrowerKnowsIsRefusedAtLoadNamingTheFileAndTheField)
+{
+    const std::string dir = test::temp_dir("session-file-grower");
+    Document doc;
+    TreeInstance t;
+    t.id = 1;
+    t.grower.name = "no-such-grower";
+    doc.trees.push_back(t);
+    save_document(dir + "/s.json", doc);
+    EXPECT_NO_THROW(load_document(dir + "/s.json")); // the shape is right
+    try {
+        load_session(dir + "/s.json");
+        FAIL() << "a session naming an unknown grower was opened";
+    } catch (const FileError& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find(dir + "/s.json"), std::string::npos) << m;
+        EXPECT_NE(m.find("trees[0].grower.name: unknown grower \"no-such-grower\""), std::string::npos) << m;
+        EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+    }
+    doc.trees[0].grower = GrowerChoice{};
+    doc.trees[0].grower.params["depth"] = std::int64_t{3};
+    save_document(dir + "/p.json", doc);
+    EXPECT_THROW(load_session(dir + "/p.json"), FileError);
+}
+
+TEST(SessionFile, SettingTheSceneGrowerAddsATreeOfEveryLobeOnlyWhenThereIsNone)
+{
+    Document doc;
+    doc.seed = 5;
+    set_scene_grower(doc, GrowerChoice{});
+    ASSERT_EQ(doc.trees.size(), 1u);
+    EXPECT_EQ(doc.trees[0].seed, 5u);
+    EXPECT_TRUE(doc.trees[0].lobe_ids.empty());
+    set_scene_grower(doc, GrowerChoice{});
+    EXPECT_EQ(doc.trees.size(), 1u);
+    GrowerChoice unknown;
+    unknown.name = "nope";
+    EXPECT_THROW(set_scene_grower(doc, unknown), InvalidInput);
+    EXPECT_EQ(doc.trees[0].grower.name, kDefaultGrowerName);
+}
+
+TEST(SessionFile, GrowWithTheDefaultGrowerNamedGivesTheSameTreeAndAnUnknownOneIsABadCommandLine)
+{
+    const std::string out = test::temp_dir("grow-grower");
+    const std::string rec = test::source_path("recordings/table1-1lobe-5strokes.lrec");
+    ASSERT_EQ(test::run_cli("grow " + rec + " --out " + out + "/a.glb").code, 0);
+    const test::CliRun named = test::run_cli("grow " + rec + " --grower " + kDefaultGrowerName + " --out " + out + "/b.glb");
+    ASSERT_EQ(named.code, 0) << named.out;
+    EXPECT_EQ(bytes(out + "/a.glb"), bytes(out + "/b.glb"));
+    const test::CliRun bad = test::run_cli("grow " + rec + " --grower l-sistem --out " + out + "/c.glb");
+    EXPECT_EQ(bad.code, 2) << bad.out;
+    EXPECT_NE(bad.out.find("--grower"), std::string::npos) << bad.out;
+    const test::CliRun help = test::run_cli("grow --help");
+    EXPECT_NE(help.out.find(kDefaultGrowerName), std::string::npos) << help.out;
+}
+
+} // namespace
+} // namespace lobe
