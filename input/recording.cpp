@@ -1,3 +1,6 @@
+// Recordings: reading either form (told by the first bytes), the binary form's reader, the
+// text form's reader, the writers of both forms and RecordingWriter. Both forms byte by byte
+// and line by line: docs/recording-format.md.
 #include "input/recording.h"
 
 #include <algorithm>
@@ -8,7 +11,9 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <string>
 #include <string_view>
+#include <system_error>
 #include <utility>
 
 #include <unistd.h>
@@ -17,128 +22,15 @@
 
 #include "core/atomic_file.h"
 #include "core/errors.h"
+#include "input/recording_format.h"
 
-// Byte-by-byte and line-by-line description of both forms: docs/recording-format.md.
-
-namespace lobe {
+namespace lobe::recording_format {
 
 namespace {
 
-using nlohmann::json;
-
 // ---------------------------------------------------------------------------------------
-// Format constants
+// Little-endian unpacking
 // ---------------------------------------------------------------------------------------
-
-constexpr std::array<unsigned char, 8> kMagic = {'L', 'O', 'B', 'E', 'R', 'E', 'C', 0x1A};
-constexpr std::uint16_t kMinorVersion = 0;
-constexpr std::size_t kFileHeaderBytes = 16; // magic 8, major u16, minor u16, header length u32
-constexpr std::uint32_t kSyncMarker = 0x1E524CFEu; // bytes FE 4C 52 1E on disk
-constexpr unsigned char kSyncFirstByte = 0xFE;
-constexpr std::size_t kRecordPrefixBytes = 9;  // sync 4, type 1, length 4
-constexpr std::size_t kRecordOverhead = 13;    // prefix + CRC 4
-constexpr std::size_t kMaxPayloadBytes = 65536;
-constexpr std::size_t kMaxHeaderBytes = 65536;
-constexpr std::size_t kMaxHeaderNesting = 16;
-constexpr std::size_t kMaxAnnotationBytes = 1000;
-constexpr std::size_t kMaxFileBytes = std::size_t{2} << 30;
-constexpr std::size_t kMaxLineBytes = 131072;
-constexpr std::size_t kMaxProblems = 20;
-constexpr double kAbsurdMetres = 1000.0;
-
-constexpr std::string_view kTextMagic = "lobesketch-recording-text";
-constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";
-
-enum class RecordType : std::uint8_t { Frame = 1, Event = 2, Annotation = 3 };
-
-constexpr std::size_t kJointBytes = 12 + 8 + 2 + 1; // position, quaternion, radius, flags
-constexpr std::size_t kHeadBytes = 28;              // position + float quaternion
-constexpr std::size_t kMaxFramePayload = 8 + 1 + kHeadBytes + kHandCount * (1 + kJointCount * kJointBytes);
-constexpr std::size_t kEventPayload = 8 + 1 + 4 + 4 + 4 + 4;
-constexpr std::size_t kMaxAnnotationPayload = 8 + 2 + kMaxAnnotationBytes;
-constexpr std::size_t kMaxRecordBytes =
-    kRecordOverhead + std::max({kMaxFramePayload, kEventPayload, kMaxAnnotationPayload});
-
-// Quantisation: orientation components × 32767 as int16, radius in 0.01 mm as u16. Values
-// that cannot be represented (NaN/Inf) get a sentinel so the reader drops the frame exactly
-// as it would drop the float.
-constexpr double kQuatScale = 32767.0;
-constexpr std::int16_t kNonFiniteQuat = -32768;
-constexpr double kRadiusPerUnit = 1e-5;
-constexpr std::uint16_t kNonFiniteRadius = 0xFFFF;
-constexpr double kMaxRadiusUnits = 65534.0;
-
-constexpr int kTextHeadNumbers = 7;
-constexpr int kTextJointNumbers = 9;
-constexpr int kTextHandNumbers = kJointCount * kTextJointNumbers; // 234
-
-// ---------------------------------------------------------------------------------------
-// CRC-32 (IEEE 802.3, reflected polynomial 0xEDB88320), table driven
-// ---------------------------------------------------------------------------------------
-
-constexpr std::array<std::uint32_t, 256> make_crc_table()
-{
-    std::array<std::uint32_t, 256> table{};
-    for (std::uint32_t i = 0; i < 256; ++i) {
-        std::uint32_t c = i;
-        for (int k = 0; k < 8; ++k) c = (c & 1u) ? (0xEDB88320u ^ (c >> 1)) : (c >> 1);
-        table[i] = c;
-    }
-    return table;
-}
-constexpr std::array<std::uint32_t, 256> kCrcTable = make_crc_table();
-
-std::uint32_t crc32(const unsigned char* data, std::size_t size)
-{
-    std::uint32_t crc = 0xFFFFFFFFu;
-    for (std::size_t i = 0; i < size; ++i) crc = kCrcTable[(crc ^ data[i]) & 0xFFu] ^ (crc >> 8);
-    return ~crc;
-}
-
-// ---------------------------------------------------------------------------------------
-// Little-endian packing
-// ---------------------------------------------------------------------------------------
-
-/// Writes little-endian values into a caller-sized buffer.
-class ByteWriter {
-public:
-    explicit ByteWriter(unsigned char* p) : begin_(p), p_(p) {}
-    void u8(std::uint8_t v) { *p_++ = v; }
-    void u16(std::uint16_t v)
-    {
-        u8(static_cast<std::uint8_t>(v));
-        u8(static_cast<std::uint8_t>(v >> 8));
-    }
-    void u32(std::uint32_t v)
-    {
-        for (int i = 0; i < 4; ++i) u8(static_cast<std::uint8_t>(v >> (8 * i)));
-    }
-    void u64(std::uint64_t v)
-    {
-        for (int i = 0; i < 8; ++i) u8(static_cast<std::uint8_t>(v >> (8 * i)));
-    }
-    void i16(std::int16_t v) { u16(static_cast<std::uint16_t>(v)); }
-    void i32(std::int32_t v) { u32(static_cast<std::uint32_t>(v)); }
-    void f32(float v) { u32(std::bit_cast<std::uint32_t>(v)); }
-    void f64(double v) { u64(std::bit_cast<std::uint64_t>(v)); }
-    void vec3(const glm::vec3& v)
-    {
-        f32(v.x);
-        f32(v.y);
-        f32(v.z);
-    }
-    void bytes(const void* data, std::size_t size)
-    {
-        if (size == 0) return;
-        std::memcpy(p_, data, size);
-        p_ += size;
-    }
-    std::size_t size() const { return static_cast<std::size_t>(p_ - begin_); }
-
-private:
-    unsigned char* begin_;
-    unsigned char* p_;
-};
 
 std::uint16_t get_u16(const unsigned char* p)
 {
@@ -207,33 +99,8 @@ private:
 };
 
 // ---------------------------------------------------------------------------------------
-// Quantisation
+// Dequantisation (the inverse of recording_writer.cpp's quantisation)
 // ---------------------------------------------------------------------------------------
-
-bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
-bool finite(const glm::quat& q)
-{
-    return std::isfinite(q.w) && std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z);
-}
-double norm2(const glm::quat& q)
-{
-    return double(q.w) * q.w + double(q.x) * q.x + double(q.y) * q.y + double(q.z) * q.z;
-}
-
-// A quaternion already unit length within 1e-4 (in |q|²) is quantised as is: a decoded
-// quaternion is within 6.2e-5 of unit length, so decode → encode returns the same integers.
-std::array<std::int16_t, 4> quantise_quat(const glm::quat& q)
-{
-    if (!finite(q)) return {kNonFiniteQuat, kNonFiniteQuat, kNonFiniteQuat, kNonFiniteQuat};
-    double n2 = norm2(q);
-    if (n2 < 1e-12) return {0, 0, 0, 0}; // the all-zero device quirk, kept for the reader
-    double s = std::abs(n2 - 1.0) > 1e-4 ? 1.0 / std::sqrt(n2) : 1.0;
-    auto one = [s](float c) {
-        double v = std::clamp(std::round(double(c) * s * kQuatScale), -kQuatScale, kQuatScale);
-        return static_cast<std::int16_t>(v);
-    };
-    return {one(q.w), one(q.x), one(q.y), one(q.z)};
-}
 
 glm::quat dequantise_quat(const std::array<std::int16_t, 4>& c)
 {
@@ -246,527 +113,16 @@ glm::quat dequantise_quat(const std::array<std::int16_t, 4>& c)
     return glm::quat(one(c[0]), one(c[1]), one(c[2]), one(c[3]));
 }
 
-std::uint16_t quantise_radius(float r)
-{
-    if (!std::isfinite(r)) return kNonFiniteRadius;
-    return static_cast<std::uint16_t>(std::clamp(std::round(double(r) / kRadiusPerUnit), 0.0, kMaxRadiusUnits));
-}
-
 float dequantise_radius(std::uint16_t u)
 {
     if (u == kNonFiniteRadius) return std::numeric_limits<float>::quiet_NaN();
     return static_cast<float>(double(u) * kRadiusPerUnit);
 }
 
-// ---------------------------------------------------------------------------------------
-// Small text helpers
-// ---------------------------------------------------------------------------------------
-
-template <typename T>
-void append_number(std::string& out, T v)
-{
-    char buf[40];
-    auto r = std::to_chars(buf, buf + sizeof buf, v);
-    out.append(buf, r.ptr);
-}
-
-template <typename T>
-std::string number_text(T v)
-{
-    std::string s;
-    append_number(s, v);
-    return s;
-}
-
-template <typename T>
-bool parse_number(std::string_view t, T& v)
-{
-    if (t.empty()) return false;
-    auto r = std::from_chars(t.data(), t.data() + t.size(), v);
-    return r.ec == std::errc() && r.ptr == t.data() + t.size();
-}
-
-/// A token from a file, made safe to quote in a one-line message.
-std::string quote_token(std::string_view t)
-{
-    constexpr std::size_t kMax = 32;
-    std::string s = "'";
-    for (std::size_t i = 0; i < t.size() && i < kMax; ++i) {
-        auto c = static_cast<unsigned char>(t[i]);
-        s += (c < 0x20 || c == 0x7F) ? '?' : static_cast<char>(c);
-    }
-    if (t.size() > kMax) s += "...";
-    return s + "'";
-}
-
-void make_one_line(std::string& s)
-{
-    for (char& c : s) {
-        auto u = static_cast<unsigned char>(c);
-        if (u < 0x20 || u == 0x7F) c = '?';
-    }
-}
-
-/// Cuts a string to at most max bytes without splitting a UTF-8 sequence.
-std::string_view clip_utf8(std::string_view s, std::size_t max)
-{
-    if (s.size() <= max) return s;
-    std::size_t n = max;
-    while (n > 0 && (static_cast<unsigned char>(s[n]) & 0xC0u) == 0x80u) --n;
-    return s.substr(0, n);
-}
-
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
-
-/// Whitespace-separated tokens of one line, without allocating.
-class Tokens {
-public:
-    explicit Tokens(std::string_view s) : s_(s) {}
-    std::string_view next()
-    {
-        while (pos_ < s_.size() && is_space(s_[pos_])) ++pos_;
-        std::size_t b = pos_;
-        while (pos_ < s_.size() && !is_space(s_[pos_])) ++pos_;
-        return s_.substr(b, pos_ - b);
-    }
-    std::string_view peek() const
-    {
-        Tokens copy = *this;
-        return copy.next();
-    }
-    /// The rest of the line after one separator character (free text).
-    std::string_view rest() const { return pos_ < s_.size() ? s_.substr(pos_ + 1) : std::string_view(); }
-
-private:
-    std::string_view s_;
-    std::size_t pos_ = 0;
-};
-
-// ---------------------------------------------------------------------------------------
-// Header JSON
-// ---------------------------------------------------------------------------------------
-
-std::string header_json(const RecordingHeader& h)
-{
-    json j = {{"source", h.source},   {"device", h.device},
-              {"units", h.units},     {"space", h.space},
-              {"nominal_rate_hz", h.nominal_rate_hz}, {"created", h.created}};
-    // Keys sorted, one line: the same header always gives the same bytes. Invalid UTF-8 from
-    // a runtime's device name becomes U+FFFD instead of an exception.
-    return j.dump(-1, ' ', false, json::error_handler_t::replace);
-}
-
-/// Deepest [ / { nesting outside strings; refuses absurd nesting before parsing.
-std::size_t json_nesting(std::string_view s)
-{
-    std::size_t depth = 0, deepest = 0;
-    bool in_string = false, escaped = false;
-    for (char c : s) {
-        if (in_string) {
-            if (escaped) escaped = false;
-            else if (c == '\\') escaped = true;
-            else if (c == '"') in_string = false;
-        } else if (c == '"') {
-            in_string = true;
-        } else if (c == '[' || c == '{') {
-            deepest = std::max(deepest, ++depth);
-        } else if ((c == ']' || c == '}') && depth > 0) {
-            --depth;
-        }
-    }
-    return deepest;
-}
-
-
 bool known_event_kind(std::uint8_t k) { return k >= 1 && k <= 7; }
 
 // ---------------------------------------------------------------------------------------
-// Collector: validation and bounded report shared by both readers
-// ---------------------------------------------------------------------------------------
-
-/// Where a record came from, formatted only when a message needs it.
-struct Where {
-    bool text = false;
-    std::size_t n = 0;
-    std::string str() const { return (text ? "line " : "record at byte ") + std::to_string(n); }
-};
-
-constexpr const char* kHandNames[kHandCount] = {"left", "right"};
-
-class Collector {
-public:
-    Collector(const std::string& name, ReadReport& report) : name_(name), report_(report) {}
-
-    Recording rec;
-
-    const std::string& name() const { return name_; }
-    bool stopped() const { return stopped_; }
-
-    void problem(std::string msg)
-    {
-        make_one_line(msg);
-        auto& list = report_.problems;
-        if (std::find(list.begin(), list.end(), msg) != list.end()) return;
-        if (list.size() < kMaxProblems) list.push_back(std::move(msg));
-        else ++more_problems_;
-    }
-
-    void drop_frame(Where w, const std::string& why)
-    {
-        ++report_.frames_dropped;
-        problem(w.str() + ": " + why);
-    }
-    void drop_event(Where w, const std::string& why)
-    {
-        ++report_.events_dropped;
-        problem(w.str() + ": " + why);
-    }
-    std::size_t next_frame_number() { return frame_number_++; }
-
-    /// Validates, repairs the known device quirks, and keeps or drops one frame.
-    void add_frame(HandFrame& f, Where w, std::size_t number)
-    {
-        if (rec.frames.size() >= kMaxRecordingFrames) {
-            stop(w, "frame limit reached (" + std::to_string(kMaxRecordingFrames) + " frames), stopped reading");
-            return;
-        }
-        std::string why = unusable(f);
-        if (!why.empty()) {
-            drop_frame(w, why + " in frame " + std::to_string(number));
-            return;
-        }
-        if (!(f.time > last_frame_time_)) {
-            drop_frame(w, "time going backwards at frame " + std::to_string(number) + " (t = " +
-                              number_text(f.time) + " after " + number_text(last_frame_time_) + ")");
-            return;
-        }
-        repair(f, number);
-        last_frame_time_ = f.time;
-        for (int h = 0; h < kHandCount; ++h) hand_seen_[h] = hand_seen_[h] || f.hands[h].active;
-        rec.frames.push_back(f);
-    }
-
-    void add_event(const InputEvent& e, Where w)
-    {
-        std::size_t number = event_number_++;
-        if (rec.events.size() >= kMaxRecordingEvents) {
-            stop(w, "event limit reached (" + std::to_string(kMaxRecordingEvents) + " events), stopped reading");
-            return;
-        }
-        if (!std::isfinite(e.time) || !std::isfinite(e.x) || !std::isfinite(e.y)) {
-            drop_event(w, "NaN/Inf in event " + std::to_string(number));
-            return;
-        }
-        if (e.time < last_event_time_) {
-            drop_event(w, "time going backwards at event " + std::to_string(number) + " (t = " +
-                              number_text(e.time) + " after " + number_text(last_event_time_) + ")");
-            return;
-        }
-        last_event_time_ = e.time;
-        rec.events.push_back(e);
-    }
-
-    void skip_unknown_event(Where w, const std::string& kind)
-    {
-        ++event_number_;
-        drop_event(w, "unknown event kind " + kind + " skipped");
-    }
-
-    void skip_unknown_setting(Where w, std::int32_t id)
-    {
-        ++event_number_;
-        drop_event(w, "unknown setting id " + std::to_string(id) + " skipped");
-    }
-
-    void add_annotation(Annotation a, Where w)
-    {
-        if (rec.annotations.size() >= kMaxRecordingAnnotations) {
-            stop(w, "annotation limit reached (" + std::to_string(kMaxRecordingAnnotations) +
-                        " annotations), stopped reading");
-            return;
-        }
-        if (!std::isfinite(a.time)) {
-            problem(w.str() + ": NaN/Inf annotation time, annotation dropped");
-            return;
-        }
-        if (a.text.size() > kMaxAnnotationBytes) {
-            a.text.resize(clip_utf8(a.text, kMaxAnnotationBytes).size());
-            problem(w.str() + ": annotation longer than " + std::to_string(kMaxAnnotationBytes) +
-                    " bytes, truncated");
-        }
-        rec.annotations.push_back(std::move(a));
-    }
-
-    /// Adds the summaries, fills the report, and refuses a file with nothing usable.
-    Recording finish()
-    {
-        auto& list = report_.problems;
-        if (more_problems_ > 0) list.push_back("... and " + std::to_string(more_problems_) + " more problems");
-        if (zero_joint_quats_ > 0)
-            list.push_back(std::to_string(zero_joint_quats_) +
-                           " all-zero joint orientations set to identity and marked invalid (first in frame " +
-                           std::to_string(first_zero_joint_) + ")");
-        if (zero_head_quats_ > 0)
-            list.push_back(std::to_string(zero_head_quats_) +
-                           " all-zero head orientations set to identity (first in frame " +
-                           std::to_string(first_zero_head_) + ")");
-        if (normalised_quats_ > 0)
-            list.push_back(std::to_string(normalised_quats_) +
-                           " orientations were not unit length and were normalised (first in frame " +
-                           std::to_string(first_normalised_) + ")");
-        if (!rec.frames.empty())
-            for (int h = 0; h < kHandCount; ++h)
-                if (!hand_seen_[h]) list.push_back(std::string(kHandNames[h]) + " hand never tracked");
-        report_.frames_read = rec.frames.size();
-
-        if (rec.frames.empty() && rec.events.empty()) {
-            std::string why;
-            if (report_.frames_dropped == 0 && report_.events_dropped == 0 && list.empty())
-                why = "the file holds no frame or event records";
-            else
-                why = std::to_string(report_.frames_dropped) + " frames and " +
-                      std::to_string(report_.events_dropped) + " events dropped" +
-                      (list.empty() ? std::string() : "; first problem: " + list.front());
-            throw FileError(name_, "no usable frames (" + why + ")");
-        }
-        return std::move(rec);
-    }
-
-private:
-    void stop(Where w, const std::string& why)
-    {
-        stopped_ = true;
-        problem(w.str() + ": " + why);
-    }
-
-    static bool position_ok(const glm::vec3& p)
-    {
-        // NaN fails every comparison, so this also refuses NaN.
-        auto ok = [](float v) { return double(std::abs(v)) <= kAbsurdMetres; };
-        return ok(p.x) && ok(p.y) && ok(p.z);
-    }
-
-    static std::string position_problem(const glm::vec3& p, const std::string& what)
-    {
-        if (!finite(p)) return "NaN/Inf in " + what + " position";
-        float m = std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
-        return "absurd coordinate " + number_text(m) + " m (limit " + number_text(kAbsurdMetres) + " m) in " +
-               what + " position";
-    }
-
-    /// Why the frame must be dropped, or empty. Checks everything before repairing anything.
-    static std::string unusable(const HandFrame& f)
-    {
-        if (!std::isfinite(f.time)) return "NaN/Inf time";
-        if (f.head_valid) {
-            if (!position_ok(f.head.position)) return position_problem(f.head.position, "head");
-            if (!finite(f.head.orientation)) return "NaN/Inf in head orientation";
-        }
-        for (int h = 0; h < kHandCount; ++h) {
-            const HandState& hand = f.hands[h];
-            if (!hand.active) continue;
-            for (int j = 0; j < kJointCount; ++j) {
-                const JointState& js = hand.joints[j];
-                auto what = [&] { return std::string(kHandNames[h]) + " " + joint_name(static_cast<Joint>(j)); };
-                if (!position_ok(js.pose.position)) return position_problem(js.pose.position, what());
-                if (!finite(js.pose.orientation)) return "NaN/Inf in " + what() + " orientation";
-                if (!std::isfinite(js.radius)) return "NaN/Inf in " + what() + " radius";
-            }
-        }
-        return {};
-    }
-
-    /// All-zero quaternions (a device quirk) become identity; far-from-unit ones are normalised.
-    /// Returns false for an all-zero quaternion.
-    bool repair_quat(glm::quat& q, std::size_t number)
-    {
-        double n2 = norm2(q);
-        if (n2 < 1e-12) {
-            q = glm::quat(1.0f, 0.0f, 0.0f, 0.0f);
-            return false;
-        }
-        if (n2 < 0.998001 || n2 > 1.002001) { // | |q| - 1 | > 1e-3
-            float s = static_cast<float>(1.0 / std::sqrt(n2));
-            q = glm::quat(q.w * s, q.x * s, q.y * s, q.z * s);
-            if (normalised_quats_++ == 0) first_normalised_ = number;
-        }
-        return true;
-    }
-
-    void repair(HandFrame& f, std::size_t number)
-    {
-        if (f.head_valid && !repair_quat(f.head.orientation, number))
-            if (zero_head_quats_++ == 0) first_zero_head_ = number;
-        for (HandState& hand : f.hands) {
-            if (!hand.active) continue;
-            for (JointState& js : hand.joints) {
-                if (repair_quat(js.pose.orientation, number)) continue;
-                js.flags = static_cast<std::uint8_t>(js.flags & ~(kOrientationValid | kOrientationTracked));
-                if (zero_joint_quats_++ == 0) first_zero_joint_ = number;
-            }
-        }
-    }
-
-    std::string name_;
-    ReadReport& report_;
-    bool stopped_ = false;
-    std::size_t more_problems_ = 0;
-    std::size_t frame_number_ = 0;
-    std::size_t event_number_ = 0;
-    double last_frame_time_ = -std::numeric_limits<double>::infinity();
-    double last_event_time_ = -std::numeric_limits<double>::infinity();
-    std::array<bool, kHandCount> hand_seen_{};
-    std::size_t zero_joint_quats_ = 0, first_zero_joint_ = 0;
-    std::size_t zero_head_quats_ = 0, first_zero_head_ = 0;
-    std::size_t normalised_quats_ = 0, first_normalised_ = 0;
-};
-
-/// Reads the header JSON of either form into h; problems are reported, never fatal, except
-/// units other than metres (every coordinate would be wrong).
-void read_header_json(std::string_view text, RecordingHeader& h, Collector& c, const std::string& where)
-{
-    if (text.size() > kMaxHeaderBytes) {
-        c.problem(where + ": header longer than " + std::to_string(kMaxHeaderBytes) + " bytes, using a default header");
-        return;
-    }
-    if (json_nesting(text) > kMaxHeaderNesting) {
-        c.problem(where + ": header nested too deeply, using a default header");
-        return;
-    }
-    json j = json::parse(text.begin(), text.end(), nullptr, false);
-    if (j.is_discarded() || !j.is_object()) {
-        c.problem(where + ": header is not a JSON object, using a default header");
-        return;
-    }
-    auto read_string = [&](const char* key, std::string& out) {
-        auto it = j.find(key);
-        if (it == j.end()) return;
-        if (it->is_string()) out = it->get<std::string>();
-        else c.problem(where + ": header field '" + key + "' is not a string, using '" + out + "'");
-    };
-    read_string("source", h.source);
-    read_string("device", h.device);
-    read_string("units", h.units);
-    read_string("space", h.space);
-    read_string("created", h.created);
-    if (auto it = j.find("nominal_rate_hz"); it != j.end()) {
-        double v = it->is_number() ? it->get<double>() : std::numeric_limits<double>::quiet_NaN();
-        if (std::isfinite(v) && v > 0.0 && v <= 100000.0) h.nominal_rate_hz = v;
-        else c.problem(where + ": header field 'nominal_rate_hz' is not a positive rate, using " +
-                       number_text(h.nominal_rate_hz));
-    }
-    if (h.units != "m") {
-        std::string units = quote_token(h.units);
-        throw FileError(c.name(), where + ": units " + units + " are not supported (recordings are in metres, 'm')");
-    }
-}
-
-// ---------------------------------------------------------------------------------------
-// Binary form: encoding
-// ---------------------------------------------------------------------------------------
-
-template <typename WritePayload>
-void append_record(std::string& out, RecordType type, WritePayload&& write_payload)
-{
-    std::array<unsigned char, kMaxRecordBytes> buf;
-    ByteWriter w(buf.data());
-    w.u32(kSyncMarker);
-    w.u8(static_cast<std::uint8_t>(type));
-    w.u32(0); // payload length, patched below
-    write_payload(w);
-    const std::size_t payload = w.size() - kRecordPrefixBytes;
-    ByteWriter(buf.data() + 5).u32(static_cast<std::uint32_t>(payload));
-    w.u32(crc32(buf.data() + 4, 5 + payload));
-    out.append(reinterpret_cast<const char*>(buf.data()), w.size());
-}
-
-void append_frame_record(std::string& out, const HandFrame& f)
-{
-    append_record(out, RecordType::Frame, [&f](ByteWriter& w) {
-        w.f64(f.time);
-        w.u8(f.head_valid ? 1 : 0);
-        if (f.head_valid) {
-            w.vec3(f.head.position);
-            w.f32(f.head.orientation.w);
-            w.f32(f.head.orientation.x);
-            w.f32(f.head.orientation.y);
-            w.f32(f.head.orientation.z);
-        }
-        for (const HandState& hand : f.hands) {
-            w.u8(hand.active ? 1 : 0);
-            if (!hand.active) continue;
-            for (const JointState& js : hand.joints) {
-                w.vec3(js.pose.position);
-                for (std::int16_t c : quantise_quat(js.pose.orientation)) w.i16(c);
-                w.u16(quantise_radius(js.radius));
-                w.u8(js.flags);
-            }
-        }
-    });
-}
-
-void append_event_record(std::string& out, const InputEvent& e)
-{
-    append_record(out, RecordType::Event, [&e](ByteWriter& w) {
-        w.f64(e.time);
-        w.u8(static_cast<std::uint8_t>(e.kind));
-        w.i32(e.code);
-        w.i32(e.value);
-        w.f32(e.x);
-        w.f32(e.y);
-    });
-}
-
-void append_annotation_record(std::string& out, const Annotation& a)
-{
-    std::string_view text = clip_utf8(a.text, kMaxAnnotationBytes);
-    append_record(out, RecordType::Annotation, [&](ByteWriter& w) {
-        w.f64(a.time);
-        w.u16(static_cast<std::uint16_t>(text.size()));
-        w.bytes(text.data(), text.size());
-    });
-}
-
-std::string binary_file_header(const RecordingHeader& header)
-{
-    std::string js = header_json(header);
-    if (js.size() > kMaxHeaderBytes)
-        throw InvalidInput("recording header longer than " + std::to_string(kMaxHeaderBytes) + " bytes");
-    std::string out(kFileHeaderBytes + js.size() + 4, '\0');
-    auto* p = reinterpret_cast<unsigned char*>(out.data());
-    ByteWriter w(p);
-    w.bytes(kMagic.data(), kMagic.size());
-    w.u16(static_cast<std::uint16_t>(kRecordingVersion));
-    w.u16(kMinorVersion);
-    w.u32(static_cast<std::uint32_t>(js.size()));
-    w.bytes(js.data(), js.size());
-    w.u32(crc32(reinterpret_cast<const unsigned char*>(js.data()), js.size()));
-    return out;
-}
-
-/// Visits frames, events and annotations merged by time (ties: frame, event, annotation);
-/// each kind keeps its own order, so decoding and re-encoding gives the same sequence.
-template <typename OnFrame, typename OnEvent, typename OnAnnotation>
-void visit_in_time_order(const Recording& rec, OnFrame&& on_frame, OnEvent&& on_event, OnAnnotation&& on_annotation)
-{
-    std::size_t f = 0, e = 0, a = 0;
-    const auto& fr = rec.frames;
-    const auto& ev = rec.events;
-    const auto& an = rec.annotations;
-    while (f < fr.size() || e < ev.size() || a < an.size()) {
-        if (f < fr.size() && (e == ev.size() || !(ev[e].time < fr[f].time)) &&
-            (a == an.size() || !(an[a].time < fr[f].time))) {
-            on_frame(fr[f++]);
-        } else if (e < ev.size() && (a == an.size() || !(an[a].time < ev[e].time))) {
-            on_event(ev[e++]);
-        } else {
-            on_annotation(an[a++]);
-        }
-    }
-}
-
-// ---------------------------------------------------------------------------------------
-// Binary form: decoding
+// Records
 // ---------------------------------------------------------------------------------------
 
 constexpr std::size_t kNotFound = std::numeric_limits<std::size_t>::max();
@@ -906,6 +262,8 @@ void drop_record(Collector& c, const unsigned char* p, std::size_t n, std::size_
     else c.drop_frame(Where{false, pos}, why);
 }
 
+} // namespace
+
 Recording parse_binary(std::string_view data, const std::string& name, ReadReport& report)
 {
     const auto* p = reinterpret_cast<const unsigned char*>(data.data());
@@ -987,117 +345,42 @@ Recording parse_binary(std::string_view data, const std::string& name, ReadRepor
     return c.finish();
 }
 
-// ---------------------------------------------------------------------------------------
-// Text form: encoding
-// ---------------------------------------------------------------------------------------
+namespace {
 
-void append_pose_text(std::string& out, const glm::vec3& p, const glm::quat& q)
+template <typename T>
+bool parse_number(std::string_view t, T& v)
 {
-    for (float v : {p.x, p.y, p.z, q.w, q.x, q.y, q.z}) {
-        out += ' ';
-        append_number(out, v);
-    }
+    if (t.empty()) return false;
+    auto r = std::from_chars(t.data(), t.data() + t.size(), v);
+    return r.ec == std::errc() && r.ptr == t.data() + t.size();
 }
 
-void append_frame_line(std::string& out, const HandFrame& f)
-{
-    out += "frame ";
-    append_number(out, f.time);
-    out += " head";
-    if (f.head_valid) append_pose_text(out, f.head.position, f.head.orientation);
-    else out += " -";
-    for (int h = 0; h < kHandCount; ++h) {
-        out += ' ';
-        out += kHandNames[h];
-        const HandState& hand = f.hands[h];
-        if (!hand.active) {
-            out += " -";
-            continue;
-        }
-        for (const JointState& js : hand.joints) {
-            append_pose_text(out, js.pose.position, js.pose.orientation);
-            out += ' ';
-            append_number(out, js.radius);
-            out += ' ';
-            append_number(out, static_cast<unsigned>(js.flags));
-        }
+/// Whitespace-separated tokens of one line, without allocating.
+class Tokens {
+public:
+    explicit Tokens(std::string_view s) : s_(s) {}
+    std::string_view next()
+    {
+        while (pos_ < s_.size() && is_space(s_[pos_])) ++pos_;
+        std::size_t b = pos_;
+        while (pos_ < s_.size() && !is_space(s_[pos_])) ++pos_;
+        return s_.substr(b, pos_ - b);
     }
-    out += '\n';
-}
-
-void append_event_line(std::string& out, const InputEvent& e)
-{
-    out += "event ";
-    append_number(out, e.time);
-    out += ' ';
-    const char* kind = event_kind_name(e.kind);
-    switch (e.kind) {
-    case InputEventKind::Key:
-    case InputEventKind::MouseButton:
-        out += kind;
-        out += ' ';
-        append_number(out, e.code);
-        out += ' ';
-        append_number(out, e.value);
-        break;
-    case InputEventKind::MouseMove:
-        out += kind;
-        out += ' ';
-        append_number(out, e.x);
-        out += ' ';
-        append_number(out, e.y);
-        break;
-    case InputEventKind::MouseWheel:
-        out += kind;
-        out += ' ';
-        append_number(out, e.y);
-        break;
-    case InputEventKind::Setting:
-        out += kind;
-        out += ' ';
-        append_number(out, e.code);
-        out += ' ';
-        append_number(out, e.value);
-        out += ' ';
-        append_number(out, e.x);
-        break;
-    case InputEventKind::ImportMesh:
-        out += kind;
-        out += ' ';
-        append_number(out, e.code);
-        break;
-    case InputEventKind::Scene:
-        out += kind;
-        out += ' ';
-        append_number(out, e.code);
-        out += ' ';
-        append_number(out, e.x);
-        break;
-    default: // a kind this build does not know: written so that readers skip it
-        out += "kind_" + std::to_string(static_cast<int>(e.kind));
-        break;
+    std::string_view peek() const
+    {
+        Tokens copy = *this;
+        return copy.next();
     }
-    out += '\n';
-}
+    /// The rest of the line after one separator character (free text).
+    std::string_view rest() const { return pos_ < s_.size() ? s_.substr(pos_ + 1) : std::string_view(); }
 
-/// Note text on one line: backslash, control characters and DEL are escaped.
-void append_escaped(std::string& out, std::string_view s)
-{
-    static constexpr char kHex[] = "0123456789abcdef";
-    for (char ch : s) {
-        auto c = static_cast<unsigned char>(ch);
-        if (ch == '\\') out += "\\\\";
-        else if (ch == '\n') out += "\\n";
-        else if (ch == '\r') out += "\\r";
-        else if (ch == '\t') out += "\\t";
-        else if (c < 0x20 || c == 0x7F) {
-            out += "\\x";
-            out += kHex[c >> 4];
-            out += kHex[c & 0xF];
-        } else out += ch;
-    }
-}
+private:
+    std::string_view s_;
+    std::size_t pos_ = 0;
+};
 
+/// Note text as append_escaped (recording_writer.cpp) wrote it; an unknown escape is kept as
+/// written.
 std::string unescape(std::string_view s)
 {
     auto hex = [](char c) -> int {
@@ -1129,21 +412,6 @@ std::string unescape(std::string_view s)
     }
     return out;
 }
-
-void append_note_line(std::string& out, const Annotation& a)
-{
-    out += "note ";
-    append_number(out, a.time);
-    if (!a.text.empty()) {
-        out += ' ';
-        append_escaped(out, clip_utf8(a.text, kMaxAnnotationBytes));
-    }
-    out += '\n';
-}
-
-// ---------------------------------------------------------------------------------------
-// Text form: decoding
-// ---------------------------------------------------------------------------------------
 
 /// Parses `<n> numbers` into out; the error names what was being read.
 template <typename T>
@@ -1312,6 +580,8 @@ void parse_text_line(Collector& c, std::string_view line, Where w)
     }
 }
 
+} // namespace
+
 Recording parse_text(std::string_view data, const std::string& name, ReadReport& report)
 {
     if (data.substr(0, kUtf8Bom.size()) == kUtf8Bom) data.remove_prefix(kUtf8Bom.size());
@@ -1364,36 +634,323 @@ Recording parse_text(std::string_view data, const std::string& name, ReadReport&
     return c.finish();
 }
 
-bool starts_with(std::string_view s, std::string_view prefix) { return s.substr(0, prefix.size()) == prefix; }
+} // namespace lobe::recording_format
+
+namespace lobe {
+
+using namespace recording_format;
+
+namespace {
+
+using nlohmann::json;
+
+// ---------------------------------------------------------------------------------------
+// Little-endian packing and quantisation
+// ---------------------------------------------------------------------------------------
+
+/// Writes little-endian values into a caller-sized buffer.
+class ByteWriter {
+public:
+    explicit ByteWriter(unsigned char* p) : begin_(p), p_(p) {}
+    void u8(std::uint8_t v) { *p_++ = v; }
+    void u16(std::uint16_t v)
+    {
+        u8(static_cast<std::uint8_t>(v));
+        u8(static_cast<std::uint8_t>(v >> 8));
+    }
+    void u32(std::uint32_t v)
+    {
+        for (int i = 0; i < 4; ++i) u8(static_cast<std::uint8_t>(v >> (8 * i)));
+    }
+    void u64(std::uint64_t v)
+    {
+        for (int i = 0; i < 8; ++i) u8(static_cast<std::uint8_t>(v >> (8 * i)));
+    }
+    void i16(std::int16_t v) { u16(static_cast<std::uint16_t>(v)); }
+    void i32(std::int32_t v) { u32(static_cast<std::uint32_t>(v)); }
+    void f32(float v) { u32(std::bit_cast<std::uint32_t>(v)); }
+    void f64(double v) { u64(std::bit_cast<std::uint64_t>(v)); }
+    void vec3(const glm::vec3& v)
+    {
+        f32(v.x);
+        f32(v.y);
+        f32(v.z);
+    }
+    void bytes(const void* data, std::size_t size)
+    {
+        if (size == 0) return;
+        std::memcpy(p_, data, size);
+        p_ += size;
+    }
+    std::size_t size() const { return static_cast<std::size_t>(p_ - begin_); }
+
+private:
+    unsigned char* begin_;
+    unsigned char* p_;
+};
+
+// A quaternion already unit length within 1e-4 (in |q|²) is quantised as is: a decoded
+// quaternion is within 6.2e-5 of unit length, so decode → encode returns the same integers.
+std::array<std::int16_t, 4> quantise_quat(const glm::quat& q)
+{
+    if (!finite(q)) return {kNonFiniteQuat, kNonFiniteQuat, kNonFiniteQuat, kNonFiniteQuat};
+    double n2 = norm2(q);
+    if (n2 < 1e-12) return {0, 0, 0, 0}; // the all-zero device quirk, kept for the reader
+    double s = std::abs(n2 - 1.0) > 1e-4 ? 1.0 / std::sqrt(n2) : 1.0;
+    auto one = [s](float c) {
+        double v = std::clamp(std::round(double(c) * s * kQuatScale), -kQuatScale, kQuatScale);
+        return static_cast<std::int16_t>(v);
+    };
+    return {one(q.w), one(q.x), one(q.y), one(q.z)};
+}
+
+std::uint16_t quantise_radius(float r)
+{
+    if (!std::isfinite(r)) return kNonFiniteRadius;
+    return static_cast<std::uint16_t>(std::clamp(std::round(double(r) / kRadiusPerUnit), 0.0, kMaxRadiusUnits));
+}
+
+// ---------------------------------------------------------------------------------------
+// Both forms: the header and the order of records
+// ---------------------------------------------------------------------------------------
+
+std::string header_json(const RecordingHeader& h)
+{
+    json j = {{"source", h.source},   {"device", h.device},
+              {"units", h.units},     {"space", h.space},
+              {"nominal_rate_hz", h.nominal_rate_hz}, {"created", h.created}};
+    // Keys sorted, one line: the same header always gives the same bytes. Invalid UTF-8 from
+    // a runtime's device name becomes U+FFFD instead of an exception.
+    return j.dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
+/// Visits frames, events and annotations merged by time (ties: frame, event, annotation);
+/// each kind keeps its own order, so decoding and re-encoding gives the same sequence.
+template <typename OnFrame, typename OnEvent, typename OnAnnotation>
+void visit_in_time_order(const Recording& rec, OnFrame&& on_frame, OnEvent&& on_event, OnAnnotation&& on_annotation)
+{
+    std::size_t f = 0, e = 0, a = 0;
+    const auto& fr = rec.frames;
+    const auto& ev = rec.events;
+    const auto& an = rec.annotations;
+    while (f < fr.size() || e < ev.size() || a < an.size()) {
+        if (f < fr.size() && (e == ev.size() || !(ev[e].time < fr[f].time)) &&
+            (a == an.size() || !(an[a].time < fr[f].time))) {
+            on_frame(fr[f++]);
+        } else if (e < ev.size() && (a == an.size() || !(an[a].time < ev[e].time))) {
+            on_event(ev[e++]);
+        } else {
+            on_annotation(an[a++]);
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Binary form
+// ---------------------------------------------------------------------------------------
+
+template <typename WritePayload>
+void append_record(std::string& out, RecordType type, WritePayload&& write_payload)
+{
+    std::array<unsigned char, kMaxRecordBytes> buf;
+    ByteWriter w(buf.data());
+    w.u32(kSyncMarker);
+    w.u8(static_cast<std::uint8_t>(type));
+    w.u32(0); // payload length, patched below
+    write_payload(w);
+    const std::size_t payload = w.size() - kRecordPrefixBytes;
+    ByteWriter(buf.data() + 5).u32(static_cast<std::uint32_t>(payload));
+    w.u32(crc32(buf.data() + 4, 5 + payload));
+    out.append(reinterpret_cast<const char*>(buf.data()), w.size());
+}
+
+void append_frame_record(std::string& out, const HandFrame& f)
+{
+    append_record(out, RecordType::Frame, [&f](ByteWriter& w) {
+        w.f64(f.time);
+        w.u8(f.head_valid ? 1 : 0);
+        if (f.head_valid) {
+            w.vec3(f.head.position);
+            w.f32(f.head.orientation.w);
+            w.f32(f.head.orientation.x);
+            w.f32(f.head.orientation.y);
+            w.f32(f.head.orientation.z);
+        }
+        for (const HandState& hand : f.hands) {
+            w.u8(hand.active ? 1 : 0);
+            if (!hand.active) continue;
+            for (const JointState& js : hand.joints) {
+                w.vec3(js.pose.position);
+                for (std::int16_t c : quantise_quat(js.pose.orientation)) w.i16(c);
+                w.u16(quantise_radius(js.radius));
+                w.u8(js.flags);
+            }
+        }
+    });
+}
+
+void append_event_record(std::string& out, const InputEvent& e)
+{
+    append_record(out, RecordType::Event, [&e](ByteWriter& w) {
+        w.f64(e.time);
+        w.u8(static_cast<std::uint8_t>(e.kind));
+        w.i32(e.code);
+        w.i32(e.value);
+        w.f32(e.x);
+        w.f32(e.y);
+    });
+}
+
+void append_annotation_record(std::string& out, const Annotation& a)
+{
+    std::string_view text = clip_utf8(a.text, kMaxAnnotationBytes);
+    append_record(out, RecordType::Annotation, [&](ByteWriter& w) {
+        w.f64(a.time);
+        w.u16(static_cast<std::uint16_t>(text.size()));
+        w.bytes(text.data(), text.size());
+    });
+}
+
+std::string binary_file_header(const RecordingHeader& header)
+{
+    std::string js = header_json(header);
+    if (js.size() > kMaxHeaderBytes)
+        throw InvalidInput("recording header longer than " + std::to_string(kMaxHeaderBytes) + " bytes");
+    std::string out(kFileHeaderBytes + js.size() + 4, '\0');
+    auto* p = reinterpret_cast<unsigned char*>(out.data());
+    ByteWriter w(p);
+    w.bytes(kMagic.data(), kMagic.size());
+    w.u16(static_cast<std::uint16_t>(kRecordingVersion));
+    w.u16(kMinorVersion);
+    w.u32(static_cast<std::uint32_t>(js.size()));
+    w.bytes(js.data(), js.size());
+    w.u32(crc32(reinterpret_cast<const unsigned char*>(js.data()), js.size()));
+    return out;
+}
+
+// ---------------------------------------------------------------------------------------
+// Text form
+// ---------------------------------------------------------------------------------------
+
+void append_pose_text(std::string& out, const glm::vec3& p, const glm::quat& q)
+{
+    for (float v : {p.x, p.y, p.z, q.w, q.x, q.y, q.z}) {
+        out += ' ';
+        append_number(out, v);
+    }
+}
+
+void append_frame_line(std::string& out, const HandFrame& f)
+{
+    out += "frame ";
+    append_number(out, f.time);
+    out += " head";
+    if (f.head_valid) append_pose_text(out, f.head.position, f.head.orientation);
+    else out += " -";
+    for (int h = 0; h < kHandCount; ++h) {
+        out += ' ';
+        out += kHandNames[h];
+        const HandState& hand = f.hands[h];
+        if (!hand.active) {
+            out += " -";
+            continue;
+        }
+        for (const JointState& js : hand.joints) {
+            append_pose_text(out, js.pose.position, js.pose.orientation);
+            out += ' ';
+            append_number(out, js.radius);
+            out += ' ';
+            append_number(out, static_cast<unsigned>(js.flags));
+        }
+    }
+    out += '\n';
+}
+
+void append_event_line(std::string& out, const InputEvent& e)
+{
+    out += "event ";
+    append_number(out, e.time);
+    out += ' ';
+    const char* kind = event_kind_name(e.kind);
+    switch (e.kind) {
+    case InputEventKind::Key:
+    case InputEventKind::MouseButton:
+        out += kind;
+        out += ' ';
+        append_number(out, e.code);
+        out += ' ';
+        append_number(out, e.value);
+        break;
+    case InputEventKind::MouseMove:
+        out += kind;
+        out += ' ';
+        append_number(out, e.x);
+        out += ' ';
+        append_number(out, e.y);
+        break;
+    case InputEventKind::MouseWheel:
+        out += kind;
+        out += ' ';
+        append_number(out, e.y);
+        break;
+    case InputEventKind::Setting:
+        out += kind;
+        out += ' ';
+        append_number(out, e.code);
+        out += ' ';
+        append_number(out, e.value);
+        out += ' ';
+        append_number(out, e.x);
+        break;
+    case InputEventKind::ImportMesh:
+        out += kind;
+        out += ' ';
+        append_number(out, e.code);
+        break;
+    case InputEventKind::Scene:
+        out += kind;
+        out += ' ';
+        append_number(out, e.code);
+        out += ' ';
+        append_number(out, e.x);
+        break;
+    default: // a kind this build does not know: written so that readers skip it
+        out += "kind_" + std::to_string(static_cast<int>(e.kind));
+        break;
+    }
+    out += '\n';
+}
+
+/// Note text on one line: backslash, control characters and DEL are escaped.
+void append_escaped(std::string& out, std::string_view s)
+{
+    static constexpr char kHex[] = "0123456789abcdef";
+    for (char ch : s) {
+        auto c = static_cast<unsigned char>(ch);
+        if (ch == '\\') out += "\\\\";
+        else if (ch == '\n') out += "\\n";
+        else if (ch == '\r') out += "\\r";
+        else if (ch == '\t') out += "\\t";
+        else if (c < 0x20 || c == 0x7F) {
+            out += "\\x";
+            out += kHex[c >> 4];
+            out += kHex[c & 0xF];
+        } else out += ch;
+    }
+}
+
+void append_note_line(std::string& out, const Annotation& a)
+{
+    out += "note ";
+    append_number(out, a.time);
+    if (!a.text.empty()) {
+        out += ' ';
+        append_escaped(out, clip_utf8(a.text, kMaxAnnotationBytes));
+    }
+    out += '\n';
+}
 
 } // namespace
-
-// ---------------------------------------------------------------------------------------
-// Public interface
-// ---------------------------------------------------------------------------------------
-
-Recording parse_recording(const std::string& bytes, const std::string& name, ReadReport* report)
-{
-    ReadReport local;
-    ReadReport& r = report ? *report : local;
-    r = ReadReport{};
-    std::string_view data(bytes);
-    if (data.empty()) throw FileError(name, "empty file");
-    const std::string_view magic(reinterpret_cast<const char*>(kMagic.data()), kMagic.size());
-    if (starts_with(data, magic)) return parse_binary(data, name, r);
-    if (data.size() < magic.size() && starts_with(magic, data))
-        throw FileError(name, "truncated file header (" + std::to_string(data.size()) + " bytes)");
-    std::string_view text = starts_with(data, kUtf8Bom) ? data.substr(kUtf8Bom.size()) : data;
-    if (starts_with(text, kTextMagic) &&
-        (text.size() == kTextMagic.size() || is_space(text[kTextMagic.size()]) || text[kTextMagic.size()] == '\n'))
-        return parse_text(data, name, r);
-    throw FileError(name, "not a Lobesketch recording (wrong magic bytes)");
-}
-
-Recording read_recording(const std::string& path, ReadReport* report)
-{
-    return parse_recording(read_file_limited(path, kMaxFileBytes), path, report);
-}
 
 std::string encode_recording_binary(const Recording& rec)
 {
@@ -1517,6 +1074,29 @@ void RecordingWriter::close()
         err = errno;
     }
     if (!ok) throw FileError(path_, std::string("close failed: ") + std::strerror(err));
+}
+
+Recording parse_recording(const std::string& bytes, const std::string& name, ReadReport* report)
+{
+    ReadReport local;
+    ReadReport& r = report ? *report : local;
+    r = ReadReport{};
+    std::string_view data(bytes);
+    if (data.empty()) throw FileError(name, "empty file");
+    const std::string_view magic(reinterpret_cast<const char*>(kMagic.data()), kMagic.size());
+    if (starts_with(data, magic)) return parse_binary(data, name, r);
+    if (data.size() < magic.size() && starts_with(magic, data))
+        throw FileError(name, "truncated file header (" + std::to_string(data.size()) + " bytes)");
+    std::string_view text = starts_with(data, kUtf8Bom) ? data.substr(kUtf8Bom.size()) : data;
+    if (starts_with(text, kTextMagic) &&
+        (text.size() == kTextMagic.size() || is_space(text[kTextMagic.size()]) || text[kTextMagic.size()] == '\n'))
+        return parse_text(data, name, r);
+    throw FileError(name, "not a Lobesketch recording (wrong magic bytes)");
+}
+
+Recording read_recording(const std::string& path, ReadReport* report)
+{
+    return parse_recording(read_file_limited(path, kMaxFileBytes), path, report);
 }
 
 bool valid_scene_event(std::int32_t component, float value)
