@@ -164,20 +164,4 @@ private:
     std::size_t count_ = 0;
 };
 
-/// Why a frame at source time `t` (seconds) cannot follow the last kept frame at `last`
-/// (NaN when there is none yet), or "" when it can: times must increase strictly.
-std::string frame_time_problem(double t, double last);
-
-/// Median interval of strictly increasing times as a rate (Hz), or `fallback` when there are
-/// fewer than two frames.
-double median_rate_hz(const std::vector<HandFrame>& frames, double fallback);
-
-/// The common end of both importers: refuses a capture with no usable frame or no frame with a
-/// usable hand (FileError naming `name`), notes an early stop, sets the nominal rate and fills
-/// the report from `logs` (in order).
-/// \param stop why reading stopped early, or "" when the frames array was read to its end
-void finish_import(Recording& rec, const std::string& name, const std::string& stop, std::size_t with_hand,
-                   std::size_t dropped, ProblemLog& problems, const std::vector<const ProblemLog*>& logs,
-                   ReadReport* report);
-
 } // namespace lobe
