@@ -1,69 +1,55 @@
+// The synthesizer's top level: the scenario's steps become both hands' timelines
+// (synth_motion.cpp), drop-outs are scheduled over them (synth_tracking.cpp), and the frames
+// are sampled at the scenario's rate with noise, tremor and a head that watches the work.
+// Scenario files: synth_scenario.cpp; ground truth: synth_truth.cpp.
 #include "input/synth.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdint>
-#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include <glm/geometric.hpp>
 #include <glm/gtc/quaternion.hpp>
-#include <glm/mat3x3.hpp>
-#include <nlohmann/json.hpp>
 
-#include "core/atomic_file.h"
-#include "core/errors.h"
-#include "core/random.h"
-#include "input/hand_model.h"
 #include "input/synth_geometry.h"
 #include "input/synth_motion.h"
 #include "input/synth_random.h"
 #include "input/synth_scenario.h"
 #include "input/synth_tracking.h"
-#include "input/tools.h"
 
 namespace lobe {
 
-namespace synth {
-
 namespace {
-
-namespace hm = hand_model;
-using json = nlohmann::json;
-
-} // namespace
-
-} // namespace synth
 
 using namespace synth;
 
-// ---------------------------------------------------------------------------------------
-// Public API
-// ---------------------------------------------------------------------------------------
+using Dropouts = std::array<std::vector<Dropout>, kHandCount>;
 
-SynthResult synthesize(const Scenario& scenario)
+/// Where the work is (the head looks there between strokes): the mean control point of the
+/// strokes and drags; the default when there are none.
+void find_work_centre(Synth& sy, const Scenario& scenario)
 {
-    validate_scenario(scenario);
-    Synth sy;
-    sy.person = make_person(scenario.seed, scenario.uniform_joint_radius_m);
-    sy.surfaces = scenario.surfaces;
+    dvec3 sum(0.0);
+    std::size_t n = 0;
+    for (const ScenarioStep& st : scenario.steps)
+        if (st.type == ScenarioStep::Type::Stroke || st.type == ScenarioStep::Type::Drag)
+            for (const glm::vec3& p : st.stroke.curve) {
+                sum += to_d(p);
+                ++n;
+            }
+    if (n > 0) sy.work_centre = sum / static_cast<double>(n);
+}
 
-    // Where the work is (the head looks there between strokes).
-    {
-        dvec3 sum(0.0);
-        std::size_t n = 0;
-        for (const ScenarioStep& st : scenario.steps)
-            if (st.type == ScenarioStep::Type::Stroke || st.type == ScenarioStep::Type::Drag)
-                for (const glm::vec3& p : st.stroke.curve) {
-                    sum += to_d(p);
-                    ++n;
-                }
-        if (n > 0) sy.work_centre = sum / static_cast<double>(n);
-    }
-
+/// Both hands' timelines, step by step (each step from its own random stream): the hand a
+/// step uses does it while the other goes to rest; keys are pressed and released; pauses
+/// pass. Both hands start at rest and idle 0.6 s before the first step and 0.8 s after the
+/// last.
+/// \throw InvalidInput when the scenario lasts more than kMaxDurationS or needs more than
+///        kMaxRecordingFrames frames.
+Build plan_timelines(Synth& sy, const Scenario& scenario)
+{
     for (int h = 0; h < kHandCount; ++h) {
         Track& tr = sy.tracks[static_cast<std::size_t>(h)];
         tr.hand = static_cast<Hand>(h);
@@ -113,9 +99,12 @@ SynthResult synthesize(const Scenario& scenario)
     out.t_end = now;
     if (out.t_end * scenario.rate_hz > static_cast<double>(kMaxRecordingFrames))
         fail("steps", "the scenario needs more than " + std::to_string(kMaxRecordingFrames) + " frames");
+    return out;
+}
 
-    const auto dropouts = scenario.dropouts ? schedule_dropouts(sy, scenario.seed)
-                                            : std::array<std::vector<Dropout>, kHandCount>{};
+/// Adds a span per drop-out to `spans` and sorts them all by start (stably).
+void add_dropout_spans(std::vector<SynthSpan>& spans, const Dropouts& dropouts)
+{
     for (int h = 0; h < kHandCount; ++h)
         for (const Dropout& d : dropouts[static_cast<std::size_t>(h)]) {
             SynthSpan sp;
@@ -123,19 +112,19 @@ SynthResult synthesize(const Scenario& scenario)
             sp.hand = static_cast<Hand>(h);
             sp.t_begin = sp.t_peak_begin = d.t0;
             sp.t_end = sp.t_peak_end = d.t1;
-            out.spans.push_back(sp);
+            spans.push_back(sp);
         }
-    std::stable_sort(out.spans.begin(), out.spans.end(),
+    std::stable_sort(spans.begin(), spans.end(),
                      [](const SynthSpan& a, const SynthSpan& b) { return a.t_begin < b.t_begin; });
+}
 
-    // Frames.
-    SynthResult result;
-    Recording& rec = result.recording;
-    rec.header.source = "synth";
-    rec.header.device = "synthetic hand";
-    rec.header.nominal_rate_hz = scenario.rate_hz;
-    rec.header.created = "";
-    rec.events = out.events;
+/// The frames, every 1/rate (± 0.5 ms with noise) from t = 0 to `out.t_end`: both hands posed
+/// from their timelines, with tremor, jitter and drop-outs; the head standing, eyes at about
+/// 1.65 m, swaying slightly, watching the drawing hand and the work (smoothed with a 0.35 s
+/// time constant).
+void sample_frames(const Synth& sy, const Build& out, const Scenario& scenario, const Dropouts& dropouts,
+                   Recording& rec)
+{
     Rng noise(stream_seed(scenario.seed, kTagNoise));
     Rng clock(stream_seed(scenario.seed, kTagClock));
     std::array<TremorState, kHandCount> tremor{};
@@ -167,8 +156,6 @@ SynthResult synthesize(const Scenario& scenario)
             f.hands[hi] = hs;
         }
 
-        // Head: standing, eyes at about 1.65 m, swaying slightly, watching the drawing hand and
-        // the tree (smoothed with a 0.35 s time constant).
         while (focus_i + 1 < out.focus.size() && out.focus[focus_i + 1].first <= t) ++focus_i;
         const dvec3 want = 0.5 * clean_tip[static_cast<std::size_t>(out.focus[focus_i].second)] + 0.5 * sy.work_centre;
         look += (want - look) * (1.0 - std::exp(-(t - last_t) / 0.35));
@@ -181,6 +168,30 @@ SynthResult synthesize(const Scenario& scenario)
         last_t = t;
         t += dt_nominal + (scenario.noise ? clock.uniform(-0.0005, 0.0005) : 0.0);
     }
+}
+
+} // namespace
+
+SynthResult synthesize(const Scenario& scenario)
+{
+    validate_scenario(scenario);
+    Synth sy;
+    sy.person = make_person(scenario.seed, scenario.uniform_joint_radius_m);
+    sy.surfaces = scenario.surfaces;
+    find_work_centre(sy, scenario);
+    Build out = plan_timelines(sy, scenario);
+
+    const Dropouts dropouts = scenario.dropouts ? schedule_dropouts(sy, scenario.seed) : Dropouts{};
+    add_dropout_spans(out.spans, dropouts);
+
+    SynthResult result;
+    Recording& rec = result.recording;
+    rec.header.source = "synth";
+    rec.header.device = "synthetic hand";
+    rec.header.nominal_rate_hz = scenario.rate_hz;
+    rec.header.created = "";
+    rec.events = out.events;
+    sample_frames(sy, out, scenario, dropouts, rec);
     result.truth = std::move(out.truth);
     result.spans = std::move(out.spans);
     result.surfaces = scenario.surfaces;
