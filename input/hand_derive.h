@@ -50,10 +50,9 @@ inline constexpr std::size_t kMaxReportedProblems = 20;
 inline const glm::vec3 kLeapDeviceOrigin{0.0f, 0.8f, -0.4f};
 
 /// Metacarpal base (the carpometacarpal joint) as a fraction of the wrist → proximal-knuckle
-/// segment. Measured on Meta Quest 3 WebXR data: 0.36–0.48, median 0.41.
+/// segment (the measurements behind it: docs/importers.md, "Joint mapping").
 inline constexpr float kMetacarpalBaseFraction = 0.4f;
-/// Wrist → middle knuckle distance in units of the middle proximal phalanx length
-/// (Meta Quest 3: 95.7 mm / 42.9 mm).
+/// Wrist → middle knuckle distance in units of the middle proximal phalanx length (as above).
 inline constexpr float kWristToKnuckleRatio = 2.2f;
 
 /// Flags of a joint computed from other joints: valid, not tracked.
