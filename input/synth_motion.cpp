@@ -22,7 +22,8 @@ Person make_person(std::uint64_t seed, double uniform_radius)
         const double side = h == static_cast<int>(Hand::Right) ? 1.0 : -1.0;
         HandPersona& hp = p.hand[static_cast<std::size_t>(h)];
         hp.shoulder = dvec3(0.18 * side, p.eye_height - 0.23, 0.02);
-        // z, y, x: the order the shipped recordings were made in (see normal3).
+        // z, y, x: the order the shipped recordings were made in (see normal3 in
+        // synth_tracking.cpp).
         const double rest_z = -rng.uniform(0.18, 0.26), rest_y = p.eye_height - rng.uniform(0.60, 0.66);
         hp.rest = dvec3(side * rng.uniform(0.19, 0.24), rest_y, rest_z);
         hp.roll = side * rng.uniform(0.5, 0.7);

@@ -9,8 +9,6 @@
 #include <cmath>
 #include <cstdint>
 
-#include <glm/vec3.hpp>
-
 #include "core/random.h"
 
 namespace lobe::synth {
@@ -33,6 +31,7 @@ inline std::uint64_t stream_seed(std::uint64_t seed, std::uint64_t tag)
     return r.next();
 }
 
+/// What a stream is for: the `tag` of stream_seed.
 enum StreamTag : std::uint64_t {
     kTagPerson = 1,
     kTagDropouts = 2,
@@ -41,16 +40,5 @@ enum StreamTag : std::uint64_t {
     kTagStep = 0x10000,      // + step index: timing choices of one step
     kTagGenerator = 0x40000, // + step index: wobble of a generated curve
 };
-
-/// Three clamped normal draws as (x, y, z), z drawn first. Function arguments are evaluated
-/// in an unspecified order (gcc right to left, clang left to right), so draws are never made
-/// inside one call's arguments; z, y, x is the order the shipped recordings were made in.
-inline glm::dvec3 normal3(Rng& rng, double k)
-{
-    const double z = rng.normal_clamped(k);
-    const double y = rng.normal_clamped(k);
-    const double x = rng.normal_clamped(k);
-    return glm::dvec3(x, y, z);
-}
 
 } // namespace lobe::synth

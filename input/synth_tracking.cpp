@@ -10,6 +10,17 @@ namespace lobe::synth {
 
 namespace {
 
+/// Three clamped normal draws as (x, y, z), z drawn first. Function arguments are evaluated
+/// in an unspecified order (gcc right to left, clang left to right), so draws are never made
+/// inside one call's arguments; z, y, x is the order the shipped recordings were made in.
+dvec3 normal3(Rng& rng, double k)
+{
+    const double z = rng.normal_clamped(k);
+    const double y = rng.normal_clamped(k);
+    const double x = rng.normal_clamped(k);
+    return dvec3(x, y, z);
+}
+
 /// True when every segment overlapping [a, b] allows a long drop-out; `from` is a segment
 /// at or before `a`.
 bool all_long(const Track& tr, std::size_t from, double a, double b)
