@@ -127,7 +127,8 @@ struct ReadReport {
 ///        or unsupported version, or no usable frame remains.
 Recording read_recording(const std::string& path, ReadReport* report = nullptr);
 
-/// Parses a recording held in memory (both forms); `name` is used in messages.
+/// Parses a recording held in memory (both forms); `name` stands for the file in messages.
+/// \throw FileError as read_recording.
 Recording parse_recording(const std::string& bytes, const std::string& name, ReadReport* report = nullptr);
 
 /// Whole-file writers (atomic: temporary file, flush, rename). Frames, events and
