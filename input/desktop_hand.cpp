@@ -13,8 +13,8 @@ namespace {
 
 namespace hm = hand_model;
 
-// Postures of the synthesizer's pinch-drawing hand (input/synth.cpp): index bent about 0.55
-// while pinching, 0.25 when open; the other fingers relaxed at 0.25 (well below the grab
+// Postures of the synthesizer's pinch-drawing hand (input/synth_motion.cpp): index bent about
+// 0.55 while pinching, 0.25 when open; the other fingers relaxed at 0.25 (well below the grab
 // threshold of 0.48). The thumb reaches the index tip from the palm side.
 constexpr float kIndexCurlPinched = 0.55f, kIndexCurlOpen = 0.25f, kOtherCurl = 0.25f;
 constexpr float kPinchedGap = -0.001f, kOpenGap = 0.05f;

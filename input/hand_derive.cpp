@@ -531,47 +531,4 @@ void ProblemLog::write_to(ReadReport* report) const
         report->problems.push_back("... and " + std::to_string(count_ - lines_.size()) + " more problems");
 }
 
-std::string frame_time_problem(double t, double last)
-{
-    if (!std::isfinite(t)) return "time is not a finite number";
-    if (std::isnan(last)) return {};
-    if (t < last) return "time goes backwards";
-    if (t == last) return "time repeats the previous frame's";
-    if (t - last > kMaxFrameGapSeconds) return "time jumps ahead by more than an hour";
-    return {};
-}
-
-double median_rate_hz(const std::vector<HandFrame>& frames, double fallback)
-{
-    if (frames.size() < 2) return fallback;
-    std::vector<double> dt;
-    dt.reserve(frames.size() - 1);
-    for (std::size_t i = 1; i < frames.size(); ++i) dt.push_back(frames[i].time - frames[i - 1].time);
-    const auto mid = dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2);
-    std::nth_element(dt.begin(), mid, dt.end());
-    return *mid > 0.0 ? 1.0 / *mid : fallback;
-}
-
-void finish_import(Recording& rec, const std::string& name, const std::string& stop, std::size_t with_hand,
-                   std::size_t dropped, ProblemLog& problems, const std::vector<const ProblemLog*>& logs,
-                   ReadReport* report)
-{
-    if (!stop.empty())
-        problems.add("frames end early (" + stop + "); the " + std::to_string(rec.frames.size()) +
-                     " frames before are kept");
-    if (rec.frames.empty()) {
-        const std::string why = !stop.empty() ? stop : problems.count() ? problems.first() : "the frames array is empty";
-        throw FileError(name, "no usable frame (" + why + ")");
-    }
-    if (with_hand == 0)
-        throw FileError(name, "no frame with a usable hand" +
-                                  (problems.count() ? " (" + problems.first() + ")" : std::string()));
-    rec.header.nominal_rate_hz = median_rate_hz(rec.frames, rec.header.nominal_rate_hz);
-    if (report != nullptr) {
-        report->frames_read += rec.frames.size();
-        report->frames_dropped += dropped;
-        for (const ProblemLog* log : logs) log->write_to(report);
-    }
-}
-
 } // namespace lobe

@@ -50,10 +50,9 @@ inline constexpr std::size_t kMaxReportedProblems = 20;
 inline const glm::vec3 kLeapDeviceOrigin{0.0f, 0.8f, -0.4f};
 
 /// Metacarpal base (the carpometacarpal joint) as a fraction of the wrist → proximal-knuckle
-/// segment. Measured on Meta Quest 3 WebXR data: 0.36–0.48, median 0.41.
+/// segment (the measurements behind it: docs/importers.md, "Joint mapping").
 inline constexpr float kMetacarpalBaseFraction = 0.4f;
-/// Wrist → middle knuckle distance in units of the middle proximal phalanx length
-/// (Meta Quest 3: 95.7 mm / 42.9 mm).
+/// Wrist → middle knuckle distance in units of the middle proximal phalanx length (as above).
 inline constexpr float kWristToKnuckleRatio = 2.2f;
 
 /// Flags of a joint computed from other joints: valid, not tracked.
@@ -163,21 +162,5 @@ private:
     std::vector<std::string> lines_;
     std::size_t count_ = 0;
 };
-
-/// Why a frame at source time `t` (seconds) cannot follow the last kept frame at `last`
-/// (NaN when there is none yet), or "" when it can: times must increase strictly.
-std::string frame_time_problem(double t, double last);
-
-/// Median interval of strictly increasing times as a rate (Hz), or `fallback` when there are
-/// fewer than two frames.
-double median_rate_hz(const std::vector<HandFrame>& frames, double fallback);
-
-/// The common end of both importers: refuses a capture with no usable frame or no frame with a
-/// usable hand (FileError naming `name`), notes an early stop, sets the nominal rate and fills
-/// the report from `logs` (in order).
-/// \param stop why reading stopped early, or "" when the frames array was read to its end
-void finish_import(Recording& rec, const std::string& name, const std::string& stop, std::size_t with_hand,
-                   std::size_t dropped, ProblemLog& problems, const std::vector<const ProblemLog*>& logs,
-                   ReadReport* report);
 
 } // namespace lobe

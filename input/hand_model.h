@@ -4,13 +4,8 @@
 /// spread, and a thumb whose tip is placed by a planar reach chain (opposition). Joints come
 /// out in OpenXR's 26-joint layout and orientation convention (-Z along the bone towards the
 /// tip, +Y out of the back of the hand, +X = Y × Z), so a left hand is the mirror image of a
-/// right one with the same axis convention.
-///
-/// Calibration: joint layout, bone lengths and radii follow a relaxed right hand of the Meta
-/// Quest 3 WebXR capture in shared/data/real (wrist frame, millimetres: index metacarpal base
-/// (-19, -10, -37), index knuckle (-23.5, -7.5, -95.5), thumb base (-29, -17, -35); index
-/// phalanges 38/24/22 mm; radii 21 mm at the metacarpals down to 7 mm at the tips; the Leap
-/// clips report ~19 mm wide fingers, so the tips here are 8–9 mm).
+/// right one with the same axis convention. Joint layout, bone lengths and radii are those of a
+/// real hand (the measurements: docs/scenario-format.md, "What the synthesizer adds").
 
 #include <array>
 

@@ -10,6 +10,7 @@
 #include "core/atomic_file.h"
 #include "core/errors.h"
 #include "input/hand_derive.h"
+#include "input/import_frames.h"
 #include "input/importers.h"
 
 namespace lobe {
@@ -256,58 +257,16 @@ Recording import_leap_json_text(const std::string& text, const std::string& name
     Recording rec;
     rec.header.source = "import-leap";
     rec.header.device = "Leap Motion";
-    ProblemLog problems;
-    std::size_t dropped = 0;
-    std::size_t with_hand = 0;
-    double first_us = std::numeric_limits<double>::quiet_NaN();
-    double last_us = std::numeric_limits<double>::quiet_NaN();
-    auto drop = [&](std::size_t index, const std::string& why) {
-        ++dropped;
-        problems.add("frame " + std::to_string(index) + " dropped: " + why);
+    FrameSource source;
+    source.seconds_per_unit = 1e-6; // timestamps in µs
+    source.read_time = [](const json& fr, double& t_us) -> std::string {
+        if (!fr.is_object()) return "not an object";
+        t_us = read_number(fr, "timestamp");
+        if (!std::isfinite(t_us)) return "timestamp missing or not a number";
+        return {};
     };
-
-    std::string stop;
-    try {
-        stop = for_each_array_element(
-            text, frames_it->second,
-            [&](const json& fr, std::size_t index) {
-                if (rec.frames.size() >= kMaxRecordingFrames) {
-                    problems.add("more than " + std::to_string(kMaxRecordingFrames) + " frames: the rest ignored");
-                    return false;
-                }
-                if (!fr.is_object()) {
-                    drop(index, "not an object");
-                    return true;
-                }
-                const double t_us = read_number(fr, "timestamp");
-                if (!std::isfinite(t_us)) {
-                    drop(index, "timestamp missing or not a number");
-                    return true;
-                }
-                const std::string time_problem =
-                    frame_time_problem(t_us * 1e-6, std::isnan(last_us) ? last_us : last_us * 1e-6);
-                if (!time_problem.empty()) {
-                    drop(index, time_problem);
-                    return true;
-                }
-                HandFrame frame;
-                const std::string why = read_frame(fr, index, frame, problems);
-                if (!why.empty()) {
-                    drop(index, why);
-                    return true;
-                }
-                if (std::isnan(first_us)) first_us = t_us;
-                last_us = t_us;
-                frame.time = (t_us - first_us) * 1e-6;
-                if (frame.hands[0].active || frame.hands[1].active) ++with_hand;
-                rec.frames.push_back(frame);
-                return true;
-            },
-            drop);
-    } catch (const LiteralError&) {
-        throw FileError(name, "frames is not an array");
-    }
-    finish_import(rec, name, stop, with_hand, dropped, problems, {&problems}, report);
+    source.read_frame = read_frame;
+    import_frames(text, frames_it->second, name, source, rec, report);
     return rec;
 }
 

@@ -2,7 +2,6 @@
 // Mapping and limits: docs/importers.md.
 #include <array>
 #include <cmath>
-#include <limits>
 #include <map>
 #include <string>
 
@@ -12,6 +11,7 @@
 #include "core/atomic_file.h"
 #include "core/errors.h"
 #include "input/hand_derive.h"
+#include "input/import_frames.h"
 #include "input/importers.h"
 
 namespace lobe {
@@ -283,7 +283,6 @@ Recording import_webxr_capture_text(const std::string& text, const std::string& 
     if (frames_it == keys.value_offset.end()) throw FileError(name, "no frames" + scan_note);
 
     ProblemLog schema_problems;
-    ProblemLog problems;
     json schema_json;
     try {
         std::size_t end = schema_it->second;
@@ -304,53 +303,17 @@ Recording import_webxr_capture_text(const std::string& text, const std::string& 
     Recording rec;
     rec.header.source = "import-webxr";
     rec.header.device = "Meta Quest 3 (WebXR)";
-    std::size_t dropped = 0;
-    std::size_t with_hand = 0;
-    double first_ms = std::numeric_limits<double>::quiet_NaN();
-    double last_ms = std::numeric_limits<double>::quiet_NaN();
-    auto drop = [&](std::size_t index, const std::string& why) {
-        ++dropped;
-        problems.add("frame " + std::to_string(index) + " dropped: " + why);
+    FrameSource source;
+    source.seconds_per_unit = 1e-3; // times in ms
+    source.read_time = [](const json& row, double& t_ms) -> std::string {
+        if (!row.is_array() || row.empty() || !row[0].is_number()) return "not an array starting with a time";
+        t_ms = row[0].get<double>();
+        return {};
     };
-
-    std::string stop;
-    try {
-        stop = for_each_array_element(
-            text, frames_it->second,
-            [&](const json& row, std::size_t index) {
-                if (rec.frames.size() >= kMaxRecordingFrames) {
-                    problems.add("more than " + std::to_string(kMaxRecordingFrames) + " frames: the rest ignored");
-                    return false;
-                }
-                if (!row.is_array() || row.empty() || !row[0].is_number()) {
-                    drop(index, "not an array starting with a time");
-                    return true;
-                }
-                const double t_ms = row[0].get<double>();
-                const std::string time_problem =
-                    frame_time_problem(t_ms * 1e-3, std::isnan(last_ms) ? last_ms : last_ms * 1e-3);
-                if (!time_problem.empty()) {
-                    drop(index, time_problem);
-                    return true;
-                }
-                HandFrame frame;
-                const std::string why = read_frame(row, index, schema, frame, problems);
-                if (!why.empty()) {
-                    drop(index, why);
-                    return true;
-                }
-                if (std::isnan(first_ms)) first_ms = t_ms;
-                last_ms = t_ms;
-                frame.time = (t_ms - first_ms) * 1e-3;
-                if (frame.hands[0].active || frame.hands[1].active) ++with_hand;
-                rec.frames.push_back(frame);
-                return true;
-            },
-            drop);
-    } catch (const LiteralError&) {
-        throw FileError(name, "frames is not an array");
-    }
-    finish_import(rec, name, stop, with_hand, dropped, problems, {&schema_problems, &problems}, report);
+    source.read_frame = [&schema](const json& row, std::size_t index, HandFrame& frame, ProblemLog& problems) {
+        return read_frame(row, index, schema, frame, problems);
+    };
+    import_frames(text, frames_it->second, name, source, rec, report, &schema_problems);
     return rec;
 }
 

@@ -1,7 +1,9 @@
 #pragma once
 /// \file one_euro.h
 /// One Euro filter (Casiez, Roussel, Vogel, CHI 2012): an adaptive low-pass whose cutoff
-/// rises with speed, so jitter at rest is removed and fast motion is not lagged.
+/// rises with speed, so jitter at rest is removed and fast motion is not lagged. Per sample,
+/// with Δt the time since the last one: α(f) = 1 / (1 + τ/Δt), τ = 1 / (2π f); the speed
+/// ẋ is low-passed at d_cutoff_hz, then x at f = min_cutoff_hz + beta · |ẋ| (speed in m/s).
 
 #include <glm/vec3.hpp>
 
@@ -14,7 +16,9 @@ public:
     OneEuroFilter3() = default;
     explicit OneEuroFilter3(const OneEuroOptions& options) : options_(options) {}
 
-    /// Filters one sample at time t (seconds, strictly increasing since the last reset).
+    /// Filters one sample (metres) at time t (seconds). The first sample (after construction
+    /// or reset) passes through; a sample whose time does not advance (a duplicated frame)
+    /// returns the last output.
     glm::vec3 filter(const glm::vec3& x, double t);
     /// Forgets the past (after tracking loss): the next sample passes through unchanged.
     void reset() { initialised_ = false; }

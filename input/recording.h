@@ -4,7 +4,8 @@
 /// keyboard), in a compact binary form for real sessions and a line-per-frame text form for
 /// hand-written fixtures. Everything derived (gestures, strokes, mode switches, edits) is
 /// recomputed on replay; derived actions may be stored as annotations that replay checks
-/// against and never applies. Format and version rules: docs/recording-format.md.
+/// against and never applies. Format, version rules and limits: docs/recording-format.md.
+/// Positions are metres in stage space, times seconds.
 
 #include <cstdint>
 #include <cstdio>
@@ -126,12 +127,18 @@ struct ReadReport {
 ///        or unsupported version, or no usable frame remains.
 Recording read_recording(const std::string& path, ReadReport* report = nullptr);
 
-/// Parses a recording held in memory (both forms); `name` is used in messages.
+/// Parses a recording held in memory (both forms); `name` stands for the file in messages.
+/// \throw FileError as read_recording.
 Recording parse_recording(const std::string& bytes, const std::string& name, ReadReport* report = nullptr);
 
-/// Whole-file writers (atomic: temporary file, flush, rename).
+/// Whole-file writers (atomic: temporary file, flush, rename). Frames, events and
+/// annotations are written merged by time (ties: frame, event, annotation); annotation texts
+/// are clipped to 1,000 bytes.
+/// \throw FileError when the file cannot be written (the previous file is then untouched);
+///        InvalidInput (binary form) when the header's JSON exceeds 64 KiB.
 void write_recording_binary(const std::string& path, const Recording& rec);
 void write_recording_text(const std::string& path, const Recording& rec);
+/// The bytes the writers above write. \throw InvalidInput (binary form) as above.
 std::string encode_recording_binary(const Recording& rec);
 std::string encode_recording_text(const Recording& rec);
 
@@ -140,16 +147,24 @@ std::string encode_recording_text(const Recording& rec);
 /// to its last complete record at any moment.
 class RecordingWriter {
 public:
-    /// \throw FileError
+    /// Creates (or truncates) `path` and writes the file header (binary form).
+    /// \throw FileError when the file cannot be created or written; InvalidInput when the
+    ///        header's JSON exceeds 64 KiB.
     RecordingWriter(const std::string& path, const RecordingHeader& header, int flush_every = 1);
+    /// Closes the file; write errors are swallowed here (call close() to see them).
     ~RecordingWriter();
     RecordingWriter(const RecordingWriter&) = delete;
     RecordingWriter& operator=(const RecordingWriter&) = delete;
 
+    /// Appends one record. Frames are flushed every `flush_every`, events and annotations at
+    /// once. \throw FileError on a write error or after close().
     void append(const HandFrame& frame);
     void append(const InputEvent& event);
     void append(const Annotation& annotation);
+    /// \throw FileError on a flush error or after close().
     void flush();
+    /// Flushes, syncs to disk and closes; a second call does nothing.
+    /// \throw FileError when any of these fails.
     void close();
     const std::string& path() const { return path_; }
 

@@ -32,8 +32,8 @@ inline HandState pose_script_hand(Hand hand, const ScriptHand& h)
     HandState out;
     if (!h.active) return out;
     hm::Articulation a;
-    // The synthesizer's pinch-ready hand (input/synth.cpp, approach_pose): index bent about
-    // halfway, the other fingers relaxed, so that the thumb can reach the index tip.
+    // The synthesizer's pinch-ready hand (input/synth_motion.cpp, approach_pose): index bent
+    // about halfway, the other fingers relaxed, so that the thumb can reach the index tip.
     const float index_curl = h.pose == HandPose::Fist ? 1.0f : h.pose == HandPose::Point ? 0.0f : 0.55f;
     const float other_curl = h.pose == HandPose::Open ? 0.23f : 1.0f;
     for (int f = hm::kIndex; f <= hm::kLittle; ++f) a.curl[std::size_t(f)] = f == hm::kIndex ? index_curl : other_curl;
