@@ -452,6 +452,9 @@ std::optional<EditOperation> SessionBuilder::drag_operation(const Drag& drag, st
             t->strokes = pick.lobe->stroke_ids;
         }
     }
+    // What a session file may not hold (document_from_json) is not made here either: the
+    // checks above leave only a pointing fingertip just past 1 km, near a stroke at the limit.
+    if (std::string why = edit_operation_problem(op); !why.empty()) return nothing(why);
     if (hooks_.check) {
         const std::string why = hooks_.check(doc_, op);
         if (!why.empty()) return nothing(why);

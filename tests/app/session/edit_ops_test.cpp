@@ -211,6 +211,26 @@ TEST(SessionBuilder, DragThatPicksNothingIsRecordedAsNothingWithAWarning)
     EXPECT_NE(empty.messages()[1].find("there are no strokes"), std::string::npos);
 }
 
+TEST(SessionBuilder, MakesNoEditASessionFileCouldNotHold)
+{
+    // A trunk stroke 1 cm inside the 1 km limit: the pointing fingertip 2 cm from it, within
+    // the pick distance but beyond the limit, where a session may not hold it.
+    Stroke edge = trunk(1);
+    for (StrokePoint& p : edge.points) p.position.x = 999.99f;
+    SessionBuilder b;
+    ASSERT_TRUE(b.apply(stroke_action(edge)));
+    const glm::vec3 p = edge.points[30].position;
+    EXPECT_FALSE(b.apply(drag_action(Tool::EditStroke, p, p + glm::vec3(0.0f, 0.02f, 0.0f), p + glm::vec3(0.02f, 0.0f, 0.0f))));
+    ASSERT_EQ(b.messages().size(), 1u);
+    EXPECT_NE(b.messages()[0].find("edits nothing: params.other_tip: a coordinate is not finite or beyond 1 km"),
+              std::string::npos)
+        << b.messages()[0];
+    EXPECT_TRUE(b.document().edits.empty());
+    // Inside the limit it is made.
+    EXPECT_TRUE(b.apply(drag_action(Tool::EditStroke, p, p + glm::vec3(0.0f, 0.02f, 0.0f), p - glm::vec3(0.02f, 0.0f, 0.0f))));
+    EXPECT_EQ(b.document().edits.size(), 1u);
+}
+
 TEST(SessionBuilder, LobeDragsTargetTheNearestLobeAndRecordItsCentreAndStrokes)
 {
     SessionBuilder b = scene();
