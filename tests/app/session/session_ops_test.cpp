@@ -497,6 +497,9 @@ TEST(SessionDuplicate, PinchDeformsOfAMovedAndTurnedLobeGoWithTheCopy)
     EXPECT_EQ(op.target, 3);
     EXPECT_EQ(op.id, 4);
     EXPECT_EQ(op.path.size(), d.edits[1].path.size());
+    // The copy is written as the file format says and read back the same.
+    const std::string written = document_to_json(d).dump(1);
+    EXPECT_EQ(document_to_json(document_from_json(nlohmann::json::parse(written))).dump(1), written);
     EXPECT_TRUE(b.messages().empty()) << b.messages().front();
 
     std::vector<std::string> warnings;
