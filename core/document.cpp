@@ -589,6 +589,138 @@ GrowerChoice grower_from_json(const json& j, const std::string& w)
     return g;
 }
 
+// Edit operations (core/edits.h): read and checked here once, when a document loads; written
+// back as read (coordinates are kept as the doubles the file held, a point keeps or lacks its
+// time), so a document the program wrote is saved again byte for byte.
+
+json xyz_json(const glm::dvec3& p) { return json::array({p.x, p.y, p.z}); }
+
+json edit_to_json(const EditOperation& op)
+{
+    json path = json::array();
+    for (const DragPoint& p : op.path) {
+        json q = xyz_json(p.position);
+        if (p.time) q.push_back(*p.time);
+        path.push_back(std::move(q));
+    }
+    json params{{"hand", hand_name(op.hand)}, {"path", std::move(path)}};
+    if (const EditStrokeParams* s = op.stroke_params()) {
+        if (s->pick_distance_m) params["pick_distance_m"] = *s->pick_distance_m;
+        if (s->half_length_m) params["half_length_m"] = *s->half_length_m;
+        if (s->other_tip) params["other_tip"] = xyz_json(*s->other_tip);
+    }
+    if (const LobeTransformParams* t = op.transform_params()) {
+        if (t->centre) params["centre"] = xyz_json(*t->centre);
+        if (t->strokes) params["strokes"] = *t->strokes;
+    }
+    return {{"id", op.id}, {"type", edit_kind_name(op.kind())}, {"target", op.target}, {"params", std::move(params)}};
+}
+
+/// The first three numbers of `j`, an array of `min_size` to `max_size` numbers; false when
+/// it is not one.
+bool read_numbers(const json& j, std::size_t min_size, std::size_t max_size, glm::dvec3& xyz, std::optional<double>& fourth)
+{
+    if (!j.is_array() || j.size() < min_size || j.size() > max_size) return false;
+    for (const json& v : j)
+        if (!v.is_number()) return false;
+    xyz = {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
+    fourth.reset();
+    if (j.size() > 3) fourth = j[3].get<double>();
+    return true;
+}
+
+glm::dvec3 read_xyz(const json& j, const std::string& where)
+{
+    glm::dvec3 p;
+    std::optional<double> none;
+    if (!read_numbers(j, 3, 3, p, none)) throw InvalidInput(where + ": expected [x, y, z] numbers");
+    return p;
+}
+
+/// The keys a kind's params may hold besides "hand" and "path".
+std::vector<const char*> param_keys(EditKind kind)
+{
+    switch (kind) {
+    case EditKind::EditStroke: return {"pick_distance_m", "half_length_m", "other_tip"};
+    case EditKind::MoveLobe:
+    case EditKind::RotateLobe:
+    case EditKind::ScaleLobe: return {"centre", "strokes"};
+    case EditKind::DeformLobe: break;
+    }
+    return {};
+}
+
+EditOperation edit_from_json(const json& e, const std::string& w)
+{
+    if (!e.is_object()) throw InvalidInput(w + ": expected an object");
+    for (auto it = e.begin(); it != e.end(); ++it)
+        if (it.key() != "id" && it.key() != "type" && it.key() != "target" && it.key() != "params")
+            throw InvalidInput(w + ": unknown key '" + it.key() + "'");
+    EditOperation op;
+    op.id = read_id(e, "id", w);
+    auto t = e.find("type");
+    if (t == e.end() || !t->is_string()) throw InvalidInput(w + ".type: expected a string");
+    const std::optional<EditKind> kind = edit_kind_from_name(t->get_ref<const std::string&>());
+    if (!kind) throw InvalidInput(w + ".type: unknown edit type \"" + t->get<std::string>() + "\"");
+    op.params = edit_params_of(*kind);
+    op.target = read_id(e, "target", w);
+
+    const std::string pw = w + ".params";
+    auto pit = e.find("params");
+    if (pit == e.end() || !pit->is_object()) throw InvalidInput(pw + ": expected an object");
+    const json& p = *pit;
+    const std::vector<const char*> keys = param_keys(*kind);
+    for (auto it = p.begin(); it != p.end(); ++it) {
+        bool known = it.key() == "hand" || it.key() == "path";
+        for (const char* k : keys) known = known || it.key() == k;
+        if (!known) throw InvalidInput(pw + ": unknown key '" + it.key() + "' for " + edit_kind_name(*kind));
+    }
+
+    auto hand = p.find("hand");
+    if (hand == p.end() || !hand->is_string() || (*hand != "left" && *hand != "right"))
+        throw InvalidInput(pw + ".hand: expected \"left\" or \"right\"");
+    op.hand = *hand == "left" ? Hand::Left : Hand::Right;
+    auto path = p.find("path");
+    if (path == p.end() || !path->is_array() || path->empty())
+        throw InvalidInput(pw + ".path: expected a non-empty array of [x, y, z] or [x, y, z, t] points");
+    if (path->size() > kMaxStrokePoints)
+        throw InvalidInput(pw + ".path: " + std::to_string(path->size()) + " points, more than the " +
+                           std::to_string(kMaxStrokePoints) + " a path may have");
+    op.path.resize(path->size());
+    for (std::size_t i = 0; i < path->size(); ++i)
+        if (!read_numbers((*path)[i], 3, 4, op.path[i].position, op.path[i].time))
+            throw InvalidInput(pw + ".path[" + std::to_string(i) + "]: expected [x, y, z] or [x, y, z, t] numbers");
+
+    auto length = [&](const char* key, std::optional<double>& out) {
+        auto it = p.find(key);
+        if (it == p.end()) return;
+        if (!it->is_number()) throw InvalidInput(pw + "." + key + ": expected a positive number");
+        out = it->get<double>();
+    };
+    if (auto* s = std::get_if<EditStrokeParams>(&op.params)) {
+        length("pick_distance_m", s->pick_distance_m);
+        length("half_length_m", s->half_length_m);
+        if (auto o = p.find("other_tip"); o != p.end()) s->other_tip = read_xyz(*o, pw + ".other_tip");
+    }
+    if (LobeTransformParams* tr = op.transform_params()) {
+        if (auto c = p.find("centre"); c != p.end()) tr->centre = read_xyz(*c, pw + ".centre");
+        if (auto s = p.find("strokes"); s != p.end()) {
+            if (!s->is_array()) throw InvalidInput(pw + ".strokes: expected an array of stroke ids");
+            if (s->size() > kMaxDocumentStrokes)
+                throw InvalidInput(pw + ".strokes: " + too_many(s->size(), kMaxDocumentStrokes, "stroke ids"));
+            tr->strokes.emplace();
+            tr->strokes->reserve(s->size());
+            for (const json& id : *s) {
+                if (!id.is_number_integer()) throw InvalidInput(pw + ".strokes: expected integer ids");
+                tr->strokes->push_back(id.get<std::int64_t>());
+            }
+        }
+    }
+    // The values: finite, within the stroke limits, positive lengths, a centre where needed.
+    if (const std::string why = edit_operation_problem(op); !why.empty()) throw InvalidInput(w + "." + why);
+    return op;
+}
+
 } // namespace
 
 const GrowerChoice& scene_grower(const Document& doc)
@@ -614,8 +746,7 @@ json document_to_json(const Document& doc)
         lobes.push_back(std::move(r));
     }
     json edits = json::array();
-    for (const EditOperation& e : doc.edits)
-        edits.push_back({{"id", e.id}, {"type", e.type}, {"target", e.target}, {"params", e.params}});
+    for (const EditOperation& e : doc.edits) edits.push_back(edit_to_json(e));
     json trees = json::array();
     for (const TreeInstance& t : doc.trees) {
         json m = json::array();
@@ -744,19 +875,8 @@ Document document_from_json(const json& j)
     }
     if (const json* a = array_of("edits")) {
         if (a->size() > kMaxDocumentEdits) throw InvalidInput("edits: " + too_many(a->size(), kMaxDocumentEdits, "edits"));
-        for (std::size_t i = 0; i < a->size(); ++i) {
-            const json& e = (*a)[i];
-            const std::string w = "edits[" + std::to_string(i) + "]";
-            if (!e.is_object()) throw InvalidInput(w + ": expected an object");
-            EditOperation op;
-            op.id = read_id(e, "id", w);
-            auto t = e.find("type");
-            if (t == e.end() || !t->is_string()) throw InvalidInput(w + ".type: expected a string");
-            op.type = t->get<std::string>();
-            op.target = read_id(e, "target", w);
-            if (auto p = e.find("params"); p != e.end()) op.params = *p;
-            doc.edits.push_back(std::move(op));
-        }
+        for (std::size_t i = 0; i < a->size(); ++i)
+            doc.edits.push_back(edit_from_json((*a)[i], "edits[" + std::to_string(i) + "]"));
     }
     if (const json* a = array_of("trees")) {
         if (a->size() > kMaxDocumentTrees) throw InvalidInput("trees: " + too_many(a->size(), kMaxDocumentTrees, "trees"));

@@ -13,6 +13,7 @@
 #include <glm/mat4x4.hpp>
 #include <nlohmann/json.hpp>
 
+#include "core/edits.h"
 #include "core/grower_choice.h"
 #include "core/mesh.h"
 #include "core/settings.h"
@@ -21,14 +22,6 @@
 namespace lobe {
 
 inline constexpr int kDocumentVersion = 1;
-
-/// An edit stored as an operation, re-applied whenever the thing it edits is rebuilt.
-struct EditOperation {
-    std::int64_t id = 0;
-    std::string type;      ///< "drag:<tool>", e.g. "drag:edit-stroke", "drag:rotate-lobe" (docs/session-format.md)
-    std::int64_t target = 0; ///< the stroke or lobe id the edit picked when it was made
-    nlohmann::json params = nlohmann::json::object();
-};
 
 /// A lobe made from an imported mesh (OBJ, PLY, OFF) instead of strokes: the mesh as the
 /// import made it (repaired, scaled, remeshed), in the lobe's own frame. Kept in the session

@@ -258,7 +258,8 @@ nlohmann::json summary(const DesktopSession& s, const std::string& label, int fr
     nlohmann::json strokes = nlohmann::json::array();
     for (const Stroke& st : d.strokes) strokes.push_back({{"id", st.id}, {"kind", stroke_kind_name(st.kind)}, {"points", st.points.size()}});
     nlohmann::json edits = nlohmann::json::array();
-    for (const EditOperation& e : d.edits) edits.push_back({{"id", e.id}, {"type", e.type}, {"target", e.target}});
+    for (const EditOperation& e : d.edits)
+        edits.push_back({{"id", e.id}, {"type", edit_kind_name(e.kind())}, {"target", e.target}});
     return {{"mark", label},
             {"frame", frame},
             {"tool", tool_name(s.status().tool)},

@@ -1,17 +1,9 @@
 #include "app/live/live_stroke_edit.h"
 
-#include <nlohmann/json.hpp>
-
 #include "app/live/drag_hand.h"
 #include "app/session/edit_ops.h"
 
 namespace lobe {
-
-namespace {
-
-nlohmann::json path_point(const glm::vec3& p, double t) { return nlohmann::json::array({p.x, p.y, p.z, t}); }
-
-} // namespace
 
 bool LiveStrokeEditView::update(const InputPipeline& pipeline, const SessionBuilder& builder)
 {
@@ -57,8 +49,7 @@ bool LiveStrokeEditView::update(const InputPipeline& pipeline, const SessionBuil
             // Only the path's first and last points decide a stroke edit.
             EditOperation& op = with_->edits.back();
             const StrokePoint& first = path.points.front();
-            op.params["path"] = nlohmann::json::array({path_point(first.position, first.time),
-                                                       path_point(end, path.points.back().time)});
+            op.path = {{glm::dvec3(first.position), first.time}, {glm::dvec3(end), path.points.back().time}};
             std::vector<SkippedEdit> skipped;
             std::vector<Stroke> strokes = effective_strokes(*with_, {}, &skipped);
             const bool applied = skipped.empty() || skipped.back().id != op.id;

@@ -24,9 +24,7 @@ bool made_transform(const Document& doc, std::size_t before, std::int64_t lobe)
 {
     for (std::size_t k = before; k < doc.edits.size(); ++k) {
         const EditOperation& op = doc.edits[k];
-        if (op.target == lobe && (op.type == edit_type::kMoveLobe || op.type == edit_type::kRotateLobe ||
-                                  op.type == edit_type::kScaleLobe))
-            return true;
+        if (op.target == lobe && is_lobe_transform(op.kind())) return true;
     }
     return false;
 }

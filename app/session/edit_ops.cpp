@@ -14,78 +14,40 @@
 
 namespace lobe {
 
-using nlohmann::json;
-
 namespace {
 
-/// The params of a drag operation that re-application reads.
-struct DragParams {
-    std::vector<glm::vec3> path;
-    std::optional<glm::vec3> other_tip;
-    std::optional<glm::dvec3> centre;
-    std::optional<std::set<std::int64_t>> strokes; ///< the lobe's strokes when the op was made
-    std::optional<double> pick_distance_m, half_length_m;
-};
-
-glm::dvec3 read_point(const json& j, const std::string& where, std::size_t min_size = 3, std::size_t max_size = 3)
+/// The path's points in the precision the meshing stage works in.
+std::vector<glm::vec3> path_positions(const EditOperation& op)
 {
-    if (!j.is_array() || j.size() < min_size || j.size() > max_size)
-        throw InvalidInput(where + ": expected [x, y, z" + (max_size > 3 ? ", t]" : "]"));
-    glm::dvec3 p;
-    for (int i = 0; i < 3; ++i) {
-        if (!j[std::size_t(i)].is_number()) throw InvalidInput(where + ": expected numbers");
-        p[i] = j[std::size_t(i)].get<double>();
-        if (!std::isfinite(p[i])) throw InvalidInput(where + ": not finite");
+    std::vector<glm::vec3> out;
+    out.reserve(op.path.size());
+    for (const DragPoint& p : op.path) out.emplace_back(p.position);
+    return out;
+}
+
+std::optional<LobeTransformKind> transform_kind(EditKind kind)
+{
+    switch (kind) {
+    case EditKind::MoveLobe: return LobeTransformKind::Move;
+    case EditKind::RotateLobe: return LobeTransformKind::Rotate;
+    case EditKind::ScaleLobe: return LobeTransformKind::Scale;
+    case EditKind::DeformLobe:
+    case EditKind::EditStroke: break;
     }
-    return p;
-}
-
-std::optional<double> read_length(const json& params, const char* key)
-{
-    auto it = params.find(key);
-    if (it == params.end()) return std::nullopt;
-    if (!it->is_number() || !(it->get<double>() > 0.0) || !std::isfinite(it->get<double>()))
-        throw InvalidInput(std::string("params.") + key + ": expected a positive number");
-    return it->get<double>();
-}
-
-DragParams parse_drag(const EditOperation& op)
-{
-    const json& p = op.params;
-    if (!p.is_object()) throw InvalidInput("params: expected an object");
-    DragParams d;
-    auto path = p.find("path");
-    if (path == p.end() || !path->is_array() || path->empty())
-        throw InvalidInput("params.path: expected a non-empty array of [x, y, z, t]");
-    d.path.reserve(path->size());
-    for (std::size_t i = 0; i < path->size(); ++i)
-        d.path.emplace_back(read_point((*path)[i], "params.path[" + std::to_string(i) + "]", 3, 4));
-    if (auto o = p.find("other_tip"); o != p.end()) d.other_tip = glm::vec3(read_point(*o, "params.other_tip"));
-    if (auto c = p.find("centre"); c != p.end()) d.centre = read_point(*c, "params.centre");
-    if (auto s = p.find("strokes"); s != p.end()) {
-        if (!s->is_array()) throw InvalidInput("params.strokes: expected an array of stroke ids");
-        d.strokes.emplace();
-        for (const json& id : *s) {
-            if (!id.is_number_integer()) throw InvalidInput("params.strokes: expected integer ids");
-            d.strokes->insert(id.get<std::int64_t>());
-        }
-    }
-    d.pick_distance_m = read_length(p, "pick_distance_m");
-    d.half_length_m = read_length(p, "half_length_m");
-    return d;
-}
-
-std::optional<LobeTransformKind> transform_kind(const std::string& type)
-{
-    if (type == edit_type::kMoveLobe) return LobeTransformKind::Move;
-    if (type == edit_type::kRotateLobe) return LobeTransformKind::Rotate;
-    if (type == edit_type::kScaleLobe) return LobeTransformKind::Scale;
     return std::nullopt;
+}
+
+/// Throws the problem edit_operation_problem finds in `op`. A document read from a file
+/// holds none (document_from_json refuses them); an operation made in code may.
+void require_well_formed(const EditOperation& op)
+{
+    if (std::string why = edit_operation_problem(op); !why.empty()) throw InvalidInput(why);
 }
 
 void report(std::vector<SkippedEdit>* skipped, const EditOperation& op, const std::string& why)
 {
-    if (skipped) skipped->push_back({op.id, "edit " + std::to_string(op.id) + " (" + op.type + "): " + why});
+    if (skipped)
+        skipped->push_back({op.id, "edit " + std::to_string(op.id) + " (" + edit_kind_name(op.kind()) + "): " + why});
 }
 
 /// A transform operation made ready to compose.
@@ -106,17 +68,17 @@ std::vector<TransformOp> transform_ops(const Document& doc, std::size_t edit_cou
     std::vector<TransformOp> out;
     for (std::size_t i = 0; i < doc.edits.size() && i < edit_count; ++i) {
         const EditOperation& op = doc.edits[i];
-        const auto kind = transform_kind(op.type);
+        const auto kind = transform_kind(op.kind());
         if (!kind) continue;
         try {
             if (!lobes.count(op.target)) throw InvalidInput("no lobe " + std::to_string(op.target));
-            const DragParams d = parse_drag(op);
-            if (*kind != LobeTransformKind::Move && !d.centre) throw InvalidInput("params.centre: missing");
+            require_well_formed(op);
+            const LobeTransformParams& p = *op.transform_params();
             TransformOp t;
             t.index = i;
             t.lobe = op.target;
-            t.matrix = drag_transform(*kind, d.path, d.centre.value_or(glm::dvec3(0.0)), options.transform);
-            t.strokes = d.strokes;
+            t.matrix = drag_transform(*kind, path_positions(op), p.centre.value_or(glm::dvec3(0.0)), options.transform);
+            if (p.strokes) t.strokes.emplace(p.strokes->begin(), p.strokes->end());
             out.push_back(std::move(t));
         } catch (const InvalidInput& e) {
             report(skipped, op, e.what());
@@ -187,19 +149,21 @@ std::vector<Stroke> edited_strokes(const Document& doc, const EditApplyOptions& 
             it->second = t.matrix * it->second;
             continue;
         }
-        if (op.type != edit_type::kEditStroke) continue;
+        const EditStrokeParams* d = op.stroke_params();
+        if (!d) continue;
         try {
             auto at = stroke_at.find(op.target);
             if (at == stroke_at.end()) throw InvalidInput("no stroke " + std::to_string(op.target));
-            const DragParams d = parse_drag(op);
+            require_well_formed(op);
             Stroke& stroke = strokes[at->second];
             auto c = closed.find(stroke.id);
             if (c == closed.end()) c = closed.emplace(stroke.id, stroke_edit_closed(doc.strokes[at->second])).first;
 
             StrokeEditOptions o = options.stroke;
-            if (d.pick_distance_m) o.pick_distance_m = *d.pick_distance_m;
-            if (d.half_length_m) o.half_length_m = *d.half_length_m;
-            StrokeDrag drag{d.path.front(), d.path.back(), d.other_tip};
+            if (d->pick_distance_m) o.pick_distance_m = *d->pick_distance_m;
+            if (d->half_length_m) o.half_length_m = *d->half_length_m;
+            StrokeDrag drag{glm::vec3(op.path.front().position), glm::vec3(op.path.back().position), std::nullopt};
+            if (d->other_tip) drag.other_tip = glm::vec3(*d->other_tip);
             // The drag was made in stage space: take it to the lobe's frame, with lengths.
             auto lobe = lobe_of.find(stroke.id);
             auto now = lobe == lobe_of.end() ? lobe_now.end() : lobe_now.find(lobe->second);
@@ -259,17 +223,17 @@ std::vector<Stroke> effective_strokes(const Document& doc, const EditApplyOption
 
 std::string check_edit_operation(const Document& doc, const EditOperation& op, const EditApplyOptions& options)
 {
-    if (op.type != edit_type::kEditStroke && !transform_kind(op.type)) return {};
+    if (op.kind() == EditKind::DeformLobe) return {};
     Document with = doc;
     with.edits.push_back(op);
     std::vector<SkippedEdit> skipped;
-    if (op.type == edit_type::kEditStroke) edited_strokes(with, options, &skipped);
+    if (op.kind() == EditKind::EditStroke) edited_strokes(with, options, &skipped);
     else lobe_transform(with, op.target, with.edits.size(), options, &skipped);
     // Only the new operation's fate matters (earlier ones were reported when they were
     // made); being the last operation, it is reported last.
     if (skipped.empty() || skipped.back().id != op.id) return {};
     // The operation is not in any document yet: the reason without "edit N (type): ".
-    const std::string prefix = "edit " + std::to_string(op.id) + " (" + op.type + "): ";
+    const std::string prefix = "edit " + std::to_string(op.id) + " (" + edit_kind_name(op.kind()) + "): ";
     const std::string& m = skipped.back().message;
     return m.rfind(prefix, 0) == 0 ? m.substr(prefix.size()) : m;
 }

@@ -4,7 +4,7 @@
 /// (meshing/stroke_edit.h) and lobe transforms (meshing/lobe_transform.h), in the order they
 /// were made. The strokes in the document stay exactly as drawn; these functions derive the
 /// edited geometry from them whenever it is needed (a lobe rebuilt, a session reloaded,
-/// undo/redo). Operation types and params: docs/session-format.md; semantics:
+/// undo/redo). Operation kinds and params: core/edits.h, docs/session-format.md; semantics:
 /// docs/editing.md.
 ///
 /// Frames. Every drag is recorded in stage space as the person saw the scene at that moment.
@@ -30,15 +30,6 @@
 
 namespace lobe {
 
-/// Edit operation types written by app/session/session_builder.h ("drag:" + the tool's name).
-namespace edit_type {
-inline constexpr char kDeformLobe[] = "drag:deform-lobe"; ///< pinch deform; applied by the lobe builder
-inline constexpr char kEditStroke[] = "drag:edit-stroke"; ///< Bézier stroke edit; target = stroke id
-inline constexpr char kMoveLobe[] = "drag:move-lobe";     ///< target = lobe id
-inline constexpr char kRotateLobe[] = "drag:rotate-lobe"; ///< target = lobe id
-inline constexpr char kScaleLobe[] = "drag:scale-lobe";   ///< target = lobe id
-} // namespace edit_type
-
 /// Settings used when operations are re-applied. A stroke edit's pick distance and
 /// half-length come from its params when present (SessionBuilder records them), else from
 /// `stroke`.
@@ -47,8 +38,9 @@ struct EditApplyOptions {
     LobeTransformOptions transform;
 };
 
-/// An operation that could not be applied (malformed params, a target that does not exist,
-/// a stroke edit that picks nothing): it is skipped, the others still apply.
+/// An operation that could not be applied (a target that does not exist, a stroke edit that
+/// picks nothing, or, for an operation made in code rather than read from a file, params that
+/// edit_operation_problem refuses): it is skipped, the others still apply.
 struct SkippedEdit {
     std::int64_t id = 0;
     std::string message; ///< one line: "edit 7 (drag:edit-stroke): …"
@@ -81,7 +73,7 @@ std::vector<Stroke> effective_strokes(const Document& doc, const EditApplyOption
 
 /// Empty when `op`, appended to the document's operations, applies; otherwise why not (one
 /// line, e.g. "stroke edit: the fingertip is 4.2 cm from stroke 3 (pick distance 3.0 cm)").
-/// Pinch deforms and unknown types are not checked here (empty).
+/// Pinch deforms are not checked here (empty).
 std::string check_edit_operation(const Document& doc, const EditOperation& op, const EditApplyOptions& options = {});
 
 } // namespace lobe

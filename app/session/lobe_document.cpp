@@ -26,8 +26,6 @@ namespace lobe {
 
 namespace {
 
-constexpr const char* kPinchEditType = "drag:deform-lobe";
-
 const Stroke* find_stroke(const std::vector<Stroke>& strokes, std::int64_t id)
 {
     for (const Stroke& s : strokes)
@@ -38,19 +36,14 @@ const Stroke* find_stroke(const std::vector<Stroke>& strokes, std::int64_t id)
 /// The start and end of an edit's fingertip path; false when it has none.
 bool drag_ends(const EditOperation& op, glm::vec3& from, glm::vec3& to)
 {
-    const auto it = op.params.find("path");
-    if (it == op.params.end() || !it->is_array() || it->empty()) return false;
-    auto point = [](const nlohmann::json& p, glm::vec3& out) {
-        if (!p.is_array() || p.size() < 3) return false;
-        for (int k = 0; k < 3; ++k) {
-            if (!p[static_cast<std::size_t>(k)].is_number()) return false;
-            const double v = p[static_cast<std::size_t>(k)].get<double>();
-            if (!(std::abs(v) <= 1e30)) return false; // not finite, or beyond what a float holds
-            out[k] = static_cast<float>(v);
-        }
+    if (op.path.empty()) return false;
+    auto point = [](const DragPoint& p, glm::vec3& out) {
+        for (int k = 0; k < 3; ++k)
+            if (!(std::abs(p.position[k]) <= 1e30)) return false; // not finite, or beyond what a float holds
+        out = glm::vec3(p.position);
         return true;
     };
-    return point(it->front(), from) && point(it->back(), to);
+    return point(op.path.front(), from) && point(op.path.back(), to);
 }
 
 double nearest_vertex_distance(const TriangleMesh& mesh, const glm::vec3& p)
@@ -337,7 +330,7 @@ std::vector<BuiltLobe> finish_lobes(const Document& doc, std::vector<BuiltLobe> 
     // lobe with a vertex nearest the pinch.
     for (std::size_t k = 0; k < doc.edits.size(); ++k) {
         const EditOperation& op = doc.edits[k];
-        if (op.type != kPinchEditType) continue;
+        if (op.kind() != EditKind::DeformLobe) continue;
         BuiltLobe* target = nullptr;
         if (op.target > 0) {
             for (BuiltLobe& b : out)
@@ -446,7 +439,7 @@ std::size_t apply_pinch_edits(const Document& doc, std::int64_t lobe_id, Triangl
 {
     std::size_t applied = 0;
     for (const EditOperation& op : doc.edits) {
-        if (op.type != kPinchEditType) continue;
+        if (op.kind() != EditKind::DeformLobe) continue;
         if (op.target > 0 && op.target != lobe_id) continue;
         if (op.target == 0) {
             glm::vec3 from, to;

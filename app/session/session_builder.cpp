@@ -34,8 +34,6 @@ double distance_to_stroke(const Stroke& s, const glm::dvec3& p)
     return best;
 }
 
-nlohmann::json point_json(const glm::dvec3& p) { return nlohmann::json::array({p.x, p.y, p.z}); }
-
 const Stroke* find_stroke(const std::vector<Stroke>& strokes, std::int64_t id)
 {
     for (const Stroke& s : strokes)
@@ -43,15 +41,21 @@ const Stroke* find_stroke(const std::vector<Stroke>& strokes, std::int64_t id)
     return nullptr;
 }
 
-std::string op_type(Tool t) { return std::string("drag:") + tool_name(t); }
-
-bool is_transform_op(const std::string& type)
+/// The kind of edit a drag under tool `t` makes ("drag:" + the tool's name in the file);
+/// nullopt for the drawing tools.
+std::optional<EditKind> edit_kind_of(Tool t)
 {
-    return type == op_type(Tool::MoveLobe) || type == op_type(Tool::RotateLobe) || type == op_type(Tool::ScaleLobe);
+    switch (t) {
+    case Tool::DeformLobe: return EditKind::DeformLobe;
+    case Tool::EditStroke: return EditKind::EditStroke;
+    case Tool::MoveLobe: return EditKind::MoveLobe;
+    case Tool::RotateLobe: return EditKind::RotateLobe;
+    case Tool::ScaleLobe: return EditKind::ScaleLobe;
+    case Tool::DrawLobe:
+    case Tool::DrawTrunk: break;
+    }
+    return std::nullopt;
 }
-
-/// Operations whose target is a lobe id (the others written now target a stroke id).
-bool is_lobe_op(const std::string& type) { return type == op_type(Tool::DeformLobe) || is_transform_op(type); }
 
 /// The stroke (of `kind`, or any when none is given) with the point nearest `p`, and that
 /// distance (infinity when there is none).
@@ -150,21 +154,17 @@ void erase_from_document(Document& doc, const std::set<std::int64_t>& strokes, s
     doc.lobes.erase(std::remove_if(doc.lobes.begin(), doc.lobes.end(),
                                    [&](const LobeRecord& l) { return lobes.count(l.id) > 0; }),
                     doc.lobes.end());
-    const std::string edit_stroke = op_type(Tool::EditStroke);
+    // A stroke edit targets a stroke id, the other kinds a lobe id.
     doc.edits.erase(std::remove_if(doc.edits.begin(), doc.edits.end(),
                                    [&](const EditOperation& op) {
-                                       if (op.type == edit_stroke) return strokes.count(op.target) > 0;
-                                       return is_lobe_op(op.type) && lobes.count(op.target) > 0;
+                                       if (op.kind() == EditKind::EditStroke) return strokes.count(op.target) > 0;
+                                       return lobes.count(op.target) > 0;
                                    }),
                     doc.edits.end());
     for (EditOperation& op : doc.edits) {
-        if (!is_transform_op(op.type) || !op.params.is_object()) continue;
-        auto list = op.params.find("strokes");
-        if (list == op.params.end() || !list->is_array()) continue;
-        nlohmann::json kept = nlohmann::json::array();
-        for (const nlohmann::json& id : *list)
-            if (!id.is_number_integer() || strokes.count(id.get<std::int64_t>()) == 0) kept.push_back(id);
-        *list = std::move(kept);
+        LobeTransformParams* t = op.transform_params();
+        if (!t || !t->strokes) continue;
+        std::erase_if(*t->strokes, [&](std::int64_t id) { return strokes.count(id) > 0; });
     }
     // A tree that listed only removed lobes would otherwise mean "every lobe" (empty list).
     doc.trees.erase(std::remove_if(doc.trees.begin(), doc.trees.end(),
@@ -391,13 +391,13 @@ bool SessionBuilder::add_drag(const InputAction& a)
 
 std::optional<EditOperation> SessionBuilder::drag_operation(const Drag& drag, std::string* reason) const
 {
-    const std::string tool = tool_name(drag.tool);
     auto nothing = [&](const std::string& why) -> std::optional<EditOperation> {
         if (reason) *reason = why;
         return std::nullopt;
     };
     if (drag.path.empty()) return nothing("it has no points");
-    if (drag.tool == Tool::DrawLobe || drag.tool == Tool::DrawTrunk) return nothing("not an editing tool");
+    const std::optional<EditKind> kind = edit_kind_of(drag.tool);
+    if (!kind) return nothing("not an editing tool");
     if (doc_.edits.size() >= kMaxDocumentEdits)
         return nothing("the session already holds " + std::to_string(kMaxDocumentEdits) + " edits, the most it may hold");
     {
@@ -414,12 +414,12 @@ std::optional<EditOperation> SessionBuilder::drag_operation(const Drag& drag, st
 
     EditOperation op;
     op.id = next_edit_id_;
-    op.type = "drag:" + tool;
-    nlohmann::json path = nlohmann::json::array();
-    for (const StrokePoint& p : drag.path) path.push_back({p.position.x, p.position.y, p.position.z, p.time});
-    op.params = {{"hand", hand_name(drag.hand)}, {"path", std::move(path)}};
+    op.params = edit_params_of(*kind);
+    op.hand = drag.hand;
+    op.path.reserve(drag.path.size());
+    for (const StrokePoint& p : drag.path) op.path.push_back({glm::dvec3(p.position), p.time});
 
-    if (drag.tool == Tool::EditStroke) {
+    if (EditStrokeParams* bend = std::get_if<EditStrokeParams>(&op.params)) {
         // The stroke with the point nearest to the drag start (the first on a tie).
         double best_d = 0.0;
         const Stroke* best = nearest_stroke(view, start, best_d);
@@ -432,11 +432,11 @@ std::optional<EditOperation> SessionBuilder::drag_operation(const Drag& drag, st
             if (d > pick_.stroke_pick_distance_m)
                 return nothing("the pointing fingertip is " + cm(d) + " from stroke " + std::to_string(best->id) +
                                " (pick distance " + cm(pick_.stroke_pick_distance_m) + ")");
-            op.params["other_tip"] = point_json(glm::dvec3(*drag.other_tip));
+            bend->other_tip = glm::dvec3(*drag.other_tip);
         }
         op.target = best->id;
-        op.params["pick_distance_m"] = pick_.stroke_pick_distance_m;
-        op.params["half_length_m"] = pick_.stroke_half_length_m;
+        bend->pick_distance_m = pick_.stroke_pick_distance_m;
+        bend->half_length_m = pick_.stroke_half_length_m;
     } else {
         // Lobe tools: the lobe whose strokes are nearest the drag start, among those it is
         // near or inside.
@@ -447,11 +447,14 @@ std::optional<EditOperation> SessionBuilder::drag_operation(const Drag& drag, st
                            " from the nearest lobe stroke (pick distance " + cm(pick_.lobe_pick_distance_m) + ")");
         }
         op.target = pick.lobe->id;
-        if (drag.tool == Tool::MoveLobe || drag.tool == Tool::RotateLobe || drag.tool == Tool::ScaleLobe) {
-            op.params["centre"] = point_json(pick.centre);
-            op.params["strokes"] = pick.lobe->stroke_ids;
+        if (LobeTransformParams* t = op.transform_params()) {
+            t->centre = pick.centre;
+            t->strokes = pick.lobe->stroke_ids;
         }
     }
+    // What a session file may not hold (document_from_json) is not made here either: the
+    // checks above leave only a pointing fingertip just past 1 km, near a stroke at the limit.
+    if (std::string why = edit_operation_problem(op); !why.empty()) return nothing(why);
     if (hooks_.check) {
         const std::string why = hooks_.check(doc_, op);
         if (!why.empty()) return nothing(why);
@@ -543,10 +546,9 @@ bool SessionBuilder::delete_at_tip(const InputAction& a)
 std::vector<EditOperation> SessionBuilder::placed_deforms(const LobeRecord& lobe, bool mirror, const glm::dvec3& shift,
                                                           double mirror_x, std::string& note) const
 {
-    const std::string deform = op_type(Tool::DeformLobe);
     std::vector<std::size_t> deforms;
     for (std::size_t i = 0; i < doc_.edits.size(); ++i)
-        if (doc_.edits[i].type == deform && doc_.edits[i].target == lobe.id) deforms.push_back(i);
+        if (doc_.edits[i].kind() == EditKind::DeformLobe && doc_.edits[i].target == lobe.id) deforms.push_back(i);
     if (deforms.empty()) return {};
 
     // Where each deform's path is now: a deform made after k operations sits where a stroke
@@ -567,42 +569,30 @@ std::vector<EditOperation> SessionBuilder::placed_deforms(const LobeRecord& lobe
     probe.strokes.push_back(unit);
     pl->stroke_ids.push_back(scale_id);
     std::vector<std::int64_t> probe_ids;
-    std::vector<std::vector<double>> times;
     for (std::size_t k : deforms) {
-        const nlohmann::json& path = doc_.edits[k].params.is_object() ? doc_.edits[k].params.value("path", nlohmann::json())
-                                                                      : nlohmann::json();
-        Stroke st;
-        st.id = next_id++;
-        std::vector<double> t;
-        bool ok = path.is_array() && !path.empty();
-        for (std::size_t i = 0; ok && i < path.size(); ++i) {
-            const nlohmann::json& q = path[i];
-            ok = q.is_array() && q.size() >= 3 && q[0].is_number() && q[1].is_number() && q[2].is_number();
-            // Finite and within what a float holds (casting a larger double is undefined).
-            for (int c = 0; ok && c < 3; ++c) ok = std::abs(q[static_cast<std::size_t>(c)].get<double>()) <= 1e30;
-            if (!ok) break;
-            st.points.push_back({glm::vec3(q[0].get<float>(), q[1].get<float>(), q[2].get<float>()), 0.0});
-            t.push_back(q.size() >= 4 && q[3].is_number() ? q[3].get<double>() : 0.0);
-        }
-        if (!ok) {
-            note = "edit " + std::to_string(doc_.edits[k].id) + " has no readable path";
+        const EditOperation& deform = doc_.edits[k];
+        // A document read from a file holds no malformed operation; one made in code may.
+        if (!edit_operation_problem(deform).empty()) {
+            note = "edit " + std::to_string(deform.id) + " has no readable path";
             return {};
         }
+        Stroke st;
+        st.id = next_id++;
+        for (const DragPoint& q : deform.path) st.points.push_back({glm::vec3(q.position), 0.0});
         probe.strokes.push_back(std::move(st));
         pl->stroke_ids.push_back(next_id - 1);
         probe_ids.push_back(next_id - 1);
-        times.push_back(std::move(t));
     }
     for (std::size_t i = 0; i < probe.edits.size(); ++i) {
         EditOperation& op = probe.edits[i];
-        if (!is_transform_op(op.type) || op.target != lobe.id || !op.params.is_object()) continue;
+        LobeTransformParams* t = op.transform_params();
+        if (!t || op.target != lobe.id) continue;
         // Without a list a transform applies to every stroke of the lobe: list them.
-        auto list = op.params.find("strokes");
-        nlohmann::json ids = list != op.params.end() && list->is_array() ? *list : nlohmann::json(lobe.stroke_ids);
+        std::vector<std::int64_t> ids = t->strokes ? *t->strokes : lobe.stroke_ids;
         ids.push_back(scale_id);
         for (std::size_t j = 0; j < deforms.size(); ++j)
             if (deforms[j] < i) ids.push_back(probe_ids[j]);
-        op.params["strokes"] = std::move(ids);
+        t->strokes = std::move(ids);
     }
     const std::vector<Stroke> now = hooks_.current_strokes ? hooks_.current_strokes(probe) : probe.strokes;
     const Stroke* u = find_stroke(now, scale_id);
@@ -621,17 +611,14 @@ std::vector<EditOperation> SessionBuilder::placed_deforms(const LobeRecord& lobe
     std::vector<EditOperation> out;
     for (std::size_t j = 0; j < deforms.size(); ++j) {
         const Stroke* p = find_stroke(now, probe_ids[j]);
-        if (!p || p->points.size() != times[j].size()) {
-            note = "edit " + std::to_string(doc_.edits[deforms[j]].id) + " could not be placed";
+        EditOperation op = doc_.edits[deforms[j]];
+        if (!p || p->points.size() != op.path.size()) {
+            note = "edit " + std::to_string(op.id) + " could not be placed";
             return {};
         }
-        EditOperation op = doc_.edits[deforms[j]];
-        nlohmann::json path = nlohmann::json::array();
-        for (std::size_t i = 0; i < p->points.size(); ++i) {
-            const glm::vec3 q = place_point(p->points[i].position, mirror, shift, mirror_x);
-            path.push_back({q.x, q.y, q.z, times[j][i]});
-        }
-        op.params["path"] = std::move(path);
+        // Each point keeps its time (or its lack of one).
+        for (std::size_t i = 0; i < p->points.size(); ++i)
+            op.path[i].position = glm::dvec3(place_point(p->points[i].position, mirror, shift, mirror_x));
         out.push_back(std::move(op));
     }
     return out;

@@ -419,7 +419,7 @@ TEST(Limits, TheBuilderRefusesStrokesLobesAndEditsPastTheDocumentLimits)
         for (std::size_t i = 0; i < kMaxDocumentEdits; ++i) {
             EditOperation op;
             op.id = static_cast<std::int64_t>(i) + 1;
-            op.type = "drag:move-lobe";
+            op.params = MoveLobeParams{};
             doc.edits.push_back(op);
         }
         SessionBuilder builder(std::move(doc));

@@ -263,13 +263,13 @@ void BM_LivePinchFrame(benchmark::State& state)
     std::vector<glm::vec3> path;
     std::size_t first = doc.edits.size();
     for (std::size_t k = 0; k < doc.edits.size() && first == doc.edits.size(); ++k)
-        if (doc.edits[k].type == "drag:deform-lobe") first = k;
+        if (doc.edits[k].kind() == EditKind::DeformLobe) first = k;
     if (first == doc.edits.size()) {
         state.SkipWithError("the recording has no pinch deform");
         return;
     }
     const EditOperation op = doc.edits[first];
-    for (const auto& p : op.params["path"]) path.emplace_back(p[0].get<float>(), p[1].get<float>(), p[2].get<float>());
+    for (const DragPoint& p : op.path) path.emplace_back(p.position);
     doc.edits.resize(first);
     doc.settings.lobes.pinch_roi_radius_m = static_cast<double>(state.range(0)) / 100.0;
     const std::vector<BuiltLobe> lobes = build_document_lobes(doc);
@@ -301,10 +301,12 @@ EditOperation bend_operation(const Stroke& stroke, float lift)
     const glm::vec3 from = stroke.points[10].position, to = from + glm::vec3(0.0f, lift, 0.0f);
     EditOperation op;
     op.id = 1000000;
-    op.type = edit_type::kEditStroke;
     op.target = stroke.id;
-    op.params = {{"hand", "right"}, {"pick_distance_m", 0.03}, {"half_length_m", 0.08}};
-    op.params["path"] = nlohmann::json::array({{from.x, from.y, from.z, 0.0}, {to.x, to.y, to.z, 1.0}});
+    EditStrokeParams bend;
+    bend.pick_distance_m = 0.03;
+    bend.half_length_m = 0.08;
+    op.params = bend;
+    op.path = {{glm::dvec3(from), 0.0}, {glm::dvec3(to), 1.0}};
     return op;
 }
 

@@ -34,7 +34,12 @@ Document sample_document()
     d.settings.branches.radial_segments = 11;
     d.settings.leaves.shape = "needle";
     d.settings.leaves.color[1] = 0.7;
-    d.edits.push_back({1, "pinch_deform", 7, {{"handle", {0.1, 0.2, 0.3}}}});
+    EditOperation deform;
+    deform.id = 1;
+    deform.target = 7;
+    deform.hand = Hand::Left;
+    deform.path = {{{0.1, 0.2, 0.3}, 1.5}, {{0.1, 0.25, 0.3}, std::nullopt}};
+    d.edits.push_back(deform);
     TreeInstance t;
     t.id = 1;
     t.seed = 9;

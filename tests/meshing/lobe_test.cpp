@@ -866,8 +866,8 @@ TEST(Lobes, APinchEditSurvivesALaterStrokeAndAReload)
     const glm::vec3 to = from + glm::vec3(0.035f, 0.0f, 0.035f);
     EditOperation op;
     op.id = 1;
-    op.type = "drag:deform-lobe";
-    op.params = {{"hand", "right"}, {"path", {{from.x, from.y, from.z, 0.0}, {to.x, to.y, to.z, 1.0}}}};
+    op.params = DeformLobeParams{};
+    op.path = {{glm::dvec3(from), 0.0}, {glm::dvec3(to), 1.0}};
     doc.edits.push_back(op);
     auto handle_moved = [&](const Document& d) {
         const auto lobes = build_document_lobes(d);

@@ -189,8 +189,8 @@ TEST(Cli, ReplayStoresEditsAndWarnsAboutADragThatPicksNothing)
     EXPECT_EQ(count_lines_with(shipped.out, "warning:"), 0u) << shipped.out;
     const Document doc = load_document(dir + "/a/session.json");
     ASSERT_EQ(doc.edits.size(), 4u);
-    EXPECT_EQ(doc.edits[0].type, "drag:edit-stroke");
-    EXPECT_EQ(doc.edits[3].type, "drag:scale-lobe");
+    EXPECT_STREQ(edit_kind_name(doc.edits[0].kind()), "drag:edit-stroke");
+    EXPECT_STREQ(edit_kind_name(doc.edits[3].kind()), "drag:scale-lobe");
 
     // One loop, then a move drag 45 cm to its side: recorded as nothing, with a warning.
     {

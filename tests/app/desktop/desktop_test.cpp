@@ -226,8 +226,8 @@ TEST(DesktopSession, SketchBuildsLobeAndTreeAndEveryChangeIsAutosaved)
     EXPECT_EQ(doc.lobes[0].stroke_ids.size(), 3u);
     EXPECT_EQ(doc.strokes.size(), 4u);
     ASSERT_EQ(doc.edits.size(), 2u) << s.status().last_message;
-    EXPECT_EQ(doc.edits[0].type, "drag:edit-stroke");
-    EXPECT_EQ(doc.edits[1].type, "drag:move-lobe");
+    EXPECT_STREQ(edit_kind_name(doc.edits[0].kind()), "drag:edit-stroke");
+    EXPECT_STREQ(edit_kind_name(doc.edits[1].kind()), "drag:move-lobe");
     EXPECT_TRUE(s.status().grown);
     EXPECT_TRUE(s.status().tree_error.empty()) << s.status().tree_error;
     EXPECT_GT(s.status().tree_triangles, 1000u);
@@ -320,7 +320,7 @@ TEST(DesktopSession, PinchDeformedLobeFollowsTheFingertipFrameByFrameAndKeepsIts
     s.mouse_button(desktop_keys::kMouseLeft, false);
     d.step(6);
     ASSERT_EQ(s.document().edits.size(), 1u) << s.status().last_message;
-    EXPECT_EQ(s.document().edits[0].type, "drag:deform-lobe");
+    EXPECT_STREQ(edit_kind_name(s.document().edits[0].kind()), "drag:deform-lobe");
     // After the release the lobe is the one built with the finished edit: where the drag left it.
     const RenderItem* after = lobe_item(s);
     ASSERT_NE(after, nullptr);
@@ -384,7 +384,7 @@ TEST(DesktopSession, MovedLobeAndItsStrokesFollowTheFingertipFrameByFrameAndStay
     s.mouse_button(desktop_keys::kMouseLeft, false);
     d.step(6);
     ASSERT_EQ(s.document().edits.size(), 1u) << s.status().last_message;
-    EXPECT_EQ(s.document().edits[0].type, "drag:move-lobe");
+    EXPECT_STREQ(edit_kind_name(s.document().edits[0].kind()), "drag:move-lobe");
     // After the release the lobe and strokes are the ones built with the finished edit:
     // where the drag left them.
     const RenderItem* after = lobe_item(s);
@@ -416,7 +416,7 @@ TEST(DesktopSession, TurnedAndScaledLobesShowLiveWhatTheFinishedEditBuilds)
         s.mouse_button(desktop_keys::kMouseLeft, false);
         d.step(6);
         ASSERT_EQ(s.document().edits.size(), 1u) << s.status().last_message;
-        EXPECT_EQ(s.document().edits[0].type, tool == keys::kRotateLobe ? "drag:rotate-lobe" : "drag:scale-lobe");
+        EXPECT_EQ(s.document().edits[0].kind(), tool == keys::kRotateLobe ? EditKind::RotateLobe : EditKind::ScaleLobe);
         // As shown at the last frame of the drag.
         EXPECT_LT(largest_miss(dragged, lobe_item(s)->geometry, glm::vec3(0.0f)), 0.001);
         for (const auto& [key, tube] : stroke_items(s)) EXPECT_LT(largest_miss(strokes_dragged.at(key), tube, glm::vec3(0.0f)), 0.001);
@@ -451,7 +451,7 @@ TEST(DesktopSession, BentStrokeFollowsTheFingertipFrameByFrameAndStaysWhereRelea
     s.mouse_button(desktop_keys::kMouseLeft, false);
     d.step(6);
     ASSERT_EQ(s.document().edits.size(), 1u) << s.status().last_message;
-    EXPECT_EQ(s.document().edits[0].type, "drag:edit-stroke");
+    EXPECT_STREQ(edit_kind_name(s.document().edits[0].kind()), "drag:edit-stroke");
     // The document's stroke, bent by the finished edit, is where the drag left it.
     for (const auto& [key, tube] : stroke_items(s)) EXPECT_LT(largest_miss(dragged.at(key), tube, glm::vec3(0.0f)), 0.001);
 }
@@ -504,7 +504,7 @@ TEST(DesktopSession, TheTreeRegrowsIntoALobeWhileItIsDraggedAndTheDocumentGetsOn
     s.mouse_button(desktop_keys::kMouseLeft, false);
     d.step(6);
     ASSERT_EQ(s.document().edits.size(), edits + 1);
-    EXPECT_EQ(s.document().edits.back().type, "drag:move-lobe");
+    EXPECT_STREQ(edit_kind_name(s.document().edits.back().kind()), "drag:move-lobe");
     EXPECT_LT(glm::length(items_mean(s, RenderMaterial::Leaf) - leaves_dragged), 0.01);
 
     // A drag that edits nothing (it starts far from every lobe) leaves the tree as it was.

@@ -85,33 +85,34 @@ TEST(ReplayEdits, EachDragBecomesAnEditOperationWithItsTarget)
     ASSERT_EQ(r.drags.size(), 4u);
     ASSERT_EQ(doc.edits.size(), 4u);
 
-    const char* types[] = {"drag:edit-stroke", "drag:move-lobe", "drag:rotate-lobe", "drag:scale-lobe"};
+    const EditKind kinds[] = {EditKind::EditStroke, EditKind::MoveLobe, EditKind::RotateLobe, EditKind::ScaleLobe};
     for (std::size_t k = 0; k < 4; ++k) {
         const EditOperation& op = doc.edits[k];
-        EXPECT_EQ(op.type, types[k]);
-        EXPECT_EQ(op.params["hand"], "right");
-        // The recorded fingertip path starts and ends where the scenario's drag did.
-        const auto& path = op.params["path"];
+        const char* name = edit_kind_name(kinds[k]);
+        EXPECT_EQ(op.kind(), kinds[k]) << name;
+        EXPECT_EQ(op.hand, Hand::Right) << name;
+        // The recorded fingertip path starts and ends where the scenario's drag did, each
+        // point with its time.
+        const std::vector<DragPoint>& path = op.path;
         ASSERT_GE(path.size(), 2u);
-        const glm::dvec3 first(path.front()[0].get<double>(), path.front()[1].get<double>(), path.front()[2].get<double>());
-        const glm::dvec3 last(path.back()[0].get<double>(), path.back()[1].get<double>(), path.back()[2].get<double>());
-        EXPECT_LT(glm::distance(first, glm::dvec3(r.drags[k].points.front())), 0.003) << types[k];
-        EXPECT_LT(glm::distance(last, glm::dvec3(r.drags[k].points.back())), 0.003) << types[k];
+        for (const DragPoint& p : path) EXPECT_TRUE(p.time.has_value()) << name;
+        EXPECT_LT(glm::distance(path.front().position, glm::dvec3(r.drags[k].points.front())), 0.003) << name;
+        EXPECT_LT(glm::distance(path.back().position, glm::dvec3(r.drags[k].points.back())), 0.003) << name;
     }
     // The stroke edit targets the equator loop (the first stroke), drawn with one hand.
     EXPECT_EQ(doc.edits[0].target, 1);
-    EXPECT_FALSE(doc.edits[0].params.contains("other_tip"));
-    EXPECT_DOUBLE_EQ(doc.edits[0].params["pick_distance_m"].get<double>(), 0.03);
-    EXPECT_DOUBLE_EQ(doc.edits[0].params["half_length_m"].get<double>(), 0.08);
+    const EditStrokeParams* bend = doc.edits[0].stroke_params();
+    ASSERT_NE(bend, nullptr);
+    EXPECT_FALSE(bend->other_tip.has_value());
+    EXPECT_EQ(bend->pick_distance_m, std::optional<double>(0.03));
+    EXPECT_EQ(bend->half_length_m, std::optional<double>(0.08));
     for (std::size_t k = 1; k < 4; ++k) {
         EXPECT_EQ(doc.edits[k].target, 1);
-        EXPECT_EQ(doc.edits[k].params["strokes"], nlohmann::json::array({1, 2, 3, 4, 5}));
+        ASSERT_NE(doc.edits[k].transform_params(), nullptr);
+        EXPECT_EQ(doc.edits[k].transform_params()->strokes, (std::vector<std::int64_t>{1, 2, 3, 4, 5}));
     }
     // Each centre is the lobe's centre where the lobe was when the drag began.
-    auto centre = [&](std::size_t k) {
-        const auto& c = doc.edits[k].params["centre"];
-        return glm::dvec3(c[0].get<double>(), c[1].get<double>(), c[2].get<double>());
-    };
+    auto centre = [&](std::size_t k) { return doc.edits[k].transform_params()->centre.value(); };
     EXPECT_LT(glm::distance(centre(1), kCentre), 0.004);
     EXPECT_LT(glm::distance(centre(2), kCentre + kShift), 0.005);
     EXPECT_LT(glm::distance(centre(3), centre(2)), 0.001); // a rotation about the centre keeps it

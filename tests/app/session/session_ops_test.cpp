@@ -243,7 +243,7 @@ TEST(SessionDelete, LastStrokeOfALobeTakesTheLobeItsOperationsAndItsTreeWithIt)
     ASSERT_EQ(d.lobes.size(), 1u);
     EXPECT_EQ(d.lobes[0].id, 1);
     ASSERT_EQ(d.edits.size(), 1u);
-    EXPECT_EQ(d.edits[0].type, edit_type::kRotateLobe);
+    EXPECT_STREQ(edit_kind_name(d.edits[0].kind()), "drag:rotate-lobe");
     ASSERT_EQ(d.trees.size(), 2u); // tree 1 showed only lobe 2; "every lobe" (tree 3) stays
     EXPECT_EQ(d.trees[0].id, 2);
     EXPECT_EQ(d.trees[0].lobe_ids, (std::vector<std::int64_t>{1}));
@@ -272,8 +272,9 @@ TEST(SessionDelete, StrokeOfAMovedLobeKeepsTheRestOfTheLobeWhereThePersonSawIt)
     const Document& d = b.document();
     EXPECT_EQ(lobe_by_id(d, 1).stroke_ids, (std::vector<std::int64_t>{1, 3, 6}));
     ASSERT_EQ(d.edits.size(), 3u); // every operation stays, applying as before
-    EXPECT_EQ(d.edits[0].params["strokes"], nlohmann::json({1, 3}));    // the move: stroke 2 forgotten
-    EXPECT_EQ(d.edits[2].params["strokes"], nlohmann::json({1, 3, 6})); // the turn
+    using Ids = std::vector<std::int64_t>;
+    EXPECT_EQ(d.edits[0].transform_params()->strokes.value(), Ids({1, 3}));    // the move: stroke 2 forgotten
+    EXPECT_EQ(d.edits[2].transform_params()->strokes.value(), Ids({1, 3, 6})); // the turn
     std::vector<SkippedEdit> skipped;
     effective_strokes(d, {}, &skipped);
     EXPECT_TRUE(skipped.empty());
@@ -492,10 +493,13 @@ TEST(SessionDuplicate, PinchDeformsOfAMovedAndTurnedLobeGoWithTheCopy)
     const Document& d = b.document();
     ASSERT_EQ(d.edits.size(), 4u);
     const EditOperation& op = d.edits.back();
-    EXPECT_EQ(op.type, edit_type::kDeformLobe);
+    EXPECT_STREQ(edit_kind_name(op.kind()), "drag:deform-lobe");
     EXPECT_EQ(op.target, 3);
     EXPECT_EQ(op.id, 4);
-    EXPECT_EQ(op.params["path"].size(), d.edits[1].params["path"].size());
+    EXPECT_EQ(op.path.size(), d.edits[1].path.size());
+    // The copy is written as the file format says and read back the same.
+    const std::string written = document_to_json(d).dump(1);
+    EXPECT_EQ(document_to_json(document_from_json(nlohmann::json::parse(written))).dump(1), written);
     EXPECT_TRUE(b.messages().empty()) << b.messages().front();
 
     std::vector<std::string> warnings;

@@ -111,10 +111,11 @@ TEST(TreeOnRecording, MovingOneLobeOfTheFourLobeSceneLeavesTheOtherLobesBranches
     centre /= static_cast<double>(moved.mesh.positions.size());
     EditOperation op;
     op.id = 1000;
-    op.type = "drag:move-lobe";
     op.target = moved.lobe_id;
-    op.params = {{"path", {{centre.x, centre.y, centre.z, 100.0}, {centre.x + 0.04, centre.y, centre.z, 101.0}}},
-                 {"centre", {centre.x, centre.y, centre.z}}};
+    op.path = {{centre, 100.0}, {centre + glm::dvec3(0.04, 0.0, 0.0), 101.0}};
+    MoveLobeParams move;
+    move.centre = centre;
+    op.params = move;
     doc.edits.push_back(op);
     const BuiltTree after = build_document_tree(doc);
     ASSERT_EQ(after.lobes.size(), 4u);

@@ -124,20 +124,20 @@ TEST(VrSession, ScriptedSessionExercisesEveryInteractionAndItsRecordingReplaysTo
     const std::size_t edits0 = s.document().edits.size();
     script.pinch_along(Hand::Right, {c + glm::vec3(0, 0.12f, 0), c + glm::vec3(0, 0.17f, 0)}, 0.1);
     ASSERT_EQ(s.document().edits.size(), edits0 + 1);
-    EXPECT_EQ(s.document().edits.back().type, "drag:deform-lobe");
+    EXPECT_STREQ(edit_kind_name(s.document().edits.back().kind()), "drag:deform-lobe");
 
     // Bend a stroke: drag a point of the horizontal loop outwards.
     poke(script, s, "BEND");
     EXPECT_EQ(s.status().tool, Tool::EditStroke);
     script.pinch_along(Hand::Right, {c + glm::vec3(0, 0, 0.12f), c + glm::vec3(0, 0, 0.16f)}, 0.1);
     ASSERT_EQ(s.document().edits.size(), edits0 + 2);
-    EXPECT_EQ(s.document().edits.back().type, "drag:edit-stroke");
+    EXPECT_STREQ(edit_kind_name(s.document().edits.back().kind()), "drag:edit-stroke");
 
     // Grab the lobe and move it 8 cm to the right.
     poke(script, s, "MOVE");
     script.pinch_along(Hand::Right, {c + glm::vec3(0.05f, 0, 0), c + glm::vec3(0.13f, 0, 0)}, 0.15);
     ASSERT_EQ(s.document().edits.size(), edits0 + 3);
-    EXPECT_EQ(s.document().edits.back().type, "drag:move-lobe");
+    EXPECT_STREQ(edit_kind_name(s.document().edits.back().kind()), "drag:move-lobe");
 
     // Undo and redo the move.
     poke(script, s, "UNDO");
@@ -294,7 +294,7 @@ TEST(VrSession, PinchDeformedLobeRisesWithTheFingertipWhileDraggedAndStaysWhereR
     script.pinch(Hand::Right, false);
     script.wait(0.2);
     ASSERT_EQ(s.document().edits.size(), 1u);
-    EXPECT_EQ(s.document().edits.back().type, "drag:deform-lobe");
+    EXPECT_STREQ(edit_kind_name(s.document().edits.back().kind()), "drag:deform-lobe");
     EXPECT_NEAR(lobe_top(s), dragged, 0.002f) << "the lobe built with the finished edit is where the drag left it";
 }
 
@@ -337,14 +337,13 @@ TEST(VrSession, MovedLobeAndItsStrokesGoWithTheFingertipWhileDraggedAndStayWhere
     script.pinch(Hand::Right, false);
     script.wait(0.2);
     ASSERT_EQ(s.document().edits.size(), 1u);
-    EXPECT_EQ(s.document().edits.back().type, "drag:move-lobe");
+    EXPECT_STREQ(edit_kind_name(s.document().edits.back().kind()), "drag:move-lobe");
     // The lobe and strokes built with the finished edit are where the drag left them.
     EXPECT_LT(glm::distance(items_mean(s, RenderMaterial::Lobe), lobe_dragged), 0.002f);
     EXPECT_LT(glm::distance(items_mean(s, RenderMaterial::Stroke), strokes_dragged), 0.002f);
     // The edit is the drag as shown: from where the pinch began to where it was released.
-    const nlohmann::json& path = s.document().edits.back().params.at("path");
-    const glm::vec3 from(path.front()[0].get<float>(), path.front()[1].get<float>(), path.front()[2].get<float>());
-    const glm::vec3 to(path.back()[0].get<float>(), path.back()[1].get<float>(), path.back()[2].get<float>());
+    const std::vector<DragPoint>& path = s.document().edits.back().path;
+    const glm::vec3 from(path.front().position), to(path.back().position);
     EXPECT_LT(glm::distance(lobe_dragged - lobe0, to - from), 0.001f);
     EXPECT_GT(glm::distance(items_mean(s, RenderMaterial::Lobe), lobe0), 0.04f);
 }
@@ -377,7 +376,7 @@ TEST(VrSession, BentStrokeGoesWithTheFingertipWhileDraggedAndStaysWhereReleased)
     script.pinch(Hand::Right, false);
     script.wait(0.2);
     ASSERT_EQ(s.document().edits.size(), 1u);
-    EXPECT_EQ(s.document().edits.back().type, "drag:edit-stroke");
+    EXPECT_STREQ(edit_kind_name(s.document().edits.back().kind()), "drag:edit-stroke");
     EXPECT_NEAR(farthest(s, RenderMaterial::Stroke, 2), last, 0.002f) << "the stroke bent by the finished edit is where the drag left it";
 }
 

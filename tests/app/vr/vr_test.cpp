@@ -99,7 +99,7 @@ void expect_same_document(const Document& want, const Document& got, const std::
     }
     ASSERT_EQ(got.edits.size(), want.edits.size()) << what;
     for (std::size_t i = 0; i < want.edits.size(); ++i) {
-        EXPECT_EQ(got.edits[i].type, want.edits[i].type) << what << " edit " << i;
+        EXPECT_EQ(got.edits[i].kind(), want.edits[i].kind()) << what << " edit " << i;
         EXPECT_EQ(got.edits[i].target, want.edits[i].target) << what << " edit " << i;
     }
     EXPECT_EQ(got.seed, want.seed) << what;

@@ -185,6 +185,41 @@ bad_session("lobe-model-huge-coordinate.json",
 bad_session("edits-object.json", session(edits={}), "edits: expected an array", "edits of the wrong type")
 bad_session("edit-type-missing.json", session(edits=[{"id": 1, "target": 1}]), "edits[0].type: expected a string",
             "an edit without a type")
+# Edit operations: refused when the session loads, naming the field (docs/session-format.md,
+# "Edit operations"); only what depends on the document (a target that is gone, a pick that
+# no longer holds) is left to re-application, which skips the edit with a warning. These
+# are refused whatever the document holds, so the sessions hold nothing else.
+
+
+def edit(kind, target=1, **params):
+    return {"id": 1, "type": kind, "target": target,
+            "params": dict({"hand": "right", "path": [[0.05, 1.55, -0.42, 1.0], [0.1, 1.55, -0.42, 1.5]]}, **params)}
+
+
+bad_session("edit-type-unknown.json", session(edits=[edit("drag:pull-lobe")]),
+            'edits[0].type: unknown edit type "drag:pull-lobe"', "an edit of a type no tool makes")
+bad_session("edit-path-point-short.json",
+            session(edits=[edit("drag:move-lobe", path=[[0.05, 1.55, -0.42, 1.0], [0.06, 1.55, -0.42, 1.1],
+                                                                           [0.1, 1.55]])]),
+            "edits[0].params.path[2]: expected [x, y, z] or [x, y, z, t] numbers", "a path point of two numbers")
+bad_session("edit-path-empty.json", session(edits=[edit("drag:deform-lobe", path=[])]),
+            "edits[0].params.path: expected a non-empty array", "a pinch deform without a path")
+bad_session("edit-path-far.json",
+            session(edits=[edit("drag:move-lobe", path=[[0.05, 1.55, -0.42, 1.0], [5000.0, 1.55, -0.42, 1.5]])]),
+            "edits[0].params.path[1]: a coordinate is not finite or beyond 1 km", "a move dragged 5 km away")
+bad_session("edit-rotate-no-centre.json", session(edits=[edit("drag:rotate-lobe", strokes=[1, 2, 3])]),
+            "edits[0].params.centre: missing", "a rotation without the centre it turns about")
+bad_session("edit-hand-missing.json",
+            session(edits=[{"id": 1, "type": "drag:deform-lobe", "target": 1,
+                                                "params": {"path": [[0.05, 1.55, -0.42, 1.0]]}}]),
+            'edits[0].params.hand: expected "left" or "right"', "an edit without the hand that made it")
+bad_session("edit-params-unknown-key.json", session(edits=[edit("drag:edit-stroke", pick_distance=0.03)]),
+            "edits[0].params: unknown key 'pick_distance' for drag:edit-stroke", "a stroke edit with a misspelt key")
+bad_session("edit-pick-distance-negative.json",
+            session(edits=[edit("drag:edit-stroke", pick_distance_m=-0.03)]),
+            "edits[0].params.pick_distance_m: expected a positive number", "a stroke edit with a negative pick distance")
+bad_session("edit-strokes-not-ids.json", session(edits=[edit("drag:move-lobe", strokes=["1"])]),
+            "edits[0].params.strokes: expected integer ids", "a move whose stroke list holds a string")
 bad_session("trees-transform-short.json", session(trees=[{"id": 1, "transform": [1, 0, 0, 0]}]),
             "trees[0].transform: expected 16 numbers", "a transform of 4 numbers")
 bad_session("tree-lobes-string.json", session(trees=[{"id": 1, "lobes": "all"}]),
