@@ -433,7 +433,8 @@ private:
             std::uint32_t n = 0;
             const VkResult listed = vkEnumerateInstanceExtensionProperties(nullptr, &n, nullptr);
             std::vector<VkExtensionProperties> available(n);
-            if (listed == VK_SUCCESS && n) vkEnumerateInstanceExtensionProperties(nullptr, &n, available.data());
+            if (listed == VK_SUCCESS && n && vkEnumerateInstanceExtensionProperties(nullptr, &n, available.data()) < VK_SUCCESS)
+                available.clear(); // a list that cannot be read has nothing in it
             keep_loaded_since(libraries);
             for (const std::string& e : instance_extensions_) {
                 const bool found = std::any_of(available.begin(), available.end(),
@@ -525,9 +526,9 @@ private:
     void choose_device(const RendererOptions& options)
     {
         std::uint32_t count = 0;
-        vkEnumeratePhysicalDevices(instance_, &count, nullptr);
+        CHECK_VKCMD(vkEnumeratePhysicalDevices(instance_, &count, nullptr));
         std::vector<VkPhysicalDevice> devices(count);
-        if (count) vkEnumeratePhysicalDevices(instance_, &count, devices.data());
+        if (count) CHECK_VKCMD(vkEnumeratePhysicalDevices(instance_, &count, devices.data()));
         // Preference: discrete GPU, integrated GPU, virtual GPU, other, CPU (or CPU first).
         auto rank = [&](VkPhysicalDeviceType t) {
             int r = 0;
@@ -1635,14 +1636,15 @@ public:
         for (int attempt = 0; attempt < 2; ++attempt) {
             if (!swapchain_ || stale_ || wanted.width != wanted_.width || wanted.height != wanted_.height)
                 if (!create_swapchain(wanted)) return false;
-            const VkResult r = vkAcquireNextImageKHR(ctx_.device(), swapchain_, kAcquireTimeoutNs, acquired_, VK_NULL_HANDLE, image);
+            const VkResult r = CHECK_VKCMD_ALLOW(
+                vkAcquireNextImageKHR(ctx_.device(), swapchain_, kAcquireTimeoutNs, acquired_, VK_NULL_HANDLE, image),
+                VK_ERROR_OUT_OF_DATE_KHR);
             if (r == VK_SUCCESS) return true;
             if (r == VK_SUBOPTIMAL_KHR) { // acquired (the semaphore will be signalled): use it, remake next frame
                 stale_ = true;
                 return true;
             }
             if (r == VK_TIMEOUT || r == VK_NOT_READY) return false;
-            if (r != VK_ERROR_OUT_OF_DATE_KHR) vk::throw_vk_error(r, "vkAcquireNextImageKHR(...)", __FILE__, __LINE__);
             stale_ = true; // out of date: remake and try once more
         }
         return false;
@@ -1696,11 +1698,8 @@ public:
         info.swapchainCount = 1;
         info.pSwapchains = &swapchain_;
         info.pImageIndices = &image;
-        const VkResult r = vkQueuePresentKHR(ctx_.queue(), &info);
-        if (r == VK_SUBOPTIMAL_KHR || r == VK_ERROR_OUT_OF_DATE_KHR)
-            stale_ = true;
-        else
-            CHECK_VKCMD(r);
+        const VkResult r = CHECK_VKCMD_ALLOW(vkQueuePresentKHR(ctx_.queue(), &info), VK_ERROR_OUT_OF_DATE_KHR);
+        if (r == VK_SUBOPTIMAL_KHR || r == VK_ERROR_OUT_OF_DATE_KHR) stale_ = true;
     }
 
 private:
@@ -1768,10 +1767,15 @@ private:
         // Every frame's submit was waited for; the presentation engine may still read the old
         // images until the device is idle.
         CHECK_VKCMD(vkDeviceWaitIdle(dev));
+        // The old swapchain is retired whether or not the new one is made: it goes either way.
         VkSwapchainKHR fresh = VK_NULL_HANDLE;
-        const VkResult created = vkCreateSwapchainKHR(dev, &info, nullptr, &fresh);
+        try {
+            CHECK_VKCMD(vkCreateSwapchainKHR(dev, &info, nullptr, &fresh));
+        } catch (...) {
+            destroy_swapchain();
+            throw;
+        }
         destroy_swapchain();
-        CHECK_VKCMD(created);
         swapchain_ = fresh;
         CHECK_VKCMD(vkGetSwapchainImagesKHR(dev, swapchain_, &n, nullptr));
         images_.resize(n);
@@ -1831,7 +1835,7 @@ void keep_vulkan_drivers_loaded()
     VkInstance instance = VK_NULL_HANDLE;
     if (vkCreateInstance(&info, nullptr, &instance) != VK_SUCCESS) return;
     std::uint32_t count = 0;
-    vkEnumeratePhysicalDevices(instance, &count, nullptr); // drivers finish loading here
+    vkEnumeratePhysicalDevices(instance, &count, nullptr); // drivers finish loading here, whatever it returns
     keep_loaded_since(before);
     vkDestroyInstance(instance, nullptr);
 }
