@@ -6,6 +6,7 @@
 #include <cstring>
 #include <limits>
 #include <numeric>
+#include <utility>
 
 #include <glm/geometric.hpp>
 
@@ -225,23 +226,61 @@ void flush(CurveScratch& scratch, SurfaceGeometry& g)
     scratch.used_v = scratch.used_f = 0;
 }
 
-/// The generalised-cylinder sweep over the kept curves, into `g` (its storage reused).
-void sweep_curves(const std::vector<BranchCurve>& curves, const std::vector<RingSample>& samples,
-                  const std::vector<RingRange>& ranges, const std::vector<char>& keep, int n, SurfaceGeometry& g,
-                  CurveScratch& scratch, std::vector<BranchRing>* rings_out)
+/// Per-ring tables of the sweep for rings of n vertices. Ring vertices are written in blocks of
+/// four (12 position floats, 8 uv floats), so the loops that write them have fixed lengths the
+/// compiler vectorises. A ring of n vertices writes ⌈n/4⌉ blocks; the excess lands where the
+/// next ring (or the apex) is written after it.
+struct RingTables {
+    std::uint32_t n = 0;
+    std::uint32_t blocks = 0;
+    /// Per block: the unit circle's cos and sin and the mirrored u of each column (welded
+    /// seam), spread to the float layout of the arrays.
+    std::vector<float> cos12, sin12, u8;
+    /// Tube triangles between a ring and the previous one, as offsets from the previous ring's
+    /// first vertex; counter-clockwise seen from outside. Padded to whole 4-index lanes; the
+    /// excess lands where the next triangles go.
+    std::uint32_t quad_lanes = 0;
+    std::vector<std::uint32_t> quad_template;
+};
+
+RingTables ring_tables(int n)
 {
+    RingTables rt;
     const auto nn = static_cast<std::uint32_t>(n);
-    std::size_t vertex_total = 0, triangle_total = 0;
-    for (std::size_t c = 0; c < curves.size(); ++c) {
-        if (!keep[c] || ranges[c].count < 2) continue;
-        vertex_total += ranges[c].count * nn + 1 + (curves[c].parent < 0 ? 1 : 0);
-        triangle_total += curve_triangles(curves[c], ranges[c].count, n);
+    rt.n = nn;
+    rt.blocks = (nn + 3) / 4;
+    rt.cos12.resize(rt.blocks * 12);
+    rt.sin12.resize(rt.blocks * 12);
+    rt.u8.resize(rt.blocks * 8);
+    for (std::uint32_t i = 0; i < rt.blocks * 12; ++i) {
+        const std::uint32_t j = i / 3;
+        const double a = 2.0 * kPi * j / n;
+        rt.cos12[i] = j < nn ? static_cast<float>(std::cos(a)) : 0.0f;
+        rt.sin12[i] = j < nn ? static_cast<float>(std::sin(a)) : 0.0f;
     }
-    // Each array is written once. When `g` already holds at least as many elements (storage
-    // kept from an earlier build), the curves are written in place; otherwise they go to a
-    // small cached scratch that is appended in batches (a resize would first fill fresh
-    // memory with zeros). Both leave room (cut off at the end) for the last SIMD lanes'
-    // overrun.
+    for (std::uint32_t i = 0; i < rt.blocks * 8; i += 2) {
+        const std::uint32_t j = i / 2;
+        rt.u8[i] = j < nn ? static_cast<float>(1.0 - std::abs(1.0 - 2.0 * j / n)) : 0.0f;
+        rt.u8[i + 1] = 0.0f;
+    }
+    rt.quad_lanes = (6 * nn + 3) / 4;
+    rt.quad_template.assign(4 * rt.quad_lanes, 0);
+    for (std::uint32_t j = 0; j < nn; ++j) {
+        const std::uint32_t j1 = j + 1 == nn ? 0 : j + 1;
+        const std::uint32_t t[6] = {j, j1, nn + j1, j, nn + j1, nn + j};
+        std::copy(t, t + 6, rt.quad_template.begin() + 6 * j);
+    }
+    return rt;
+}
+
+/// Makes `g` ready for the sweep's `vertex_total` vertices and `triangle_total` triangles.
+/// Each array is written once. When `g` already holds at least as many elements (storage
+/// kept from an earlier build), the curves are written in place (returns true); otherwise
+/// they go to a small cached scratch that is appended in batches (a resize would first fill
+/// fresh memory with zeros). Both leave room (cut off at the end) for the last SIMD lanes'
+/// overrun.
+bool prepare_sweep_output(SurfaceGeometry& g, std::size_t vertex_total, std::size_t triangle_total)
+{
     auto holds = [](const auto& v, std::size_t count, std::size_t pad) {
         return v.size() >= count && v.capacity() >= count + pad; // only the padding gets initialised
     };
@@ -263,196 +302,239 @@ void sweep_curves(const std::vector<BranchCurve>& curves, const std::vector<Ring
         g.uvs.reserve(vertex_total + 4);
         g.triangles.reserve(triangle_total + 2);
     }
+    return in_place;
+}
+
+/// Tangents of a curve's R rings from the neighbouring ring centres.
+void ring_tangents(const RingSample* rs, std::uint32_t R, glm::vec3* tangents)
+{
+    for (std::uint32_t k = 0; k < R; ++k) {
+        const glm::vec3 d = rs[std::min(k + 1, R - 1)].centre - rs[k == 0 ? 0 : k - 1].centre;
+        const float len = glm::length(d);
+        if (len > 1e-12f) {
+            tangents[k] = d / len;
+        } else {
+            const glm::vec3 d1 = rs[std::min(k + 1, R - 1)].centre - rs[k].centre;
+            const float l1 = glm::length(d1);
+            tangents[k] = l1 > 1e-12f ? d1 / l1 : (k > 0 ? tangents[k - 1] : glm::vec3(0, 1, 0));
+        }
+    }
+}
+
+/// The normal of curve c's first frame (its tangent `t0`): the parent's transported normal at
+/// the fork, projected (when the parent is kept), else any; then turned by the curve's phase.
+glm::vec3 first_frame_normal(const std::vector<BranchCurve>& curves, const std::vector<RingSample>& samples,
+                             const std::vector<RingRange>& ranges, const std::vector<char>& keep, std::size_t c,
+                             const glm::vec3& t0, const glm::vec3* normal_of_ring, const glm::vec3* tangent_of_ring, int n)
+{
+    const BranchCurve& curve = curves[c];
+    glm::vec3 N;
+    if (curve.parent >= 0 && keep[static_cast<std::size_t>(curve.parent)]) {
+        const RingRange& pr = ranges[static_cast<std::size_t>(curve.parent)];
+        const RingSample* ps = samples.data() + pr.first;
+        const RingSample* hit = std::lower_bound(ps, ps + pr.count, curve.fork_arc_m,
+                                                 [](const RingSample& r, float s) { return r.arc < s; });
+        std::uint32_t k = static_cast<std::uint32_t>(hit - ps);
+        if (k >= pr.count) k = pr.count - 1;
+        if (k > 0 && curve.fork_arc_m - ps[k - 1].arc < ps[k].arc - curve.fork_arc_m) --k;
+        const glm::vec3 pn = normal_of_ring[pr.first + k];
+        const glm::vec3 pb = glm::cross(tangent_of_ring[pr.first + k], pn);
+        glm::vec3 cand = pn - glm::dot(pn, t0) * t0;
+        if (glm::length(cand) < 1e-3f) cand = pb - glm::dot(pb, t0) * t0;
+        N = glm::length(cand) > 1e-6f ? glm::normalize(cand) : any_perpendicular(t0);
+    } else {
+        N = any_perpendicular(t0);
+    }
+    if (curve.phase != 0.0f) {
+        const double delta = 2.0 * kPi * static_cast<double>(curve.phase) / n;
+        N = static_cast<float>(std::cos(delta)) * N + static_cast<float>(std::sin(delta)) * glm::cross(t0, N);
+    }
+    return N;
+}
+
+/// Double reflection (Wang, Jüttler, Zheng and Liu 2008): the rotation-minimising frame's
+/// normal `N` carried along the step `v1` (c1 = |v1|²) from a ring with tangent `t_prev` to
+/// one with tangent `t`, then made exactly normal to `t`.
+glm::vec3 transport_normal(glm::vec3 N, const glm::vec3& v1, float c1, const glm::vec3& t_prev, const glm::vec3& t)
+{
+    if (c1 > 1e-24f) {
+        const glm::vec3 nl = N - (2.0f / c1) * glm::dot(v1, N) * v1;
+        const glm::vec3 tl = t_prev - (2.0f / c1) * glm::dot(v1, t_prev) * v1;
+        const glm::vec3 v2 = t - tl;
+        const float c2 = glm::dot(v2, v2);
+        N = c2 > 1e-24f ? nl - (2.0f / c2) * glm::dot(v2, nl) * v2 : nl;
+    }
+    const glm::vec3 o = N - glm::dot(N, t) * t;
+    const float ol = glm::length(o);
+    return ol > 1e-6f ? o / ol : any_perpendicular(t);
+}
+
+/// One ring's vertices (centre + r · (cos·N + sin·B), normals, uvs at v = `vcoord`), written
+/// in blocks of four from `pos`, `nor`, `uv`.
+void write_ring_vertices(const RingTables& rt, const glm::vec3& N, const glm::vec3& B, const glm::vec3& centre, float r,
+                         float vcoord, glm::vec3* pos, glm::vec3* nor, glm::vec2* uv)
+{
+    // Four vertices = three 4-float lanes of positions (and of normals): the frame
+    // and centre repeat with period 3 across the lanes.
+    const V4 n0{N.x, N.y, N.z, N.x}, n1{N.y, N.z, N.x, N.y}, n2{N.z, N.x, N.y, N.z};
+    const V4 b0{B.x, B.y, B.z, B.x}, b1{B.y, B.z, B.x, B.y}, b2{B.z, B.x, B.y, B.z};
+    const V4 c0{centre.x, centre.y, centre.z, centre.x}, c1{centre.y, centre.z, centre.x, centre.y},
+        c2{centre.z, centre.x, centre.y, centre.z};
+    const V4 rv{r, r, r, r}, vv{0.0f, vcoord, 0.0f, vcoord};
+    float* p = &pos->x;
+    float* q = &nor->x;
+    float* w = &uv->x;
+    for (std::uint32_t b = 0; b < rt.blocks; ++b) {
+        const float* cb = rt.cos12.data() + 12 * b;
+        const float* sb = rt.sin12.data() + 12 * b;
+        const V4 d0 = load4(cb) * n0 + load4(sb) * b0;
+        const V4 d1 = load4(cb + 4) * n1 + load4(sb + 4) * b1;
+        const V4 d2 = load4(cb + 8) * n2 + load4(sb + 8) * b2;
+        store4(q + 12 * b, d0);
+        store4(q + 12 * b + 4, d1);
+        store4(q + 12 * b + 8, d2);
+        store4(p + 12 * b, c0 + rv * d0);
+        store4(p + 12 * b + 4, c1 + rv * d1);
+        store4(p + 12 * b + 8, c2 + rv * d2);
+        const float* ub = rt.u8.data() + 8 * b;
+        store4(w + 8 * b, load4(ub) + vv);
+        store4(w + 8 * b + 4, load4(ub + 4) + vv);
+    }
+}
+
+/// The 2n tube triangles between the ring whose first vertex is `previous` and the next one,
+/// written in whole 4-index lanes from `tri`.
+void write_tube_triangles(const RingTables& rt, std::uint32_t previous, std::array<std::uint32_t, 3>* tri)
+{
+    std::uint32_t* t2 = tri->data();
+    const std::uint32_t* tq = rt.quad_template.data();
+    const U4 av{previous, previous, previous, previous};
+    for (std::uint32_t i = 0; i < rt.quad_lanes; ++i) {
+        U4 x;
+        std::memcpy(&x, tq + 4 * i, sizeof x);
+        x += av;
+        std::memcpy(t2 + 4 * i, &x, sizeof x);
+    }
+}
+
+/// Where one curve's vertices and triangles are written (in the mesh, or in the scratch batch).
+struct CurveOutput {
+    glm::vec3* pos;
+    glm::vec3* nor;
+    glm::vec2* uv;
+    std::array<std::uint32_t, 3>* tri;
+};
+
+/// Sweeps curve c (R ≥ 2 rings) into `out`: the root's base cap, its rings with their frames
+/// (stored per ring for the curves that fork from it), the tube between them and the tip cone.
+/// `base` is the curve's first vertex in the mesh. Returns the vertices and triangles written.
+std::pair<std::uint32_t, std::size_t> sweep_curve(const std::vector<BranchCurve>& curves,
+                                                  const std::vector<RingSample>& samples,
+                                                  const std::vector<RingRange>& ranges, const std::vector<char>& keep,
+                                                  std::size_t c, const RingTables& rt, std::uint32_t base,
+                                                  CurveOutput out, CurveScratch& scratch,
+                                                  std::vector<BranchRing>* rings_out)
+{
+    const std::uint32_t nn = rt.n;
+    const RingSample* rs = samples.data() + ranges[c].first;
+    const std::uint32_t R = ranges[c].count;
+    const bool root = curves[c].parent < 0;
+    glm::vec3* const tangents = scratch.tangent.data();
+    glm::vec3* const normal_of_ring = scratch.normal_of_ring.data();
+    glm::vec3* const tangent_of_ring = scratch.tangent_of_ring.data();
+    ring_tangents(rs, R, tangents);
+    const glm::vec3 t0 = tangents[0];
+    glm::vec3 N = first_frame_normal(curves, samples, ranges, keep, c, t0, normal_of_ring, tangent_of_ring,
+                                     static_cast<int>(nn));
+
+    std::uint32_t v = 0; // local vertex index
+    std::size_t f = 0;
+    if (root) { // flat base cap centre
+        out.pos[0] = rs[0].centre;
+        out.nor[0] = -t0;
+        out.uv[0] = glm::vec2(0.5f, 0.0f);
+        v = 1;
+    }
+    float vcoord = 0.0f;
+    glm::vec3 t_prev = t0;
+    for (std::uint32_t k = 0; k < R; ++k) {
+        const glm::vec3 t = tangents[k];
+        if (k > 0) {
+            const glm::vec3 v1 = rs[k].centre - rs[k - 1].centre;
+            const float c1 = glm::dot(v1, v1);
+            N = transport_normal(N, v1, c1, t_prev, t);
+            const float r_avg = 0.5f * (rs[k].radius + rs[k - 1].radius);
+            vcoord += std::sqrt(c1) / (static_cast<float>(kPi) * r_avg);
+        }
+        t_prev = t;
+        const glm::vec3 B = glm::cross(t, N);
+        normal_of_ring[ranges[c].first + k] = N;
+        tangent_of_ring[ranges[c].first + k] = t;
+        const glm::vec3 centre = rs[k].centre;
+        const float r = rs[k].radius;
+        if (rings_out) rings_out->push_back({centre, t, r, rs[k].arc, base + v, static_cast<int>(c)});
+        write_ring_vertices(rt, N, B, centre, r, vcoord, out.pos + v, out.nor + v, out.uv + v);
+        const std::uint32_t gv = base + v; // this ring's first vertex in the mesh
+        if (k == 0 && root) {
+            for (std::uint32_t j = 0; j + 1 < nn; ++j) out.tri[f++] = {base, gv + j + 1, gv + j};
+            out.tri[f++] = {base, gv, gv + nn - 1};
+        }
+        if (k > 0) {
+            write_tube_triangles(rt, gv - nn, out.tri + f);
+            f += 2 * nn;
+        }
+        v += nn;
+    }
+    // Tip cone: apex one tip radius beyond the last ring.
+    const std::uint32_t last = base + v - nn;
+    const glm::vec3 t_end = tangents[R - 1];
+    const float r_end = rs[R - 1].radius;
+    out.pos[v] = rs[R - 1].centre + r_end * t_end;
+    out.nor[v] = t_end;
+    out.uv[v] = glm::vec2(0.5f, vcoord + 1.0f / static_cast<float>(kPi));
+    const std::uint32_t apex = base + v;
+    ++v;
+    for (std::uint32_t j = 0; j + 1 < nn; ++j) out.tri[f++] = {last + j, last + j + 1, apex};
+    out.tri[f++] = {last + nn - 1, last, apex};
+    return {v, f};
+}
+
+/// The generalised-cylinder sweep over the kept curves, into `g` (its storage reused).
+void sweep_curves(const std::vector<BranchCurve>& curves, const std::vector<RingSample>& samples,
+                  const std::vector<RingRange>& ranges, const std::vector<char>& keep, int n, SurfaceGeometry& g,
+                  CurveScratch& scratch, std::vector<BranchRing>* rings_out)
+{
+    const auto nn = static_cast<std::uint32_t>(n);
+    std::size_t vertex_total = 0, triangle_total = 0;
+    for (std::size_t c = 0; c < curves.size(); ++c) {
+        if (!keep[c] || ranges[c].count < 2) continue;
+        vertex_total += ranges[c].count * nn + 1 + (curves[c].parent < 0 ? 1 : 0);
+        triangle_total += curve_triangles(curves[c], ranges[c].count, n);
+    }
+    const bool in_place = prepare_sweep_output(g, vertex_total, triangle_total);
     if (rings_out) {
         rings_out->clear();
         rings_out->reserve(samples.size());
     }
-
-    // Ring vertices are written in blocks of four (12 position floats, 8 uv floats), so the
-    // loops below have fixed lengths the compiler vectorises. A ring of n vertices writes
-    // ⌈n/4⌉ blocks; the excess lands where the next ring (or the apex) is written after it.
-    // Tables per block: the unit circle's cos and sin and the mirrored u of each column
-    // (welded seam), spread to the float layout of the arrays.
-    const std::uint32_t blocks = (nn + 3) / 4;
-    std::vector<float> cos12(blocks * 12), sin12(blocks * 12), u8(blocks * 8);
-    for (std::uint32_t i = 0; i < blocks * 12; ++i) {
-        const std::uint32_t j = i / 3;
-        const double a = 2.0 * kPi * j / n;
-        cos12[i] = j < nn ? static_cast<float>(std::cos(a)) : 0.0f;
-        sin12[i] = j < nn ? static_cast<float>(std::sin(a)) : 0.0f;
-    }
-    for (std::uint32_t i = 0; i < blocks * 8; i += 2) {
-        const std::uint32_t j = i / 2;
-        u8[i] = j < nn ? static_cast<float>(1.0 - std::abs(1.0 - 2.0 * j / n)) : 0.0f;
-        u8[i + 1] = 0.0f;
-    }
-    // Tube triangles between a ring and the previous one, as offsets from the previous ring's
-    // first vertex; counter-clockwise seen from outside.
-    // Padded to whole 4-index lanes; the excess lands where the next triangles go.
-    const std::uint32_t quad_lanes = (6 * nn + 3) / 4;
-    std::vector<std::uint32_t> quad_template(4 * quad_lanes, 0);
-    for (std::uint32_t j = 0; j < nn; ++j) {
-        const std::uint32_t j1 = j + 1 == nn ? 0 : j + 1;
-        const std::uint32_t t[6] = {j, j1, nn + j1, j, nn + j1, nn + j};
-        std::copy(t, t + 6, quad_template.begin() + 6 * j);
-    }
-
+    const RingTables rt = ring_tables(n);
     // Transported frame of every ring, looked up by child curves at their fork.
     if (scratch.normal_of_ring.size() < samples.size()) {
         scratch.normal_of_ring.resize(samples.size());
         scratch.tangent_of_ring.resize(samples.size());
     }
-    glm::vec3* const normal_of_ring = scratch.normal_of_ring.data();
-    glm::vec3* const tangent_of_ring = scratch.tangent_of_ring.data();
     std::size_t written_v = 0, written_f = 0;
-
     for (std::size_t c = 0; c < curves.size(); ++c) {
         if (!keep[c] || ranges[c].count < 2) continue;
-        const BranchCurve& curve = curves[c];
-        const RingSample* rs = samples.data() + ranges[c].first;
         const std::uint32_t R = ranges[c].count;
-        const bool root = curve.parent < 0;
-        const std::size_t curve_vertices = R * nn + 1 + (root ? 1 : 0);
-        scratch.fit(R, in_place ? 0 : curve_vertices + 4, in_place ? 0 : curve_triangles(curve, R, n) + 2);
-        glm::vec3* pos = in_place ? g.positions.data() + written_v : scratch.pos.data() + scratch.used_v;
-        glm::vec3* nor = in_place ? g.normals.data() + written_v : scratch.nor.data() + scratch.used_v;
-        glm::vec2* uv = in_place ? g.uvs.data() + written_v : scratch.uv.data() + scratch.used_v;
-        std::array<std::uint32_t, 3>* tri = in_place ? g.triangles.data() + written_f : scratch.tri.data() + scratch.used_f;
-        glm::vec3* tangents = scratch.tangent.data();
-        const auto base = static_cast<std::uint32_t>(written_v); // the curve's first vertex in the mesh
-
-        // Tangents from the neighbouring ring centres.
-        for (std::uint32_t k = 0; k < R; ++k) {
-            const glm::vec3 d = rs[std::min(k + 1, R - 1)].centre - rs[k == 0 ? 0 : k - 1].centre;
-            const float len = glm::length(d);
-            if (len > 1e-12f) {
-                tangents[k] = d / len;
-            } else {
-                const glm::vec3 d1 = rs[std::min(k + 1, R - 1)].centre - rs[k].centre;
-                const float l1 = glm::length(d1);
-                tangents[k] = l1 > 1e-12f ? d1 / l1 : (k > 0 ? tangents[k - 1] : glm::vec3(0, 1, 0));
-            }
-        }
-
-        // First frame: the parent's at the fork, projected; else any. Then the curve's phase.
-        glm::vec3 N;
-        const glm::vec3 t0 = tangents[0];
-        if (!root && keep[static_cast<std::size_t>(curve.parent)]) {
-            const RingRange& pr = ranges[static_cast<std::size_t>(curve.parent)];
-            const RingSample* ps = samples.data() + pr.first;
-            const RingSample* hit = std::lower_bound(ps, ps + pr.count, curve.fork_arc_m,
-                                                     [](const RingSample& r, float s) { return r.arc < s; });
-            std::uint32_t k = static_cast<std::uint32_t>(hit - ps);
-            if (k >= pr.count) k = pr.count - 1;
-            if (k > 0 && curve.fork_arc_m - ps[k - 1].arc < ps[k].arc - curve.fork_arc_m) --k;
-            const glm::vec3 pn = normal_of_ring[pr.first + k];
-            const glm::vec3 pb = glm::cross(tangent_of_ring[pr.first + k], pn);
-            glm::vec3 cand = pn - glm::dot(pn, t0) * t0;
-            if (glm::length(cand) < 1e-3f) cand = pb - glm::dot(pb, t0) * t0;
-            N = glm::length(cand) > 1e-6f ? glm::normalize(cand) : any_perpendicular(t0);
-        } else {
-            N = any_perpendicular(t0);
-        }
-        if (curve.phase != 0.0f) {
-            const double delta = 2.0 * kPi * static_cast<double>(curve.phase) / n;
-            N = static_cast<float>(std::cos(delta)) * N + static_cast<float>(std::sin(delta)) * glm::cross(t0, N);
-        }
-
-        std::uint32_t v = 0; // local vertex index
-        std::size_t f = 0;
-        if (root) { // flat base cap centre
-            pos[0] = rs[0].centre;
-            nor[0] = -t0;
-            uv[0] = glm::vec2(0.5f, 0.0f);
-            v = 1;
-        }
-        float vcoord = 0.0f;
-        glm::vec3 t_prev = t0;
-        for (std::uint32_t k = 0; k < R; ++k) {
-            const glm::vec3 t = tangents[k];
-            if (k > 0) {
-                // Double reflection (Wang, Jüttler, Zheng and Liu 2008): rotation-minimising.
-                const glm::vec3 v1 = rs[k].centre - rs[k - 1].centre;
-                const float c1 = glm::dot(v1, v1);
-                if (c1 > 1e-24f) {
-                    const glm::vec3 nl = N - (2.0f / c1) * glm::dot(v1, N) * v1;
-                    const glm::vec3 tl = t_prev - (2.0f / c1) * glm::dot(v1, t_prev) * v1;
-                    const glm::vec3 v2 = t - tl;
-                    const float c2 = glm::dot(v2, v2);
-                    N = c2 > 1e-24f ? nl - (2.0f / c2) * glm::dot(v2, nl) * v2 : nl;
-                }
-                const glm::vec3 o = N - glm::dot(N, t) * t;
-                const float ol = glm::length(o);
-                N = ol > 1e-6f ? o / ol : any_perpendicular(t);
-                const float r_avg = 0.5f * (rs[k].radius + rs[k - 1].radius);
-                vcoord += std::sqrt(c1) / (static_cast<float>(kPi) * r_avg);
-            }
-            t_prev = t;
-            const glm::vec3 B = glm::cross(t, N);
-            normal_of_ring[ranges[c].first + k] = N;
-            tangent_of_ring[ranges[c].first + k] = t;
-            const glm::vec3 centre = rs[k].centre;
-            const float r = rs[k].radius;
-            if (rings_out) rings_out->push_back({centre, t, r, rs[k].arc, base + v, static_cast<int>(c)});
-            {
-                // Four vertices = three 4-float lanes of positions (and of normals): the frame
-                // and centre repeat with period 3 across the lanes.
-                const V4 n0{N.x, N.y, N.z, N.x}, n1{N.y, N.z, N.x, N.y}, n2{N.z, N.x, N.y, N.z};
-                const V4 b0{B.x, B.y, B.z, B.x}, b1{B.y, B.z, B.x, B.y}, b2{B.z, B.x, B.y, B.z};
-                const V4 c0{centre.x, centre.y, centre.z, centre.x}, c1{centre.y, centre.z, centre.x, centre.y},
-                    c2{centre.z, centre.x, centre.y, centre.z};
-                const V4 rv{r, r, r, r}, vv{0.0f, vcoord, 0.0f, vcoord};
-                float* p = &pos[v].x;
-                float* q = &nor[v].x;
-                float* w = &uv[v].x;
-                for (std::uint32_t b = 0; b < blocks; ++b) {
-                    const float* cb = cos12.data() + 12 * b;
-                    const float* sb = sin12.data() + 12 * b;
-                    const V4 d0 = load4(cb) * n0 + load4(sb) * b0;
-                    const V4 d1 = load4(cb + 4) * n1 + load4(sb + 4) * b1;
-                    const V4 d2 = load4(cb + 8) * n2 + load4(sb + 8) * b2;
-                    store4(q + 12 * b, d0);
-                    store4(q + 12 * b + 4, d1);
-                    store4(q + 12 * b + 8, d2);
-                    store4(p + 12 * b, c0 + rv * d0);
-                    store4(p + 12 * b + 4, c1 + rv * d1);
-                    store4(p + 12 * b + 8, c2 + rv * d2);
-                    const float* ub = u8.data() + 8 * b;
-                    store4(w + 8 * b, load4(ub) + vv);
-                    store4(w + 8 * b + 4, load4(ub + 4) + vv);
-                }
-            }
-            const std::uint32_t gv = base + v; // this ring's first vertex in the mesh
-            if (k == 0 && root) {
-                for (std::uint32_t j = 0; j + 1 < nn; ++j) tri[f++] = {base, gv + j + 1, gv + j};
-                tri[f++] = {base, gv, gv + nn - 1};
-            }
-            if (k > 0) {
-                const std::uint32_t a = gv - nn; // previous ring
-                std::uint32_t* t2 = tri[f].data();
-                const std::uint32_t* tq = quad_template.data();
-                const U4 av{a, a, a, a};
-                for (std::uint32_t i = 0; i < quad_lanes; ++i) {
-                    U4 x;
-                    std::memcpy(&x, tq + 4 * i, sizeof x);
-                    x += av;
-                    std::memcpy(t2 + 4 * i, &x, sizeof x);
-                }
-                f += 2 * nn;
-            }
-            v += nn;
-        }
-        // Tip cone: apex one tip radius beyond the last ring.
-        const std::uint32_t last = base + v - nn;
-        const glm::vec3 t_end = tangents[R - 1];
-        const float r_end = rs[R - 1].radius;
-        pos[v] = rs[R - 1].centre + r_end * t_end;
-        nor[v] = t_end;
-        uv[v] = glm::vec2(0.5f, vcoord + 1.0f / static_cast<float>(kPi));
-        const std::uint32_t apex = base + v;
-        ++v;
-        for (std::uint32_t j = 0; j + 1 < nn; ++j) tri[f++] = {last + j, last + j + 1, apex};
-        tri[f++] = {last + nn - 1, last, apex};
+        const std::size_t curve_vertices = R * nn + 1 + (curves[c].parent < 0 ? 1 : 0);
+        scratch.fit(R, in_place ? 0 : curve_vertices + 4, in_place ? 0 : curve_triangles(curves[c], R, n) + 2);
+        const CurveOutput out =
+            in_place ? CurveOutput{g.positions.data() + written_v, g.normals.data() + written_v, g.uvs.data() + written_v,
+                                   g.triangles.data() + written_f}
+                     : CurveOutput{scratch.pos.data() + scratch.used_v, scratch.nor.data() + scratch.used_v,
+                                   scratch.uv.data() + scratch.used_v, scratch.tri.data() + scratch.used_f};
+        const auto [v, f] = sweep_curve(curves, samples, ranges, keep, c, rt, static_cast<std::uint32_t>(written_v), out,
+                                        scratch, rings_out);
         written_v += v;
         written_f += f;
         if (!in_place) {

@@ -61,7 +61,7 @@ std::vector<BranchCurve> smooth_branch_curves(const TreeGraph& graph, const std:
 
 /// Resolution of one branch mesh.
 struct BranchMeshOptions {
-    int radial_segments = 8;        ///< vertices around each ring (≥ 3)
+    int radial_segments = 8;        ///< vertices around each ring (3 to 1024)
     double ring_spacing_m = 0.015;  ///< largest distance between consecutive rings along a curve (> 0)
     /// A curve point is skipped (no ring on it) only while the curve turns there by less than
     /// this angle; larger turns always get a ring.
@@ -86,6 +86,7 @@ struct BranchRing {
 /// consecutive rings at most ring_spacing_m apart. Exposed for budget computations: a kept
 /// curve with R rings costs 2·n·(R − 1) + n triangles (tube and tip cone), plus n for the
 /// base cap of the root curve.
+/// \throw InvalidInput when radial_segments is outside [3, 1024] or ring_spacing_m ≤ 0.
 std::size_t count_branch_rings(const BranchCurve& curve, const BranchMeshOptions& options);
 
 /// Sweeps a generalised cylinder along each kept curve: rings of radial_segments welded
@@ -96,7 +97,7 @@ std::size_t count_branch_rings(const BranchCurve& curve, const BranchMeshOptions
 /// from its parent's at the fork, turned by the curve's phase so no two rings meeting at a
 /// fork share a vertex position. Radii below 10 µm are raised to 10 µm.
 /// \param rings when not null, receives every ring of every kept curve.
-/// \throw InvalidInput when radial_segments < 3 or ring_spacing_m ≤ 0.
+/// \throw InvalidInput when radial_segments is outside [3, 1024] or ring_spacing_m ≤ 0.
 SurfaceGeometry build_branch_mesh(const std::vector<BranchCurve>& curves, const BranchMeshOptions& options,
                                   std::vector<BranchRing>* rings = nullptr);
 
@@ -139,8 +140,8 @@ inline constexpr std::size_t kMaxTreeTriangles = 50000000;
 /// LOD's budget) at the same tips, so the foliage keeps its area and silhouette.
 /// Deterministic: the same inputs give the same bytes.
 /// \throw InvalidInput on an invalid graph (see merge_coincident_nodes), lod_count outside
-/// [1, 6], radial_segments < 3, ring_spacing_m ≤ 0, an unknown leaf shape, or a LOD0 beyond
-/// kMaxTreeTriangles.
+/// [1, 6], radial_segments outside [3, 1024], ring_spacing_m ≤ 0, an unknown leaf shape, a
+/// lobe override make_leaf_cloud refuses, or a LOD0 beyond kMaxTreeTriangles.
 /// `lobe_leaves`: per-lobe leaf length, count and seed (make_leaf_cloud).
 TreeGeometry build_tree_geometry(const TreeGraph& graph, const BranchSettings& branches, const LeafSettings& leaves,
                                  std::uint64_t seed, const std::string& species = {},

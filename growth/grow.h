@@ -78,20 +78,23 @@ struct ClusterSpan {
 };
 ClusterSpan cluster_span(const std::vector<glm::vec3>& unit_dirs);
 
-/// Splits a cluster into ⌈θh/t⌉ × ⌈θv/t⌉ pieces by azimuth and elevation (one piece when
-/// neither span exceeds t). Returns the non-empty pieces as indices into `unit_dirs`, in
-/// bin order; `grid` (when given) receives the number of bins horizontally and vertically.
+/// Splits a cluster into ⌈θh/t⌉ × ⌈θv/t⌉ pieces by azimuth and elevation (§5.2; one piece
+/// when neither span exceeds t = `split_angle_deg`, degrees; at most kMaxPiecesPerNode).
+/// Returns the non-empty pieces as indices into `unit_dirs`, in bin order; `grid_h` and
+/// `grid_v` (when given) receive the number of bins horizontally and vertically.
 std::vector<std::vector<int>> split_cluster(const std::vector<glm::vec3>& unit_dirs, double split_angle_deg,
                                             int* grid_h = nullptr, int* grid_v = nullptr);
 
-/// V_cluster: the mean of the unit vectors from `node` to `attractors`, each weighted by the
-/// inverse of its distance (nearer attractors pull harder), normalised.
+/// V_cluster (§5.2): the mean of the unit vectors from `node` to `attractors`, each weighted by
+/// the inverse of its distance (nearer attractors pull harder), normalised; +Y when they
+/// cancel out.
 glm::dvec3 cluster_direction(const glm::vec3& node, const std::vector<glm::vec3>& attractors);
 
 /// Grows one lobe from `skeleton` (its shared nodes and the limbs made for lobe
 /// `lobe_index`). The returned nodes' parents index `skeleton.graph.nodes` when below
 /// skeleton.graph.size() and the returned nodes (offset by that size) otherwise.
 /// `ray` (optional) is the lobe's ray caster when the caller has one.
+/// \throw InvalidInput when the library has no subtree.
 std::vector<TreeNode> grow_in_lobe(const Skeleton& skeleton, int lobe_index, const GrowthLobe& lobe,
                                    const GrowthSettings& settings, const SubtreeLibrary& library,
                                    std::uint64_t seed, LobeGrowthStats& stats, const MeshRaycaster* ray = nullptr);
@@ -100,6 +103,7 @@ std::vector<TreeNode> grow_in_lobe(const Skeleton& skeleton, int lobe_index, con
 /// growth, merged into one graph rooted at the trunk base. Radii are left to
 /// assign_pipe_radii (radii.h). `max_tree_nodes` caps the whole tree (kMaxTreeNodes; tests
 /// lower it).
+/// \throw InvalidInput when there is a lobe to grow and the library has no subtree.
 GrowthResult grow_tree(const std::vector<std::vector<glm::vec3>>& trunk_strokes, const std::vector<GrowthLobe>& lobes,
                        const GrowthSettings& settings, const SubtreeLibrary& library, std::uint64_t seed,
                        std::size_t max_tree_nodes = kMaxTreeNodes);

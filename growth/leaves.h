@@ -86,7 +86,7 @@ struct LeafCloud {
 
 /// Draws the LOD0 leaves of `graph` (see build_leaf_quads). A lobe with an entry in
 /// `per_lobe` takes its leaf length, count and seed from there.
-/// 	hrow InvalidInput when an override's length is not in (0, 1] m or its count not in [0, 64].
+/// \throw InvalidInput when an override's length is not in (0, 1] m or its count not in [0, 64].
 LeafCloud make_leaf_cloud(const TreeGraph& graph, const LeafSettings& leaves, std::uint64_t seed,
                           const LobeLeafOverrides& per_lobe = {});
 

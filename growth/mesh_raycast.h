@@ -2,9 +2,7 @@
 /// \file mesh_raycast.h
 /// Rays against a closed triangle mesh (a lobe), through a bounding volume hierarchy: every
 /// crossing along a ray, inside/outside by parity, and the signed distance along a direction
-/// that growth (§5.2) scales subtrees by. Written here rather than taken from CGAL's AABB tree
-/// to keep CGAL out of growth/ (compile time) and because growth casts thousands of short
-/// queries per tree: a flat, cache-friendly BVH of floats answers one in well under a microsecond.
+/// that growth (§5.2) scales subtrees by. Why not CGAL's AABB tree: docs/growth.md, "Ray casting".
 
 #include <limits>
 #include <vector>

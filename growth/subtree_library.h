@@ -34,6 +34,7 @@ inline constexpr std::size_t kMaxSubtrees = 256;
 /// duplicate names).
 SubtreeLibrary parse_subtree_library(const std::string& text, const std::string& where);
 /// The library shipped with the program (growth/data/subtrees.json, compiled in).
+/// \throw InvalidInput when the program was built without it.
 const SubtreeLibrary& default_subtree_library();
 
 /// Per-subtree weights from names (GrowthSettings::subtree_weights): missing names weigh 0,

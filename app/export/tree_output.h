@@ -19,6 +19,7 @@ LobeLeafOverrides document_lobe_leaves(const Document& doc, const BuiltTree& tre
 
 /// Branch and leaf geometry of `tree` at every LOD, with the document's branch and leaf
 /// settings and seed, and each lobe's leaf overrides.
+/// \throw InvalidInput as build_tree_geometry (growth/branch_geometry.h).
 TreeGeometry document_tree_geometry(const Document& doc, const BuiltTree& tree);
 
 /// Triangles of one LOD (branches + leaves).

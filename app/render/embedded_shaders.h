@@ -1,6 +1,6 @@
 #pragma once
 /// \file embedded_shaders.h
-/// The renderer's SPIR-V, compiled from app/shaders/*.{vert,frag} by glslc at build time
+/// The renderer's SPIR-V, compiled from app/render/shaders/*.{vert,frag} by glslc at build time
 /// and embedded by app/render/embed_spirv.cmake.
 
 #include <cstdint>

@@ -41,6 +41,7 @@ inline constexpr std::array<float, 4> kStrokeColor{1.0f, 0.55f, 0.1f, 1.0f};
 SurfaceGeometry polyline_tube(const std::vector<glm::vec3>& points, float radius_m = 0.003f, int sides = 6);
 
 /// A lobe mesh with area-weighted vertex normals, ready to draw.
+/// \throw InvalidInput for a triangle index outside the mesh's vertices.
 SurfaceGeometry lobe_surface(const TriangleMesh& mesh);
 
 /// The scene of a grown tree: `geometry`'s LOD `content.lod` (branches and/or leaves), the
@@ -51,7 +52,7 @@ RenderScene tree_render_scene(const TreeGeometry& geometry, const std::vector<Tr
                               const std::vector<Stroke>& strokes, float ground_y, const RenderContent& content);
 
 /// Replaces the mesh of the item tree_render_scene made for lobe `index` (a lobe being
-/// deformed live); false when `scene` has no such item.
+/// deformed live); false when `scene` has no such item. \throw InvalidInput as lobe_surface.
 bool replace_lobe_item(RenderScene& scene, std::size_t index, const TriangleMesh& mesh);
 
 /// Replaces the tube of the item tree_render_scene made for `stroke` (found by its id) with
@@ -67,6 +68,7 @@ RenderScene glb_render_scene(const std::string& path, const RenderContent& conte
 
 /// The share of pixels of `picture` that differ from `background` (same size) by more than
 /// `threshold` in any channel; `mask` (optional) gets 1 for those pixels, 0 elsewhere.
+/// \throw InvalidInput when the two pictures differ in size.
 double coverage(const RgbaImage& picture, const RgbaImage& background, int threshold = 24,
                 std::vector<std::uint8_t>* mask = nullptr);
 

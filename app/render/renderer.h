@@ -1,7 +1,8 @@
 #pragma once
 /// \file renderer.h
 /// Pictures of a tree and its sketch: a Vulkan renderer behind a plain C++ interface (no
-/// Vulkan type here; the Vulkan code is in app/render/renderer.cpp). What it draws, the camera
+/// Vulkan type here; the Vulkan code is in app/render/renderer.cpp and the parts it puts
+/// together, app/render/vulkan_context.h and the headers beside it). What it draws, the camera
 /// framing and device selection are described in docs/rendering.md.
 ///
 /// ```cpp

@@ -1,5 +1,5 @@
 #version 450
-// Leaves drawn instanced (app/render/renderer.cpp, docs/rendering.md): one shared quad and one
+// Leaves drawn instanced (app/render/scene_drawer.cpp, docs/rendering.md): one shared quad and one
 // instance per leaf. Binding 0 (per vertex) holds the uvs of the quad's four corners, shared
 // by every leaf of the mesh; binding 1 (per instance) holds three corners of the leaf and its
 // normal. Corner k is vertex k of the leaf's four in the mesh (growth/leaves.cpp's order):
