@@ -26,7 +26,7 @@
 #include "growth/subtree_library.h"
 #include "input/recording.h"
 #include "app/session/session_builder.h"
-#include "input/truth_surface.h"
+#include "tests/support/shapes.h"
 #include "app/session/lobe_document.h"
 #include "meshing/mesh_io.h"
 #include "meshing/model_import.h"
@@ -437,10 +437,8 @@ TEST(Limits, TheBuilderRefusesStrokesLobesAndEditsPastTheDocumentLimits)
 
 TEST(Limits, RemeshingRefusesASurfaceThatWouldMakeTooManyTriangles)
 {
-    TruthSurface s;
-    s.center = {0.0, 0.0, 0.0};
-    s.radii = {2.0, 2.0, 2.0}; // about 50 m²: 4.6 million triangles at 5 mm
-    const TriangleMesh sphere = truth_surface_mesh(s, 2);
+    // About 50 m²: 4.6 million triangles at 5 mm.
+    const TriangleMesh sphere = test::ellipsoid({0.0, 0.0, 0.0}, {2.0, 2.0, 2.0}, 2);
     RemeshOptions o;
     o.target_edge_length_m = 0.005;
     try {
@@ -457,15 +455,11 @@ TEST(Limits, RemeshingRefusesASurfaceThatWouldMakeTooManyTriangles)
 
 TEST(Limits, TheWholeTreeStopsAtItsNodeCapAndSaysWhichLobesWereNotGrown)
 {
-    TruthSurface s;
-    s.center = {0.0, 1.4, 0.0};
-    s.radii = {0.17, 0.14, 0.16};
     GrowthLobe a, b;
     a.id = 1;
-    a.mesh = truth_surface_mesh(s, 3);
-    s.center = {0.5, 1.4, 0.0};
+    a.mesh = test::ellipsoid({0.0, 1.4, 0.0}, {0.17, 0.14, 0.16}, 3);
     b.id = 2;
-    b.mesh = truth_surface_mesh(s, 3);
+    b.mesh = test::ellipsoid({0.5, 1.4, 0.0}, {0.17, 0.14, 0.16}, 3);
     const std::vector<std::vector<glm::vec3>> trunk{{{0, 1.0f, 0}, {0, 1.1f, 0}, {0, 1.2f, 0}, {0, 1.3f, 0}}};
     GrowthSettings settings;
     const GrowthResult free = grow_tree(trunk, {a, b}, settings, default_subtree_library(), 1);

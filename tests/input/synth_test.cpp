@@ -18,6 +18,7 @@
 #include "core/errors.h"
 #include "input/synth.h"
 #include "input/tools.h"
+#include "tests/support/shapes.h"
 #include "tests/support/test_paths.h"
 
 using namespace lobe;
@@ -313,12 +314,7 @@ TEST(SynthScenario, ShippedLobesAreEnclosedByTheirStrokes)
 {
     // A person enclosing foliage leaves no empty patch wider than about 60° of arc seen from
     // the lobe's centre: every direction is within 30° of a stroke.
-    std::vector<glm::dvec3> probes;
-    for (int i = 0; i < 4000; ++i) {
-        const double z = 1.0 - (2.0 * i + 1.0) / 4000.0, rho = std::sqrt(1.0 - z * z);
-        const double phi = kPi * (3.0 - std::sqrt(5.0)) * i;
-        probes.emplace_back(rho * std::cos(phi), rho * std::sin(phi), z);
-    }
+    const std::vector<glm::dvec3> probes = test::sphere_directions(4000);
     for (const Shipped& sc : kShipped) {
         const SynthResult& r = shipped(sc.file);
         for (std::size_t k = 0; k < r.surfaces.size(); ++k) {

@@ -1,7 +1,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -13,7 +12,6 @@
 #include <random>
 #include <set>
 #include <string>
-#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -32,6 +30,7 @@
 #include "core/errors.h"
 #include "core/mesh.h"
 #include "meshing/laplacian_edit.h"
+#include "tests/support/shapes.h"
 
 using namespace lobe;
 
@@ -40,47 +39,10 @@ namespace {
 constexpr double kRadius = 0.25;
 const glm::dvec3 kCentre{0.0, 1.2, -0.4};
 
-/// Geodesic sphere: an icosahedron whose faces are split into frequency² triangles,
-/// projected onto the sphere (10·frequency² + 2 vertices). `radial` gives the radius for a
-/// unit direction.
-TriangleMesh geodesic_sphere(int frequency, const std::function<double(const glm::dvec3&)>& radial)
-{
-    const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-    const std::vector<glm::dvec3> ico = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                                         {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-    const std::vector<std::array<int, 3>> faces = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
-                                                   {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
-                                                   {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
-                                                   {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
-    TriangleMesh mesh;
-    std::map<std::tuple<long long, long long, long long>, int> index;
-    auto vertex = [&](const glm::dvec3& p) {
-        const glm::dvec3 u = glm::normalize(p);
-        const auto key = std::make_tuple(std::llround(u.x * 1e7), std::llround(u.y * 1e7), std::llround(u.z * 1e7));
-        const auto [it, added] = index.emplace(key, int(mesh.positions.size()));
-        if (added)
-            mesh.positions.emplace_back(kCentre + radial(u) * u);
-        return it->second;
-    };
-    const int n = frequency;
-    for (auto f : faces) {
-        const glm::dvec3 a = ico[std::size_t(f[0])], b = ico[std::size_t(f[1])], c = ico[std::size_t(f[2])];
-        if (glm::dot(glm::cross(b - a, c - a), a + b + c) < 0.0)
-            throw std::logic_error("icosahedron face not counter-clockwise");
-        auto at = [&](int i, int j) { return vertex(a + (b - a) * (double(i) / n) + (c - a) * (double(j) / n)); };
-        for (int i = 0; i < n; ++i)
-            for (int j = 0; i + j < n; ++j) {
-                mesh.triangles.push_back({at(i, j), at(i + 1, j), at(i, j + 1)});
-                if (i + j + 1 < n)
-                    mesh.triangles.push_back({at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
-            }
-    }
-    return mesh;
-}
-
+/// The test lobe: a geodesic sphere of kRadius about kCentre (frequency 22: 4,842 vertices).
 TriangleMesh sphere(int frequency = 22)
 {
-    return geodesic_sphere(frequency, [](const glm::dvec3&) { return kRadius; });
+    return test::geodesic_sphere(frequency, kCentre, kRadius);
 }
 
 /// Gaussian bump of the given height and width (metres, along the surface) around `axis`.
@@ -380,7 +342,7 @@ TEST(LaplacianEdit, SolveMatchesAnIndependentDenseLeastSquaresSolveOfTheSameEner
 {
     // 362 vertices; a bump makes the cotangent weights uneven.
     const glm::dvec3 axis = glm::normalize(glm::dvec3(0.3, 1.0, 0.1));
-    const TriangleMesh mesh = geodesic_sphere(6, [&](const glm::dvec3& u) { return kRadius + bump_height(u, axis, 0.03, 0.06); });
+    const TriangleMesh mesh = test::geodesic_sphere(6, kCentre, [&](const glm::dvec3& u) { return kRadius + bump_height(u, axis, 0.03, 0.06); });
     ASSERT_EQ(mesh.vertex_count(), 362u);
     const int h = pick_handle(mesh, glm::vec3(kCentre + 0.26 * glm::normalize(glm::dvec3(0.0, 1.0, 0.3))), 0.05);
     const glm::vec3 target = mesh.positions[std::size_t(h)] + glm::vec3(0.03f, 0.06f, -0.02f);
@@ -413,7 +375,7 @@ TEST(LaplacianEdit, BumpInTheRoiKeepsItsHeightProfileFarBetterThanADistanceFallo
     const double height = 0.012, sigma = 0.012;
     const TriangleMesh plain = sphere();
     const TriangleMesh bumpy =
-        geodesic_sphere(22, [&](const glm::dvec3& u) { return kRadius + bump_height(u, bump_axis, height, sigma); });
+        test::geodesic_sphere(22, kCentre, [&](const glm::dvec3& u) { return kRadius + bump_height(u, bump_axis, height, sigma); });
     const int h = vertex_towards(plain, handle_dir);
     const double away = kRadius * std::acos(glm::dot(outward(plain, h), bump_axis));
     ASSERT_GT(away, 0.04);

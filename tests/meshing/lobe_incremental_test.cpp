@@ -23,38 +23,22 @@
 #include "meshing/mesh_quality.h"
 #include "meshing/repair.h"
 #include "tests/support/replay_fixture.h"
+#include "tests/support/shapes.h"
 
 namespace lobe {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-/// Raw stroke points 5 mm apart with 1 mm of wobble (as the lobe benchmark draws them).
-std::vector<glm::vec3> raw_loop(const glm::dvec3& centre, const glm::dvec3& u, const glm::dvec3& v, double r, int seed)
-{
-    const int n = static_cast<int>(2 * kPi * r / 0.005);
-    std::vector<glm::vec3> out;
-    for (int i = 0; i < n; ++i) {
-        const double t = 2 * kPi * i / n;
-        const double w = 0.001 * std::sin(7 * t + seed);
-        out.emplace_back(centre + (r + w) * (std::cos(t) * u + std::sin(t) * v));
-    }
-    return out;
-}
+using test::raw_loop;
 
-/// The benchmark's lobe: six loops through the centre 30° apart, four stacked rings, and a
-/// loop tilted by 45° as the eleventh stroke.
+/// The benchmark's lobe: its ten strokes (six loops through the centre 30° apart, four
+/// stacked rings) and a loop tilted by 45° as the eleventh stroke.
 std::vector<std::vector<glm::vec3>> eleven_strokes()
 {
     const glm::dvec3 c(0.0, 1.4, -0.45);
     const double r = 0.2;
-    std::vector<std::vector<glm::vec3>> s;
-    for (int k = 0; k < 6; ++k) {
-        const double a = k * kPi / 6;
-        s.push_back(raw_loop(c, {0, 1, 0}, {std::cos(a), 0, std::sin(a)}, r, k));
-    }
-    for (double h : {-0.15, -0.08, 0.08, 0.15})
-        s.push_back(raw_loop(c + glm::dvec3(0, h, 0), {1, 0, 0}, {0, 0, 1}, std::sqrt(r * r - h * h), static_cast<int>(h * 100)));
+    std::vector<std::vector<glm::vec3>> s = test::ten_stroke_lobe();
     s.push_back(raw_loop(c, glm::normalize(glm::dvec3(1, 1, 0)), {0, 0, 1}, r, 11));
     return s;
 }

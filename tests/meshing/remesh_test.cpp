@@ -22,79 +22,16 @@
 #include "meshing/remesh.h"
 #include "meshing/repair.h"
 #include "tests/support/hole_meshes.h"
+#include "tests/support/shapes.h"
 #include "tests/support/test_paths.h"
 
 using namespace lobe;
 using lobe::test::dome_with_wavy_base;
+using lobe::test::icosphere;
 using lobe::test::sphere_with_slit;
+using lobe::test::uv_sphere;
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
-/// Icosphere of radius r (outward oriented), `levels` rounds of 4-to-1 subdivision.
-TriangleMesh icosphere(int levels, double r, glm::dvec3 centre = glm::dvec3(0.0))
-{
-    const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-    std::vector<glm::dvec3> p = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                                 {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-    std::vector<std::array<int, 3>> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
-                                         {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
-                                         {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
-                                         {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
-    for (int l = 0; l < levels; ++l) {
-        std::map<std::pair<int, int>, int> mid;
-        auto midpoint = [&](int a, int b) {
-            const auto key = std::make_pair(std::min(a, b), std::max(a, b));
-            auto it = mid.find(key);
-            if (it != mid.end()) return it->second;
-            p.push_back(0.5 * (p[static_cast<std::size_t>(a)] + p[static_cast<std::size_t>(b)]));
-            return mid[key] = static_cast<int>(p.size()) - 1;
-        };
-        std::vector<std::array<int, 3>> g;
-        for (const auto& tri : f) {
-            const int ab = midpoint(tri[0], tri[1]), bc = midpoint(tri[1], tri[2]), ca = midpoint(tri[2], tri[0]);
-            g.push_back({tri[0], ab, ca});
-            g.push_back({tri[1], bc, ab});
-            g.push_back({tri[2], ca, bc});
-            g.push_back({ab, bc, ca});
-        }
-        f = std::move(g);
-    }
-    TriangleMesh m;
-    for (const auto& q : p) m.positions.emplace_back(centre + r * glm::normalize(q));
-    m.triangles = f;
-    return m;
-}
-
-/// UV sphere of radius r with `rings` latitude bands (even: the equator is a ring of mesh
-/// edges) and `segments` longitudes; returns the equator loop in `equator`.
-TriangleMesh uv_sphere(int rings, int segments, double r, std::vector<int>& equator)
-{
-    TriangleMesh m;
-    m.positions.emplace_back(0.f, static_cast<float>(r), 0.f);
-    for (int i = 1; i < rings; ++i) {
-        const double th = kPi * i / rings;
-        for (int j = 0; j < segments; ++j) {
-            const double ph = 2.0 * kPi * j / segments;
-            m.positions.emplace_back(glm::dvec3(r * std::sin(th) * std::cos(ph), r * std::cos(th), r * std::sin(th) * std::sin(ph)));
-        }
-    }
-    m.positions.emplace_back(0.f, static_cast<float>(-r), 0.f);
-    const int south = static_cast<int>(m.positions.size()) - 1;
-    auto at = [&](int ring, int j) { return 1 + (ring - 1) * segments + (j % segments); };
-    for (int j = 0; j < segments; ++j) m.triangles.push_back({0, at(1, j + 1), at(1, j)});
-    for (int i = 1; i + 1 < rings; ++i)
-        for (int j = 0; j < segments; ++j) {
-            m.triangles.push_back({at(i, j), at(i, j + 1), at(i + 1, j + 1)});
-            m.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i + 1, j)});
-        }
-    for (int j = 0; j < segments; ++j) m.triangles.push_back({south, at(rings - 1, j), at(rings - 1, j + 1)});
-    equator.clear();
-    for (int j = 0; j < segments; ++j) equator.push_back(at(rings / 2, j));
-    for (int j = 0; j < segments; ++j) m.feature_edges.push_back({equator[static_cast<std::size_t>(j)], equator[static_cast<std::size_t>((j + 1) % segments)]});
-    return m;
-}
 
 double segment_distance(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b)
 {
