@@ -18,11 +18,13 @@
 #include "core/errors.h"
 #include "input/synth.h"
 #include "input/tools.h"
+#include "tests/support/expect_throw.h"
 #include "tests/support/shapes.h"
 #include "tests/support/test_paths.h"
 
 using namespace lobe;
 using json = nlohmann::json;
+using lobe::test::invalid_input_message;
 
 namespace {
 
@@ -133,18 +135,6 @@ json minimal_scenario()
                                             {"curve", json::array({json::array({0.0, 1.3, -0.4}),
                                                                    json::array({0.1, 1.35, -0.4}),
                                                                    json::array({0.2, 1.3, -0.4})})}}})}};
-}
-
-/// The message of the InvalidInput `fn` throws (empty when it throws nothing).
-template <typename Fn>
-std::string invalid_input_message(Fn&& fn)
-{
-    try {
-        fn();
-    } catch (const InvalidInput& e) {
-        return e.what();
-    }
-    return "";
 }
 
 Scenario idle_scenario(double seconds)

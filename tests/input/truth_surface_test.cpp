@@ -17,6 +17,7 @@
 #include "core/errors.h"
 #include "input/truth_surface.h"
 #include "meshing/polyline.h"
+#include "tests/support/expect_throw.h"
 #include "tests/support/shapes.h"
 #include "tests/support/test_paths.h"
 
@@ -24,6 +25,7 @@ using namespace lobe;
 using json = nlohmann::json;
 using glm::dvec3;
 using lobe::test::ellipsoid_surface;
+using lobe::test::invalid_input_message;
 using lobe::test::sphere_directions;
 
 namespace {
@@ -46,17 +48,6 @@ TruthSurface turned()
     const double c = std::cos(30.0 * kDeg), sn = std::sin(30.0 * kDeg);
     s.axes = {dvec3(c, 0.0, -sn), dvec3(0.0, 1.0, 0.0), dvec3(sn, 0.0, c)};
     return s;
-}
-
-template <typename Fn>
-std::string invalid_input_message(Fn&& fn)
-{
-    try {
-        fn();
-    } catch (const InvalidInput& e) {
-        return e.what();
-    }
-    return "";
 }
 
 /// Largest radial gap of the centripetal Catmull–Rom spline through `ctrl` (the synthesizer's

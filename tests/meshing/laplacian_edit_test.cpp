@@ -30,6 +30,7 @@
 #include "core/errors.h"
 #include "core/mesh.h"
 #include "meshing/laplacian_edit.h"
+#include "tests/support/expect_throw.h"
 #include "tests/support/shapes.h"
 
 using namespace lobe;
@@ -111,24 +112,6 @@ std::vector<glm::dvec3> vertex_normals(const TriangleMesh& mesh)
     for (auto& v : n)
         v = glm::normalize(v);
     return n;
-}
-
-/// Calls f, expects an exception of type E with a one-line message, and returns it.
-template <class E, class F> std::string expect_one_line_throw(F&& f)
-{
-    try {
-        f();
-    } catch (const E& e) {
-        const std::string what = e.what();
-        EXPECT_EQ(what.find('\n'), std::string::npos) << what;
-        EXPECT_FALSE(what.empty());
-        return what;
-    } catch (const std::exception& e) {
-        ADD_FAILURE() << "wrong exception type: " << e.what();
-        return {};
-    }
-    ADD_FAILURE() << "no exception";
-    return {};
 }
 
 bool same_positions(const TriangleMesh& a, const TriangleMesh& b)
@@ -490,10 +473,10 @@ TEST(PinchEdit, PickHandleTakesTheNearestVertexWithinReach)
     const glm::vec3 p = mesh.positions[100] + glm::vec3(0.002f, -0.001f, 0.001f);
     EXPECT_EQ(pick_handle(mesh, p), 100);
     const glm::vec3 far = glm::vec3(kCentre + 0.29 * outward(mesh, 100)); // 4 cm off the surface
-    expect_one_line_throw<InvalidInput>([&] { pick_handle(mesh, far); });
+    test::expect_one_line_throw<InvalidInput>([&] { pick_handle(mesh, far); });
     EXPECT_EQ(pick_handle(mesh, far, 0.05), 100);
-    expect_one_line_throw<InvalidInput>([&] { pick_handle(TriangleMesh{}, p); });
-    expect_one_line_throw<InvalidInput>([&] { pick_handle(mesh, glm::vec3(std::nanf(""), 0.f, 0.f)); });
+    test::expect_one_line_throw<InvalidInput>([&] { pick_handle(TriangleMesh{}, p); });
+    test::expect_one_line_throw<InvalidInput>([&] { pick_handle(mesh, glm::vec3(std::nanf(""), 0.f, 0.f)); });
 }
 
 TEST(PinchEdit, DegenerateInputsThrowOneLineMessagesAndLeaveTheMeshUnchanged)
@@ -503,40 +486,40 @@ TEST(PinchEdit, DegenerateInputsThrowOneLineMessagesAndLeaveTheMeshUnchanged)
     const int h = 5;
     const float nan = std::numeric_limits<float>::quiet_NaN();
 
-    expect_one_line_throw<InvalidInput>([&] { PinchEditor(TriangleMesh{}, 0); });
-    expect_one_line_throw<InvalidInput>([&] { PinchEditor(mesh, -1); });
-    expect_one_line_throw<InvalidInput>([&] { PinchEditor(mesh, int(mesh.vertex_count())); });
+    test::expect_one_line_throw<InvalidInput>([&] { PinchEditor(TriangleMesh{}, 0); });
+    test::expect_one_line_throw<InvalidInput>([&] { PinchEditor(mesh, -1); });
+    test::expect_one_line_throw<InvalidInput>([&] { PinchEditor(mesh, int(mesh.vertex_count())); });
     PinchEditOptions tiny;
     tiny.roi_radius_m = 1e-4; // shorter than every edge: the ROI is the handle alone
-    const std::string no_free = expect_one_line_throw<InvalidInput>([&] { PinchEditor(mesh, h, tiny); });
+    const std::string no_free = test::expect_one_line_throw<InvalidInput>([&] { PinchEditor(mesh, h, tiny); });
     EXPECT_NE(no_free.find("no free vertex"), std::string::npos) << no_free;
     PinchEditOptions bad_radius;
     bad_radius.roi_radius_m = std::nan("");
-    expect_one_line_throw<InvalidInput>([&] { PinchEditor(mesh, h, bad_radius); });
+    test::expect_one_line_throw<InvalidInput>([&] { PinchEditor(mesh, h, bad_radius); });
     {
         TriangleMesh broken = mesh;
         broken.triangles[3][1] = 100000;
-        expect_one_line_throw<InvalidInput>([&] { PinchEditor(broken, h); });
+        test::expect_one_line_throw<InvalidInput>([&] { PinchEditor(broken, h); });
         broken = mesh;
         broken.positions[7].y = nan;
-        expect_one_line_throw<InvalidInput>([&] { PinchEditor(broken, h); });
+        test::expect_one_line_throw<InvalidInput>([&] { PinchEditor(broken, h); });
     }
 
     const PinchEditor editor(mesh, h);
     const glm::vec3 start = mesh.positions[std::size_t(h)];
-    expect_one_line_throw<InvalidInput>([&] { editor.drag_to(glm::vec3(nan, 0.f, 0.f), mesh); });
+    test::expect_one_line_throw<InvalidInput>([&] { editor.drag_to(glm::vec3(nan, 0.f, 0.f), mesh); });
     const std::string too_far =
-        expect_one_line_throw<InvalidInput>([&] { editor.drag_to(start + glm::vec3(0.f, 1.01f, 0.f), mesh); });
+        test::expect_one_line_throw<InvalidInput>([&] { editor.drag_to(start + glm::vec3(0.f, 1.01f, 0.f), mesh); });
     EXPECT_NE(too_far.find("1.01"), std::string::npos) << too_far;
     TriangleMesh other = sphere(5);
-    expect_one_line_throw<InvalidInput>([&] { editor.drag_to(start, other); });
-    expect_one_line_throw<InvalidInput>([&] { laplacian_deform(mesh, h, start + glm::vec3(0.f, 0.f, 1.5f)); });
+    test::expect_one_line_throw<InvalidInput>([&] { editor.drag_to(start, other); });
+    test::expect_one_line_throw<InvalidInput>([&] { laplacian_deform(mesh, h, start + glm::vec3(0.f, 0.f, 1.5f)); });
     EXPECT_TRUE(same_positions(mesh, before));
 
     // Every vertex in one point: all cotangent weights vanish and the system is singular.
     TriangleMesh collapsed = before;
     std::fill(collapsed.positions.begin(), collapsed.positions.end(), glm::vec3(0.1f, 1.0f, 0.0f));
     const TriangleMesh collapsed_before = collapsed;
-    expect_one_line_throw<SolverError>([&] { laplacian_deform(collapsed, h, glm::vec3(0.1f, 1.05f, 0.0f)); });
+    test::expect_one_line_throw<SolverError>([&] { laplacian_deform(collapsed, h, glm::vec3(0.1f, 1.05f, 0.0f)); });
     EXPECT_TRUE(same_positions(collapsed, collapsed_before));
 }
