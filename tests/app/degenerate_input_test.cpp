@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <limits>
 #include <map>
 #include <set>
@@ -26,12 +27,13 @@
 #include "growth/subtree_library.h"
 #include "input/recording.h"
 #include "app/session/session_builder.h"
-#include "input/truth_surface.h"
+#include "tests/support/shapes.h"
 #include "app/session/lobe_document.h"
 #include "meshing/mesh_io.h"
 #include "meshing/model_import.h"
 #include "meshing/remesh.h"
 #include "tests/support/cli_run.h"
+#include "tests/support/test_data.h"
 #include "tests/support/test_paths.h"
 
 using namespace lobe;
@@ -49,6 +51,15 @@ struct Case {
     std::string note;
     std::string path() const { return test::source_path(kRoot + "/" + file); }
 };
+
+/// True when the corpus files named (relative to kRoot) are there; else the test has failed
+/// with one line naming the first one missing.
+bool have_corpus(std::initializer_list<const char*> files, const char* file = __builtin_FILE(), int line = __builtin_LINE())
+{
+    for (const char* f : files)
+        if (test::source_data(kRoot + "/" + f, file, line).empty()) return false;
+    return true;
+}
 
 std::vector<Case> load_cases()
 {
@@ -135,6 +146,7 @@ InputAction stroke_action(const Case& c)
 
 TEST(DegenerateInput, CorpusCoversEveryKindAndEveryFileIsListed)
 {
+    if (!have_corpus({"cases.json"})) return;
     std::map<std::string, int> count;
     std::set<std::string> listed;
     for (const Case& c : cases()) {
@@ -146,15 +158,20 @@ TEST(DegenerateInput, CorpusCoversEveryKindAndEveryFileIsListed)
     for (const char* kind : {"session", "lobes", "stroke", "settings", "species", "recording", "mesh", "model"})
         EXPECT_GE(count[kind], 5) << kind;
     // Every file of the kind folders has its case (a file without one would never be read).
-    for (const auto& [kind, n] : count)
-        for (const auto& f : fs::directory_iterator(test::source_path(kRoot + "/" + kind)))
+    for (const auto& [kind, n] : count) {
+        const std::string folder = test::source_path(kRoot + "/" + kind);
+        if (!test::require_data(folder)) continue;
+        for (const auto& f : fs::directory_iterator(folder))
             EXPECT_TRUE(listed.count(kind + "/" + f.path().filename().string())) << "not in cases.json: " << f.path();
+    }
     RecordProperty("cases", static_cast<int>(cases().size()));
 }
 
 TEST(DegenerateInput, SessionDocumentsAreRefusedInOneLineAndTheOpenDocumentStays)
 {
+    if (!have_corpus({"cases.json", "base-session.json"})) return;
     for (const Case& c : cases_of("session")) {
+        if (!test::require_data(c.path())) continue;
         SCOPED_TRACE(c.file + " (" + c.note + ")");
         Document doc = base_document();
         const json before = document_to_json(doc);
@@ -165,7 +182,9 @@ TEST(DegenerateInput, SessionDocumentsAreRefusedInOneLineAndTheOpenDocumentStays
 
 TEST(DegenerateInput, LobeStrokesThatCannotJoinAreReportedInOneLineAndTheDocumentStays)
 {
+    if (!have_corpus({"cases.json"})) return;
     for (const Case& c : cases_of("lobes")) {
+        if (!test::require_data(c.path())) continue;
         SCOPED_TRACE(c.file + " (" + c.note + ")");
         Document doc;
         ASSERT_NO_THROW(doc = load_document(c.path())) << "a session that loads, whose lobes report a problem";
@@ -186,7 +205,9 @@ TEST(DegenerateInput, LobeStrokesThatCannotJoinAreReportedInOneLineAndTheDocumen
 
 TEST(DegenerateInput, LiveStrokesAreRefusedWithOneMessageAndChangeNothing)
 {
+    if (!have_corpus({"cases.json", "base-session.json"})) return;
     for (const Case& c : cases_of("stroke")) {
+        if (!test::require_data(c.path())) continue;
         SCOPED_TRACE(c.file + " (" + c.note + ")");
         SessionBuilder builder(base_document());
         const json before = document_to_json(builder.document());
@@ -203,6 +224,7 @@ TEST(DegenerateInput, LiveStrokesAreRefusedWithOneMessageAndChangeNothing)
 
 TEST(DegenerateInput, GoodLiveStrokesStillJoin)
 {
+    if (!have_corpus({"base-session.json"})) return;
     // The control: a bent lobe stroke and a straight trunk stroke are taken.
     SessionBuilder builder(base_document());
     InputAction a;
@@ -224,7 +246,9 @@ TEST(DegenerateInput, GoodLiveStrokesStillJoin)
 
 TEST(DegenerateInput, SettingsFilesAreRefusedInOneLine)
 {
+    if (!have_corpus({"cases.json", "base-session.json"})) return;
     for (const Case& c : cases_of("settings")) {
+        if (!test::require_data(c.path())) continue;
         SCOPED_TRACE(c.file + " (" + c.note + ")");
         Document doc = base_document();
         const json before = settings_json(doc.settings);
@@ -238,7 +262,9 @@ TEST(DegenerateInput, SettingsFilesAreRefusedInOneLine)
 
 TEST(DegenerateInput, SpeciesPresetsAreRefusedInOneLineAndSettingsStay)
 {
+    if (!have_corpus({"cases.json"})) return;
     for (const Case& c : cases_of("species")) {
+        if (!test::require_data(c.path())) continue;
         SCOPED_TRACE(c.file + " (" + c.note + ")");
         Settings s;
         const json before = settings_json(s);
@@ -249,7 +275,9 @@ TEST(DegenerateInput, SpeciesPresetsAreRefusedInOneLineAndSettingsStay)
 
 TEST(DegenerateInput, RecordingsAreRefusedInOneLine)
 {
+    if (!have_corpus({"cases.json"})) return;
     for (const Case& c : cases_of("recording")) {
+        if (!test::require_data(c.path())) continue;
         SCOPED_TRACE(c.file + " (" + c.note + ")");
         expect_refused(c, [](const std::string& p) { read_recording(p); });
     }
@@ -257,7 +285,9 @@ TEST(DegenerateInput, RecordingsAreRefusedInOneLine)
 
 TEST(DegenerateInput, MeshesAreRefusedInOneLine)
 {
+    if (!have_corpus({"cases.json"})) return;
     for (const Case& c : cases_of("mesh")) {
+        if (!test::require_data(c.path())) continue;
         SCOPED_TRACE(c.file + " (" + c.note + ")");
         expect_refused(c, [](const std::string& p) { read_mesh(p); });
     }
@@ -265,7 +295,9 @@ TEST(DegenerateInput, MeshesAreRefusedInOneLine)
 
 TEST(DegenerateInput, MeshesThatReadButCannotBecomeALobeAreRefusedInOneLine)
 {
+    if (!have_corpus({"cases.json"})) return;
     for (const Case& c : cases_of("model")) {
+        if (!test::require_data(c.path())) continue;
         SCOPED_TRACE(c.file + " (" + c.note + ")");
         expect_refused(c, [](const std::string& p) { lobe_from_model(p); });
     }
@@ -273,6 +305,10 @@ TEST(DegenerateInput, MeshesThatReadButCannotBecomeALobeAreRefusedInOneLine)
 
 TEST(DegenerateInput, TheCommandLineSaysOneLineAndExitsWithOne)
 {
+    if (!have_corpus({"recording/wrong-magic.lrec", "recording/text-nan-joints.txt", "session/version-unknown.json",
+                      "session/stroke-duplicate-id.json", "base-session.json", "settings/max-nodes-range.json",
+                      "species/max-nodes-range.json"}))
+        return;
     const std::string out = test::temp_dir("degenerate_cli");
     const struct {
         std::string args, file, expect;
@@ -437,10 +473,8 @@ TEST(Limits, TheBuilderRefusesStrokesLobesAndEditsPastTheDocumentLimits)
 
 TEST(Limits, RemeshingRefusesASurfaceThatWouldMakeTooManyTriangles)
 {
-    TruthSurface s;
-    s.center = {0.0, 0.0, 0.0};
-    s.radii = {2.0, 2.0, 2.0}; // about 50 m²: 4.6 million triangles at 5 mm
-    const TriangleMesh sphere = truth_surface_mesh(s, 2);
+    // About 50 m²: 4.6 million triangles at 5 mm.
+    const TriangleMesh sphere = test::ellipsoid({0.0, 0.0, 0.0}, {2.0, 2.0, 2.0}, 2);
     RemeshOptions o;
     o.target_edge_length_m = 0.005;
     try {
@@ -457,15 +491,11 @@ TEST(Limits, RemeshingRefusesASurfaceThatWouldMakeTooManyTriangles)
 
 TEST(Limits, TheWholeTreeStopsAtItsNodeCapAndSaysWhichLobesWereNotGrown)
 {
-    TruthSurface s;
-    s.center = {0.0, 1.4, 0.0};
-    s.radii = {0.17, 0.14, 0.16};
     GrowthLobe a, b;
     a.id = 1;
-    a.mesh = truth_surface_mesh(s, 3);
-    s.center = {0.5, 1.4, 0.0};
+    a.mesh = test::ellipsoid({0.0, 1.4, 0.0}, {0.17, 0.14, 0.16}, 3);
     b.id = 2;
-    b.mesh = truth_surface_mesh(s, 3);
+    b.mesh = test::ellipsoid({0.5, 1.4, 0.0}, {0.17, 0.14, 0.16}, 3);
     const std::vector<std::vector<glm::vec3>> trunk{{{0, 1.0f, 0}, {0, 1.1f, 0}, {0, 1.2f, 0}, {0, 1.3f, 0}}};
     GrowthSettings settings;
     const GrowthResult free = grow_tree(trunk, {a, b}, settings, default_subtree_library(), 1);

@@ -22,6 +22,7 @@
 #include "input/synth.h"
 #include "meshing/mesh_io.h"
 #include "meshing/model_import.h"
+#include "tests/support/test_data.h"
 #include "tests/support/test_paths.h"
 
 using namespace lobe;
@@ -58,7 +59,9 @@ const std::map<std::string, std::function<void(const std::string&)>>& readers()
 
 TEST(FuzzRegressions, EveryFoundInputGivesAOneLineError)
 {
-    const fs::path root = test::source_path("tests/data/fuzz-regressions");
+    const std::string folder = test::source_data("tests/data/fuzz-regressions");
+    if (folder.empty()) return;
+    const fs::path root = folder;
     ASSERT_TRUE(fs::is_directory(root)) << root;
     std::size_t files = 0;
     for (const auto& dir : fs::directory_iterator(root)) {

@@ -3,10 +3,7 @@
 // Run with --benchmark_repetitions=5 --benchmark_report_aggregates_only=true for medians.
 #include <benchmark/benchmark.h>
 
-#include <array>
 #include <cmath>
-#include <map>
-#include <tuple>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -14,48 +11,15 @@
 
 #include "core/mesh.h"
 #include "meshing/laplacian_edit.h"
+#include "tests/support/shapes.h"
 
 using namespace lobe;
 
 namespace {
 
-/// Geodesic sphere of radius 0.25 m: icosahedron faces split into frequency² triangles.
-TriangleMesh sphere_lobe(int frequency)
-{
-    const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-    const std::vector<glm::dvec3> ico = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                                         {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-    const std::vector<std::array<int, 3>> faces = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
-                                                   {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
-                                                   {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
-                                                   {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
-    TriangleMesh mesh;
-    std::map<std::tuple<long long, long long, long long>, int> index;
-    auto vertex = [&](const glm::dvec3& p) {
-        const glm::dvec3 u = glm::normalize(p);
-        const auto key = std::make_tuple(std::llround(u.x * 1e7), std::llround(u.y * 1e7), std::llround(u.z * 1e7));
-        const auto [it, added] = index.emplace(key, int(mesh.positions.size()));
-        if (added)
-            mesh.positions.emplace_back(glm::dvec3(0.0, 1.2, -0.4) + 0.25 * u);
-        return it->second;
-    };
-    const int n = frequency;
-    for (auto f : faces) {
-        const glm::dvec3 a = ico[std::size_t(f[0])], b = ico[std::size_t(f[1])], c = ico[std::size_t(f[2])];
-        auto at = [&](int i, int j) { return vertex(a + (b - a) * (double(i) / n) + (c - a) * (double(j) / n)); };
-        for (int i = 0; i < n; ++i)
-            for (int j = 0; i + j < n; ++j) {
-                mesh.triangles.push_back({at(i, j), at(i + 1, j), at(i, j + 1)});
-                if (i + j + 1 < n)
-                    mesh.triangles.push_back({at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
-            }
-    }
-    return mesh;
-}
-
 const TriangleMesh& lobe_mesh()
 {
-    static const TriangleMesh mesh = sphere_lobe(22); // 4,842 vertices
+    static const TriangleMesh mesh = test::geodesic_sphere(22, glm::dvec3(0.0, 1.2, -0.4), 0.25); // 4,842 vertices
     return mesh;
 }
 

@@ -18,6 +18,7 @@
 #include "meshing/remesh.h"
 #include "tests/bench/cgal_surface_mesh.h"
 #include "tests/support/replay_fixture.h"
+#include "tests/support/shapes.h"
 
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wconversion"
@@ -38,32 +39,7 @@ constexpr double kPi = 3.14159265358979323846;
 const glm::dvec3 kCentre(0.0, 1.4, -0.45);
 constexpr double kRadius = 0.2;
 
-/// Raw stroke points 5 mm apart (the pipeline's minimum point spacing) with 1 mm of wobble.
-std::vector<glm::vec3> raw_loop(const glm::dvec3& centre, const glm::dvec3& u, const glm::dvec3& v, double r, int seed)
-{
-    const int n = static_cast<int>(2 * kPi * r / 0.005);
-    std::vector<glm::vec3> out;
-    for (int i = 0; i < n; ++i) {
-        const double t = 2 * kPi * i / n;
-        const double w = 0.001 * std::sin(7 * t + seed);
-        out.emplace_back(centre + (r + w) * (std::cos(t) * u + std::sin(t) * v));
-    }
-    return out;
-}
-
-std::vector<std::vector<glm::vec3>> ten_strokes()
-{
-    std::vector<std::vector<glm::vec3>> s;
-    for (int k = 0; k < 6; ++k) {
-        const double a = k * kPi / 6;
-        s.push_back(raw_loop(kCentre, {0, 1, 0}, {std::cos(a), 0, std::sin(a)}, kRadius, k));
-    }
-    for (double h : {-0.15, -0.08, 0.08, 0.15}) {
-        const double r = std::sqrt(kRadius * kRadius - h * h);
-        s.push_back(raw_loop(kCentre + glm::dvec3(0, h, 0), {1, 0, 0}, {0, 0, 1}, r, static_cast<int>(h * 100)));
-    }
-    return s;
-}
+using test::raw_loop;
 
 /// The timed adding, apart so that scripts/count-instructions.sh can count it under callgrind.
 [[gnu::noinline]] void add_timed(Lobe& lobe, const LobeStrokeSamples& prepared) { lobe.add_prepared(prepared); }
@@ -94,7 +70,7 @@ Lobe time_adding_stroke(benchmark::State& state, const Lobe& base, const LobeStr
 void BM_AddStrokeToTenStrokeLobe(benchmark::State& state)
 {
     Lobe base;
-    const auto strokes = ten_strokes();
+    const auto strokes = test::ten_stroke_lobe();
     for (std::size_t i = 0; i < strokes.size(); ++i) base.add_stroke(static_cast<std::int64_t>(i + 1), strokes[i]);
     std::vector<glm::vec3> extra;
     if (state.range(0) == 0) extra = raw_loop(kCentre, glm::normalize(glm::dvec3(1, 1, 0)), {0, 0, 1}, kRadius, 11);
@@ -181,7 +157,7 @@ BENCHMARK(BM_PrepareStroke)->Unit(benchmark::kMillisecond);
 void BM_RemeshTenStrokeLobe(benchmark::State& state)
 {
     Lobe lobe;
-    const auto strokes = ten_strokes();
+    const auto strokes = test::ten_stroke_lobe();
     for (std::size_t i = 0; i < strokes.size(); ++i) lobe.add_stroke(static_cast<std::int64_t>(i + 1), strokes[i]);
     RemeshOptions options;
     options.relax_feature_edges = true;
@@ -210,7 +186,7 @@ BENCHMARK(BM_RemeshTenStrokeLobe)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)
 void BM_RemeshAfterEleventhStroke(benchmark::State& state)
 {
     Lobe lobe;
-    const auto strokes = ten_strokes();
+    const auto strokes = test::ten_stroke_lobe();
     for (std::size_t i = 0; i < strokes.size(); ++i) lobe.add_stroke(static_cast<std::int64_t>(i + 1), strokes[i]);
     RemeshOptions options;
     options.iterations = static_cast<unsigned>(LobeSettings{}.remesh_iterations);
@@ -237,7 +213,7 @@ BENCHMARK(BM_RemeshAfterEleventhStroke)->Arg(0)->Arg(1)->Unit(benchmark::kMillis
 void BM_CgalDefaultRemeshTenStrokeLobe10Iterations(benchmark::State& state)
 {
     Lobe lobe;
-    const auto strokes = ten_strokes();
+    const auto strokes = test::ten_stroke_lobe();
     for (std::size_t i = 0; i < strokes.size(); ++i) lobe.add_stroke(static_cast<std::int64_t>(i + 1), strokes[i]);
     const bench::SurfaceMesh input = bench::to_surface_mesh(lobe.surface().mesh);
     bench::SurfaceMesh sm;

@@ -4,10 +4,7 @@
 // Quality of each result is reported as counters. Goal: remesh_isotropic ≤ 20 ms.
 #include <benchmark/benchmark.h>
 
-#include <array>
 #include <cmath>
-#include <map>
-#include <utility>
 #include <vector>
 
 #pragma GCC diagnostic push
@@ -29,6 +26,7 @@
 #include "meshing/mesh_quality.h"
 #include "meshing/remesh.h"
 #include "tests/bench/cgal_surface_mesh.h"
+#include "tests/support/shapes.h"
 
 using namespace lobe;
 using lobe::bench::SurfaceMesh;
@@ -41,40 +39,9 @@ namespace {
 /// bumps of ±2 cm.
 TriangleMesh bumpy_lobe()
 {
-    const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-    std::vector<glm::dvec3> p = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                                 {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-    std::vector<std::array<int, 3>> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
-                                         {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
-                                         {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
-                                         {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
-    for (int l = 0; l < 4; ++l) {
-        std::map<std::pair<int, int>, int> mid;
-        auto midpoint = [&](int a, int b) {
-            const auto key = std::make_pair(std::min(a, b), std::max(a, b));
-            auto it = mid.find(key);
-            if (it != mid.end()) return it->second;
-            p.push_back(0.5 * (p[static_cast<std::size_t>(a)] + p[static_cast<std::size_t>(b)]));
-            return mid[key] = static_cast<int>(p.size()) - 1;
-        };
-        std::vector<std::array<int, 3>> g;
-        for (const auto& tri : f) {
-            const int ab = midpoint(tri[0], tri[1]), bc = midpoint(tri[1], tri[2]), ca = midpoint(tri[2], tri[0]);
-            g.push_back({tri[0], ab, ca});
-            g.push_back({tri[1], bc, ab});
-            g.push_back({tri[2], ca, bc});
-            g.push_back({ab, bc, ca});
-        }
-        f = std::move(g);
-    }
-    TriangleMesh m;
-    for (const auto& q : p) {
-        const glm::dvec3 n = glm::normalize(q);
-        const double r = 0.2 + 0.02 * std::sin(3.0 * n.x) * std::cos(2.0 * n.y + 1.0) * std::sin(2.5 * n.z + 0.5);
-        m.positions.emplace_back(r * n);
-    }
-    m.triangles = f;
-    return m;
+    return test::icosphere(4, [](const glm::dvec3& n) {
+        return 0.2 + 0.02 * std::sin(3.0 * n.x) * std::cos(2.0 * n.y + 1.0) * std::sin(2.5 * n.z + 0.5);
+    });
 }
 
 const TriangleMesh& bench_lobe()

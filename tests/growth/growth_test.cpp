@@ -14,20 +14,14 @@
 #include "growth/skeleton.h"
 #include "growth/species.h"
 #include "growth/subtree_library.h"
-#include "input/truth_surface.h"
+#include "tests/support/shapes.h"
 
 namespace lobe {
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 
-TriangleMesh ellipsoid(glm::dvec3 centre, glm::dvec3 radii, int subdivisions = 3)
-{
-    TruthSurface s;
-    s.center = centre;
-    s.radii = radii;
-    return truth_surface_mesh(s, subdivisions);
-}
+using test::ellipsoid;
 
 glm::vec3 dir_from(double azimuth_deg, double elevation_deg)
 {

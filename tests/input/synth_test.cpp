@@ -18,10 +18,14 @@
 #include "core/errors.h"
 #include "input/synth.h"
 #include "input/tools.h"
+#include "tests/support/expect_throw.h"
+#include "tests/support/shapes.h"
+#include "tests/support/test_data.h"
 #include "tests/support/test_paths.h"
 
 using namespace lobe;
 using json = nlohmann::json;
+using lobe::test::invalid_input_message;
 
 namespace {
 
@@ -42,13 +46,16 @@ const Shipped kShipped[] = {
     {"recordings/edit-stroke-transform.scenario.json", 5, 0, 4, {}},
 };
 
-/// Each shipped scenario synthesized once per test run.
-const SynthResult& shipped(const std::string& file)
+/// Each shipped scenario synthesized once per test run; null when its file is missing (the
+/// test has then failed with one line).
+const SynthResult* shipped(const std::string& file)
 {
+    const std::string path = test::source_data(file);
+    if (path.empty()) return nullptr;
     static std::map<std::string, SynthResult> cache;
     auto it = cache.find(file);
-    if (it == cache.end()) it = cache.emplace(file, synthesize(load_scenario(test::source_path(file)))).first;
-    return it->second;
+    if (it == cache.end()) it = cache.emplace(file, synthesize(load_scenario(path))).first;
+    return &it->second;
 }
 
 bool tracked(const HandState& h)
@@ -134,18 +141,6 @@ json minimal_scenario()
                                                                    json::array({0.2, 1.3, -0.4})})}}})}};
 }
 
-/// The message of the InvalidInput `fn` throws (empty when it throws nothing).
-template <typename Fn>
-std::string invalid_input_message(Fn&& fn)
-{
-    try {
-        fn();
-    } catch (const InvalidInput& e) {
-        return e.what();
-    }
-    return "";
-}
-
 Scenario idle_scenario(double seconds)
 {
     Scenario s;
@@ -187,7 +182,9 @@ double rms(const std::vector<glm::dvec3>& r)
 
 TEST(SynthScenario, SameScenarioGivesBitIdenticalFramesTwice)
 {
-    Scenario s = load_scenario(test::source_path(kShipped[0].file));
+    const std::string path = test::source_data(kShipped[0].file);
+    if (path.empty()) return;
+    Scenario s = load_scenario(path);
     SynthResult a = synthesize(s);
     SynthResult b = synthesize(s);
     ASSERT_EQ(a.recording.frames.size(), b.recording.frames.size());
@@ -210,8 +207,10 @@ TEST(SynthScenario, SameScenarioGivesBitIdenticalFramesTwice)
 TEST(SynthScenario, EveryShippedScenarioParsesWithTheRightStrokeCounts)
 {
     for (const Shipped& sc : kShipped) {
+        const SynthResult* synthesized = shipped(sc.file);
+        if (!synthesized) return;
         SCOPED_TRACE(sc.file);
-        const SynthResult& r = shipped(sc.file);
+        const SynthResult& r = *synthesized;
         int lobes = 0, trunks = 0, drags = 0;
         for (const GroundTruthStroke& g : r.truth) {
             if (g.drag) ++drags;
@@ -244,8 +243,10 @@ TEST(SynthScenario, ShippedStrokesAreWithinArmsReach)
     // Shoulders about 0.23 m below the eyes (1.61–1.69 m) and 0.18 m to the side; an arm
     // reaches about 0.7 m to the index tip.
     for (const Shipped& sc : kShipped) {
+        const SynthResult* synthesized = shipped(sc.file);
+        if (!synthesized) return;
         SCOPED_TRACE(sc.file);
-        for (const GroundTruthStroke& g : shipped(sc.file).truth) {
+        for (const GroundTruthStroke& g : synthesized->truth) {
             const glm::vec3 shoulder(g.hand == Hand::Right ? 0.18f : -0.18f, 1.42f, 0.02f);
             for (const glm::vec3& p : g.points) {
                 ASSERT_LT(glm::distance(p, shoulder), 0.72f);
@@ -274,7 +275,9 @@ TEST(SynthScenario, KidneyLobeOfTheFourLobeTreeIsNonConvex)
         }
         return pos_turns > 0 && neg_turns > 0;
     };
-    const SynthResult& r = shipped(kShipped[1].file);
+    const SynthResult* synthesized = shipped(kShipped[1].file);
+    if (!synthesized) return;
+    const SynthResult& r = *synthesized;
     ASSERT_GE(r.truth.size(), 14u);
     EXPECT_FALSE(turns_both_ways(r.truth[0])) << "the first loop of the top lobe is convex";
     for (std::size_t k = 11; k <= 13; ++k) EXPECT_TRUE(turns_both_ways(r.truth[k])) << "kidney loop " << k;
@@ -283,8 +286,10 @@ TEST(SynthScenario, KidneyLobeOfTheFourLobeTreeIsNonConvex)
 TEST(SynthScenario, ShippedLobeStrokesAreDrawnOnOneSurfacePerLobe)
 {
     for (const Shipped& sc : kShipped) {
+        const SynthResult* synthesized = shipped(sc.file);
+        if (!synthesized) return;
         SCOPED_TRACE(sc.file);
-        const SynthResult& r = shipped(sc.file);
+        const SynthResult& r = *synthesized;
         ASSERT_EQ(r.surfaces.size(), sc.lobe_strokes_per_lobe.size());
         if (sc.lobe_strokes_per_lobe.empty()) continue; // an editing scene without surfaces
         std::vector<double> new_lobe; // N presses: the next lobe stroke starts the next lobe
@@ -313,14 +318,11 @@ TEST(SynthScenario, ShippedLobesAreEnclosedByTheirStrokes)
 {
     // A person enclosing foliage leaves no empty patch wider than about 60° of arc seen from
     // the lobe's centre: every direction is within 30° of a stroke.
-    std::vector<glm::dvec3> probes;
-    for (int i = 0; i < 4000; ++i) {
-        const double z = 1.0 - (2.0 * i + 1.0) / 4000.0, rho = std::sqrt(1.0 - z * z);
-        const double phi = kPi * (3.0 - std::sqrt(5.0)) * i;
-        probes.emplace_back(rho * std::cos(phi), rho * std::sin(phi), z);
-    }
+    const std::vector<glm::dvec3> probes = test::sphere_directions(4000);
     for (const Shipped& sc : kShipped) {
-        const SynthResult& r = shipped(sc.file);
+        const SynthResult* synthesized = shipped(sc.file);
+        if (!synthesized) return;
+        const SynthResult& r = *synthesized;
         for (std::size_t k = 0; k < r.surfaces.size(); ++k) {
             SCOPED_TRACE(std::string(sc.file) + " lobe " + std::to_string(k));
             std::vector<glm::dvec3> dirs;
@@ -345,7 +347,9 @@ TEST(SynthScenario, ShippedLobesAreEnclosedByTheirStrokes)
 
 TEST(SynthScenario, KidneyLobeSurfaceHasADeepWideDentThatItsStrokesCross)
 {
-    const SynthResult& r = shipped(kShipped[1].file);
+    const SynthResult* synthesized = shipped(kShipped[1].file);
+    if (!synthesized) return;
+    const SynthResult& r = *synthesized;
     ASSERT_EQ(r.surfaces.size(), 4u);
     const TruthSurface& kidney = r.surfaces[2];
     ASSERT_EQ(kidney.dents.size(), 1u);
@@ -374,7 +378,9 @@ TEST(SynthScenario, KidneyLobeSurfaceHasADeepWideDentThatItsStrokesCross)
 
 TEST(SynthScenario, PinchEditDragsStartOnTheLobeAndPullFiveCentimetresOutwards)
 {
-    const SynthResult& r = shipped(kShipped[3].file);
+    const SynthResult* synthesized = shipped(kShipped[3].file);
+    if (!synthesized) return;
+    const SynthResult& r = *synthesized;
     ASSERT_EQ(r.surfaces.size(), 1u);
     const TruthSurface& lobe = r.surfaces[0];
     int drags = 0;
@@ -443,8 +449,10 @@ TEST(SynthScenario, SectionStrokesFollowTheirSurfaceInTheAskedDirection)
 TEST(SynthFrames, TimesStrictlyIncreaseAtNinetyHertz)
 {
     for (const Shipped& sc : kShipped) {
+        const SynthResult* synthesized = shipped(sc.file);
+        if (!synthesized) return;
         SCOPED_TRACE(sc.file);
-        const auto& frames = shipped(sc.file).recording.frames;
+        const auto& frames = synthesized->recording.frames;
         EXPECT_EQ(frames.front().time, 0.0);
         for (std::size_t i = 1; i < frames.size(); ++i) {
             double dt = frames[i].time - frames[i - 1].time;
@@ -459,7 +467,9 @@ TEST(SynthFrames, TimesStrictlyIncreaseAtNinetyHertz)
 
 TEST(SynthFrames, HeadStandsAtEyeHeightAndLooksAtTheWork)
 {
-    const auto& frames = shipped(kShipped[0].file).recording.frames;
+    const SynthResult* synthesized = shipped(kShipped[0].file);
+    if (!synthesized) return;
+    const auto& frames = synthesized->recording.frames;
     for (std::size_t i = 0; i < frames.size(); i += 30) {
         const Pose& head = frames[i].head;
         EXPECT_NEAR(head.position.y, 1.65f, 0.07f);
@@ -519,8 +529,10 @@ TEST(SynthFrames, JointsFollowTheOpenXrConventionForBothHands)
 TEST(SynthFrames, OtherHandIsPresentAndTracked)
 {
     for (const Shipped& sc : kShipped) {
+        const SynthResult* synthesized = shipped(sc.file);
+        if (!synthesized) return;
         SCOPED_TRACE(sc.file);
-        const auto& frames = shipped(sc.file).recording.frames;
+        const auto& frames = synthesized->recording.frames;
         std::size_t both = 0;
         for (const HandFrame& f : frames)
             if (tracked(f.hand(Hand::Left)) && tracked(f.hand(Hand::Right))) ++both;
@@ -530,7 +542,9 @@ TEST(SynthFrames, OtherHandIsPresentAndTracked)
 
 TEST(SynthFrames, UniformRadiusOptionGivesEveryJointOneRadiusAndStillPinches)
 {
-    Scenario s = load_scenario(test::source_path(kShipped[0].file));
+    const std::string path = test::source_data(kShipped[0].file);
+    if (path.empty()) return;
+    Scenario s = load_scenario(path);
     s.uniform_joint_radius_m = 0.01;
     SynthResult r = synthesize(s);
     const HandState& h = r.recording.frames[10].hand(Hand::Right);
@@ -549,8 +563,10 @@ TEST(SynthFrames, UniformRadiusOptionGivesEveryJointOneRadiusAndStillPinches)
 TEST(SynthStrokes, IndexTipFollowsTheGroundTruthWithinFourMillimetres)
 {
     for (const Shipped& sc : kShipped) {
+        const SynthResult* synthesized = shipped(sc.file);
+        if (!synthesized) return;
         SCOPED_TRACE(sc.file);
-        const SynthResult& r = shipped(sc.file);
+        const SynthResult& r = *synthesized;
         for (std::size_t k = 0; k < r.truth.size(); ++k) {
             const GroundTruthStroke& g = r.truth[k];
             int n = 0;
@@ -569,8 +585,10 @@ TEST(SynthStrokes, IndexTipStaysOnTheCurveEndsWhileTheThumbCloses)
 {
     // The thumb moves onto the still index tip (0.2–0.4 s), never the other way round.
     for (const Shipped& sc : kShipped) {
+        const SynthResult* synthesized = shipped(sc.file);
+        if (!synthesized) return;
         SCOPED_TRACE(sc.file);
-        const SynthResult& r = shipped(sc.file);
+        const SynthResult& r = *synthesized;
         for (const GroundTruthStroke& g : r.truth)
             for (const HandFrame& f : r.recording.frames) {
                 if (!tracked(f.hand(g.hand))) continue;
@@ -589,8 +607,10 @@ TEST(SynthStrokes, PeakTipSpeedIsBetweenPointTwoAndOneMetrePerSecond)
 {
     // Speed over ±4 frames (89 ms, about one tremor period), skipping drop-outs.
     for (const Shipped& sc : kShipped) {
+        const SynthResult* synthesized = shipped(sc.file);
+        if (!synthesized) return;
         SCOPED_TRACE(sc.file);
-        const SynthResult& r = shipped(sc.file);
+        const SynthResult& r = *synthesized;
         const auto& fr = r.recording.frames;
         for (std::size_t k = 0; k < r.truth.size(); ++k) {
             const GroundTruthStroke& g = r.truth[k];
@@ -617,8 +637,10 @@ TEST(SynthStrokes, PeakTipSpeedIsBetweenPointTwoAndOneMetrePerSecond)
 TEST(SynthPinch, GapIsClosedDuringStrokesAndOpenWellBetweenThem)
 {
     for (const Shipped& sc : kShipped) {
+        const SynthResult* synthesized = shipped(sc.file);
+        if (!synthesized) return;
         SCOPED_TRACE(sc.file);
-        const SynthResult& r = shipped(sc.file);
+        const SynthResult& r = *synthesized;
         const auto& fr = r.recording.frames;
         for (std::size_t k = 0; k < r.truth.size(); ++k) {
             const GroundTruthStroke& g = r.truth[k];
@@ -645,8 +667,10 @@ TEST(SynthPinch, ThumbClosesFromAnOpenGapLikeTheLeapClip)
 {
     // shared/data/real/leap-pinch.json: about 77 mm open, settling near -1 mm pinched.
     for (const Shipped& sc : kShipped) {
+        const SynthResult* synthesized = shipped(sc.file);
+        if (!synthesized) return;
         SCOPED_TRACE(sc.file);
-        const SynthResult& r = shipped(sc.file);
+        const SynthResult& r = *synthesized;
         for (const GroundTruthStroke& g : r.truth) {
             double open = 0.0, closed = 1.0;
             for (const HandFrame& f : r.recording.frames) {
@@ -666,8 +690,10 @@ TEST(SynthDistractors, NearPinchClosestGapIsTwelveToTwentyMillimetres)
 {
     int count = 0;
     for (const Shipped& sc : kShipped) {
+        const SynthResult* synthesized = shipped(sc.file);
+        if (!synthesized) return;
         SCOPED_TRACE(sc.file);
-        const SynthResult& r = shipped(sc.file);
+        const SynthResult& r = *synthesized;
         for (const SynthSpan& s : r.spans) {
             if (s.type != SynthSpan::Type::NearPinch) continue;
             ++count;
@@ -685,8 +711,10 @@ TEST(SynthDistractors, GrabCurlsMiddleRingLittleAndStrokesDoNot)
 {
     int grabs = 0;
     for (const Shipped& sc : kShipped) {
+        const SynthResult* synthesized = shipped(sc.file);
+        if (!synthesized) return;
         SCOPED_TRACE(sc.file);
-        const SynthResult& r = shipped(sc.file);
+        const SynthResult& r = *synthesized;
         for (const SynthSpan& s : r.spans) {
             if (s.type != SynthSpan::Type::Grab) continue;
             ++grabs;
@@ -712,7 +740,11 @@ TEST(SynthDistractors, GrabCurlsMiddleRingLittleAndStrokesDoNot)
 
 TEST(SynthKeys, KeyStepsBecomePressAndReleaseEvents)
 {
-    const auto& events = shipped(kShipped[0].file).recording.events;
+    const SynthResult* one_lobe = shipped(kShipped[0].file);
+    if (!one_lobe) return;
+    const SynthResult* pinch_edit = shipped(kShipped[3].file);
+    if (!pinch_edit) return;
+    const auto& events = one_lobe->recording.events;
     ASSERT_EQ(events.size(), 2u);
     EXPECT_EQ(events[0].kind, InputEventKind::Key);
     EXPECT_EQ(events[0].code, keys::kDrawTrunk);
@@ -721,10 +753,10 @@ TEST(SynthKeys, KeyStepsBecomePressAndReleaseEvents)
     EXPECT_EQ(events[1].value, 0);
     EXPECT_NEAR(events[1].time - events[0].time, 0.08, 0.011);
     // The trunk strokes come after the key.
-    for (const GroundTruthStroke& g : shipped(kShipped[0].file).truth)
+    for (const GroundTruthStroke& g : one_lobe->truth)
         EXPECT_EQ(g.kind == StrokeKind::Trunk, g.t_begin > events[0].time);
 
-    const auto& edit = shipped(kShipped[3].file).recording.events;
+    const auto& edit = pinch_edit->recording.events;
     std::vector<int> pressed;
     for (const InputEvent& e : edit)
         if (e.value == 1) pressed.push_back(e.code);
@@ -748,7 +780,9 @@ TEST(SynthNoise, HighPassJitterOfATipAtRestIsHalfToTwoAndAHalfMillimetres)
         EXPECT_LE(residual, 0.0025) << hand_name(hand);
     }
     // The same on a shipped recording: the idle left hand while the right hand draws.
-    const SynthResult& s = shipped(kShipped[0].file);
+    const SynthResult* synthesized = shipped(kShipped[0].file);
+    if (!synthesized) return;
+    const SynthResult& s = *synthesized;
     const GroundTruthStroke& g = s.truth[0];
     std::vector<glm::dvec3> tip;
     for (const HandFrame& f : s.recording.frames)
@@ -808,8 +842,10 @@ TEST(SynthDropouts, ExistLastFiftyToThreeHundredMsAndStayShortInsideStrokes)
 {
     int inactive = 0, quirk = 0;
     for (const Shipped& sc : kShipped) {
+        const SynthResult* synthesized = shipped(sc.file);
+        if (!synthesized) return;
         SCOPED_TRACE(sc.file);
-        const SynthResult& r = shipped(sc.file);
+        const SynthResult& r = *synthesized;
         const auto& fr = r.recording.frames;
         int runs = 0, in_stroke = 0;
         for (Hand hand : {Hand::Left, Hand::Right}) {
@@ -1046,7 +1082,9 @@ TEST(SynthScenarioErrors, BadFilesGiveOneLineFileErrorsNamingTheFile)
 
 TEST(SynthGroundTruth, JsonRoundTripKeepsEveryField)
 {
-    const SynthResult& r = shipped(kShipped[3].file);
+    const SynthResult* synthesized = shipped(kShipped[3].file);
+    if (!synthesized) return;
+    const SynthResult& r = *synthesized;
     const std::string dir = test::temp_dir("synth-truth");
     const std::string path = dir + "/pinch-edit.truth.json";
     json j = ground_truth_to_json(r.truth, r.surfaces);

@@ -17,29 +17,27 @@
 #include "core/errors.h"
 #include "input/truth_surface.h"
 #include "meshing/polyline.h"
+#include "tests/support/expect_throw.h"
+#include "tests/support/shapes.h"
+#include "tests/support/test_data.h"
 #include "tests/support/test_paths.h"
 
 using namespace lobe;
 using json = nlohmann::json;
 using glm::dvec3;
+using lobe::test::ellipsoid_surface;
+using lobe::test::invalid_input_message;
+using lobe::test::sphere_directions;
 
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180.0;
 
-TruthSurface ellipsoid(const dvec3& center, const dvec3& radii)
-{
-    TruthSurface s;
-    s.center = center;
-    s.radii = radii;
-    return s;
-}
-
 /// The kidney of the four-lobe scene: long front to back, dented 45 mm towards −X.
 TruthSurface kidney()
 {
-    TruthSurface s = ellipsoid(dvec3(0.21, 1.30, -0.46), dvec3(0.10, 0.09, 0.16));
+    TruthSurface s = ellipsoid_surface(dvec3(0.21, 1.30, -0.46), dvec3(0.10, 0.09, 0.16));
     s.dents.push_back({dvec3(-1.0, 0.0, 0.0), 45.0, 65.0});
     return s;
 }
@@ -47,33 +45,10 @@ TruthSurface kidney()
 /// An ellipsoid turned 30° about the vertical.
 TruthSurface turned()
 {
-    TruthSurface s = ellipsoid(dvec3(0.05, 1.40, -0.42), dvec3(0.17, 0.12, 0.08));
+    TruthSurface s = ellipsoid_surface(dvec3(0.05, 1.40, -0.42), dvec3(0.17, 0.12, 0.08));
     const double c = std::cos(30.0 * kDeg), sn = std::sin(30.0 * kDeg);
     s.axes = {dvec3(c, 0.0, -sn), dvec3(0.0, 1.0, 0.0), dvec3(sn, 0.0, c)};
     return s;
-}
-
-std::vector<dvec3> sphere_directions(int n)
-{
-    std::vector<dvec3> out;
-    for (int i = 0; i < n; ++i) {
-        const double z = 1.0 - (2.0 * i + 1.0) / n;
-        const double rho = std::sqrt(1.0 - z * z);
-        const double phi = kPi * (3.0 - std::sqrt(5.0)) * i;
-        out.emplace_back(rho * std::cos(phi), rho * std::sin(phi), z);
-    }
-    return out;
-}
-
-template <typename Fn>
-std::string invalid_input_message(Fn&& fn)
-{
-    try {
-        fn();
-    } catch (const InvalidInput& e) {
-        return e.what();
-    }
-    return "";
 }
 
 /// Largest radial gap of the centripetal Catmull–Rom spline through `ctrl` (the synthesizer's
@@ -118,7 +93,7 @@ json good_surface()
 
 TEST(TruthSurfaceRadius, SphereHasItsRadiusEverywhere)
 {
-    const TruthSurface s = ellipsoid(dvec3(0.0, 1.4, -0.4), dvec3(0.12));
+    const TruthSurface s = ellipsoid_surface(dvec3(0.0, 1.4, -0.4), dvec3(0.12));
     for (const dvec3& u : sphere_directions(200)) {
         EXPECT_NEAR(radius(s, u), 0.12, 1e-12);
         EXPECT_NEAR(glm::distance(point(s, u), s.center), 0.12, 1e-12);
@@ -302,7 +277,7 @@ TEST(TruthSurfaceSection, RefusesMissedGrazedAndSplitSections)
     EXPECT_NE(msg.find("grazes"), std::string::npos) << msg;
 
     // A crater on top of a ball: a plane between its floor and its rim cuts two loops.
-    TruthSurface crater = ellipsoid(dvec3(0.0, 1.4, -0.4), dvec3(0.1));
+    TruthSurface crater = ellipsoid_surface(dvec3(0.0, 1.4, -0.4), dvec3(0.1));
     crater.dents.push_back({dvec3(0.0, 1.0, 0.0), 50.0, 25.0});
     sec.offset_m = 0.075;
     msg = invalid_input_message([&] { section_points(crater, sec, "s"); });
@@ -415,12 +390,15 @@ TEST(TruthSurfaceJson, BadSurfacesGiveOneLineInvalidInputNamingTheField)
 
 TEST(TruthSurfaceShipped, TruthFilesCarryTheScenarioSurfacesAndStrokesLieOnThem)
 {
+    const std::string recordings = test::source_data("recordings");
+    if (recordings.empty()) return;
     int checked = 0;
-    for (const auto& e : std::filesystem::directory_iterator(test::source_path("recordings"))) {
+    for (const auto& e : std::filesystem::directory_iterator(recordings)) {
         const std::string name = e.path().filename().string();
         if (!name.ends_with(".scenario.json")) continue;
-        SCOPED_TRACE(name);
         const std::string stem = e.path().string().substr(0, e.path().string().size() - 14);
+        if (!test::require_data(stem + ".truth.json")) return;
+        SCOPED_TRACE(name);
         json truth, scenario;
         std::ifstream(stem + ".truth.json") >> truth;
         std::ifstream(stem + ".scenario.json") >> scenario;

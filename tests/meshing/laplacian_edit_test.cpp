@@ -1,7 +1,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -13,7 +12,6 @@
 #include <random>
 #include <set>
 #include <string>
-#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -32,6 +30,8 @@
 #include "core/errors.h"
 #include "core/mesh.h"
 #include "meshing/laplacian_edit.h"
+#include "tests/support/expect_throw.h"
+#include "tests/support/shapes.h"
 
 using namespace lobe;
 
@@ -40,47 +40,10 @@ namespace {
 constexpr double kRadius = 0.25;
 const glm::dvec3 kCentre{0.0, 1.2, -0.4};
 
-/// Geodesic sphere: an icosahedron whose faces are split into frequency² triangles,
-/// projected onto the sphere (10·frequency² + 2 vertices). `radial` gives the radius for a
-/// unit direction.
-TriangleMesh geodesic_sphere(int frequency, const std::function<double(const glm::dvec3&)>& radial)
-{
-    const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-    const std::vector<glm::dvec3> ico = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                                         {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-    const std::vector<std::array<int, 3>> faces = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
-                                                   {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
-                                                   {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
-                                                   {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
-    TriangleMesh mesh;
-    std::map<std::tuple<long long, long long, long long>, int> index;
-    auto vertex = [&](const glm::dvec3& p) {
-        const glm::dvec3 u = glm::normalize(p);
-        const auto key = std::make_tuple(std::llround(u.x * 1e7), std::llround(u.y * 1e7), std::llround(u.z * 1e7));
-        const auto [it, added] = index.emplace(key, int(mesh.positions.size()));
-        if (added)
-            mesh.positions.emplace_back(kCentre + radial(u) * u);
-        return it->second;
-    };
-    const int n = frequency;
-    for (auto f : faces) {
-        const glm::dvec3 a = ico[std::size_t(f[0])], b = ico[std::size_t(f[1])], c = ico[std::size_t(f[2])];
-        if (glm::dot(glm::cross(b - a, c - a), a + b + c) < 0.0)
-            throw std::logic_error("icosahedron face not counter-clockwise");
-        auto at = [&](int i, int j) { return vertex(a + (b - a) * (double(i) / n) + (c - a) * (double(j) / n)); };
-        for (int i = 0; i < n; ++i)
-            for (int j = 0; i + j < n; ++j) {
-                mesh.triangles.push_back({at(i, j), at(i + 1, j), at(i, j + 1)});
-                if (i + j + 1 < n)
-                    mesh.triangles.push_back({at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
-            }
-    }
-    return mesh;
-}
-
+/// The test lobe: a geodesic sphere of kRadius about kCentre (frequency 22: 4,842 vertices).
 TriangleMesh sphere(int frequency = 22)
 {
-    return geodesic_sphere(frequency, [](const glm::dvec3&) { return kRadius; });
+    return test::geodesic_sphere(frequency, kCentre, kRadius);
 }
 
 /// Gaussian bump of the given height and width (metres, along the surface) around `axis`.
@@ -149,24 +112,6 @@ std::vector<glm::dvec3> vertex_normals(const TriangleMesh& mesh)
     for (auto& v : n)
         v = glm::normalize(v);
     return n;
-}
-
-/// Calls f, expects an exception of type E with a one-line message, and returns it.
-template <class E, class F> std::string expect_one_line_throw(F&& f)
-{
-    try {
-        f();
-    } catch (const E& e) {
-        const std::string what = e.what();
-        EXPECT_EQ(what.find('\n'), std::string::npos) << what;
-        EXPECT_FALSE(what.empty());
-        return what;
-    } catch (const std::exception& e) {
-        ADD_FAILURE() << "wrong exception type: " << e.what();
-        return {};
-    }
-    ADD_FAILURE() << "no exception";
-    return {};
 }
 
 bool same_positions(const TriangleMesh& a, const TriangleMesh& b)
@@ -380,7 +325,7 @@ TEST(LaplacianEdit, SolveMatchesAnIndependentDenseLeastSquaresSolveOfTheSameEner
 {
     // 362 vertices; a bump makes the cotangent weights uneven.
     const glm::dvec3 axis = glm::normalize(glm::dvec3(0.3, 1.0, 0.1));
-    const TriangleMesh mesh = geodesic_sphere(6, [&](const glm::dvec3& u) { return kRadius + bump_height(u, axis, 0.03, 0.06); });
+    const TriangleMesh mesh = test::geodesic_sphere(6, kCentre, [&](const glm::dvec3& u) { return kRadius + bump_height(u, axis, 0.03, 0.06); });
     ASSERT_EQ(mesh.vertex_count(), 362u);
     const int h = pick_handle(mesh, glm::vec3(kCentre + 0.26 * glm::normalize(glm::dvec3(0.0, 1.0, 0.3))), 0.05);
     const glm::vec3 target = mesh.positions[std::size_t(h)] + glm::vec3(0.03f, 0.06f, -0.02f);
@@ -413,7 +358,7 @@ TEST(LaplacianEdit, BumpInTheRoiKeepsItsHeightProfileFarBetterThanADistanceFallo
     const double height = 0.012, sigma = 0.012;
     const TriangleMesh plain = sphere();
     const TriangleMesh bumpy =
-        geodesic_sphere(22, [&](const glm::dvec3& u) { return kRadius + bump_height(u, bump_axis, height, sigma); });
+        test::geodesic_sphere(22, kCentre, [&](const glm::dvec3& u) { return kRadius + bump_height(u, bump_axis, height, sigma); });
     const int h = vertex_towards(plain, handle_dir);
     const double away = kRadius * std::acos(glm::dot(outward(plain, h), bump_axis));
     ASSERT_GT(away, 0.04);
@@ -528,10 +473,10 @@ TEST(PinchEdit, PickHandleTakesTheNearestVertexWithinReach)
     const glm::vec3 p = mesh.positions[100] + glm::vec3(0.002f, -0.001f, 0.001f);
     EXPECT_EQ(pick_handle(mesh, p), 100);
     const glm::vec3 far = glm::vec3(kCentre + 0.29 * outward(mesh, 100)); // 4 cm off the surface
-    expect_one_line_throw<InvalidInput>([&] { pick_handle(mesh, far); });
+    test::expect_one_line_throw<InvalidInput>([&] { pick_handle(mesh, far); });
     EXPECT_EQ(pick_handle(mesh, far, 0.05), 100);
-    expect_one_line_throw<InvalidInput>([&] { pick_handle(TriangleMesh{}, p); });
-    expect_one_line_throw<InvalidInput>([&] { pick_handle(mesh, glm::vec3(std::nanf(""), 0.f, 0.f)); });
+    test::expect_one_line_throw<InvalidInput>([&] { pick_handle(TriangleMesh{}, p); });
+    test::expect_one_line_throw<InvalidInput>([&] { pick_handle(mesh, glm::vec3(std::nanf(""), 0.f, 0.f)); });
 }
 
 TEST(PinchEdit, DegenerateInputsThrowOneLineMessagesAndLeaveTheMeshUnchanged)
@@ -541,40 +486,40 @@ TEST(PinchEdit, DegenerateInputsThrowOneLineMessagesAndLeaveTheMeshUnchanged)
     const int h = 5;
     const float nan = std::numeric_limits<float>::quiet_NaN();
 
-    expect_one_line_throw<InvalidInput>([&] { PinchEditor(TriangleMesh{}, 0); });
-    expect_one_line_throw<InvalidInput>([&] { PinchEditor(mesh, -1); });
-    expect_one_line_throw<InvalidInput>([&] { PinchEditor(mesh, int(mesh.vertex_count())); });
+    test::expect_one_line_throw<InvalidInput>([&] { PinchEditor(TriangleMesh{}, 0); });
+    test::expect_one_line_throw<InvalidInput>([&] { PinchEditor(mesh, -1); });
+    test::expect_one_line_throw<InvalidInput>([&] { PinchEditor(mesh, int(mesh.vertex_count())); });
     PinchEditOptions tiny;
     tiny.roi_radius_m = 1e-4; // shorter than every edge: the ROI is the handle alone
-    const std::string no_free = expect_one_line_throw<InvalidInput>([&] { PinchEditor(mesh, h, tiny); });
+    const std::string no_free = test::expect_one_line_throw<InvalidInput>([&] { PinchEditor(mesh, h, tiny); });
     EXPECT_NE(no_free.find("no free vertex"), std::string::npos) << no_free;
     PinchEditOptions bad_radius;
     bad_radius.roi_radius_m = std::nan("");
-    expect_one_line_throw<InvalidInput>([&] { PinchEditor(mesh, h, bad_radius); });
+    test::expect_one_line_throw<InvalidInput>([&] { PinchEditor(mesh, h, bad_radius); });
     {
         TriangleMesh broken = mesh;
         broken.triangles[3][1] = 100000;
-        expect_one_line_throw<InvalidInput>([&] { PinchEditor(broken, h); });
+        test::expect_one_line_throw<InvalidInput>([&] { PinchEditor(broken, h); });
         broken = mesh;
         broken.positions[7].y = nan;
-        expect_one_line_throw<InvalidInput>([&] { PinchEditor(broken, h); });
+        test::expect_one_line_throw<InvalidInput>([&] { PinchEditor(broken, h); });
     }
 
     const PinchEditor editor(mesh, h);
     const glm::vec3 start = mesh.positions[std::size_t(h)];
-    expect_one_line_throw<InvalidInput>([&] { editor.drag_to(glm::vec3(nan, 0.f, 0.f), mesh); });
+    test::expect_one_line_throw<InvalidInput>([&] { editor.drag_to(glm::vec3(nan, 0.f, 0.f), mesh); });
     const std::string too_far =
-        expect_one_line_throw<InvalidInput>([&] { editor.drag_to(start + glm::vec3(0.f, 1.01f, 0.f), mesh); });
+        test::expect_one_line_throw<InvalidInput>([&] { editor.drag_to(start + glm::vec3(0.f, 1.01f, 0.f), mesh); });
     EXPECT_NE(too_far.find("1.01"), std::string::npos) << too_far;
     TriangleMesh other = sphere(5);
-    expect_one_line_throw<InvalidInput>([&] { editor.drag_to(start, other); });
-    expect_one_line_throw<InvalidInput>([&] { laplacian_deform(mesh, h, start + glm::vec3(0.f, 0.f, 1.5f)); });
+    test::expect_one_line_throw<InvalidInput>([&] { editor.drag_to(start, other); });
+    test::expect_one_line_throw<InvalidInput>([&] { laplacian_deform(mesh, h, start + glm::vec3(0.f, 0.f, 1.5f)); });
     EXPECT_TRUE(same_positions(mesh, before));
 
     // Every vertex in one point: all cotangent weights vanish and the system is singular.
     TriangleMesh collapsed = before;
     std::fill(collapsed.positions.begin(), collapsed.positions.end(), glm::vec3(0.1f, 1.0f, 0.0f));
     const TriangleMesh collapsed_before = collapsed;
-    expect_one_line_throw<SolverError>([&] { laplacian_deform(collapsed, h, glm::vec3(0.1f, 1.05f, 0.0f)); });
+    test::expect_one_line_throw<SolverError>([&] { laplacian_deform(collapsed, h, glm::vec3(0.1f, 1.05f, 0.0f)); });
     EXPECT_TRUE(same_positions(collapsed, collapsed_before));
 }

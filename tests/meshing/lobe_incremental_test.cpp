@@ -23,38 +23,23 @@
 #include "meshing/mesh_quality.h"
 #include "meshing/repair.h"
 #include "tests/support/replay_fixture.h"
+#include "tests/support/shapes.h"
+#include "tests/support/test_data.h"
 
 namespace lobe {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-/// Raw stroke points 5 mm apart with 1 mm of wobble (as the lobe benchmark draws them).
-std::vector<glm::vec3> raw_loop(const glm::dvec3& centre, const glm::dvec3& u, const glm::dvec3& v, double r, int seed)
-{
-    const int n = static_cast<int>(2 * kPi * r / 0.005);
-    std::vector<glm::vec3> out;
-    for (int i = 0; i < n; ++i) {
-        const double t = 2 * kPi * i / n;
-        const double w = 0.001 * std::sin(7 * t + seed);
-        out.emplace_back(centre + (r + w) * (std::cos(t) * u + std::sin(t) * v));
-    }
-    return out;
-}
+using test::raw_loop;
 
-/// The benchmark's lobe: six loops through the centre 30° apart, four stacked rings, and a
-/// loop tilted by 45° as the eleventh stroke.
+/// The benchmark's lobe: its ten strokes (six loops through the centre 30° apart, four
+/// stacked rings) and a loop tilted by 45° as the eleventh stroke.
 std::vector<std::vector<glm::vec3>> eleven_strokes()
 {
     const glm::dvec3 c(0.0, 1.4, -0.45);
     const double r = 0.2;
-    std::vector<std::vector<glm::vec3>> s;
-    for (int k = 0; k < 6; ++k) {
-        const double a = k * kPi / 6;
-        s.push_back(raw_loop(c, {0, 1, 0}, {std::cos(a), 0, std::sin(a)}, r, k));
-    }
-    for (double h : {-0.15, -0.08, 0.08, 0.15})
-        s.push_back(raw_loop(c + glm::dvec3(0, h, 0), {1, 0, 0}, {0, 0, 1}, std::sqrt(r * r - h * h), static_cast<int>(h * 100)));
+    std::vector<std::vector<glm::vec3>> s = test::ten_stroke_lobe();
     s.push_back(raw_loop(c, glm::normalize(glm::dvec3(1, 1, 0)), {0, 0, 1}, r, 11));
     return s;
 }
@@ -284,6 +269,7 @@ TEST(LobeIncremental, EveryShippedLobeStrokeRemeshesOnlyTheRegionsItChangedAndKe
     std::size_t strokes = 0, regions = 0, remeshed = 0, triangles = 0, unchanged = 0;
     std::vector<double> shares; // per stroke: share of the remeshed lobe's triangles kept
     for (const char* name : {"table1-1lobe-5strokes", "table1-3lobes-16strokes", "table1-4lobes-22strokes", "pinch-edit"}) {
+        if (test::source_data(std::string("recordings/") + name + ".lrec").empty()) return;
         const Document doc = test::replay_document(name);
         RemeshOptions remesh;
         remesh.target_edge_length_m = doc.settings.lobes.edge_length_m;
@@ -380,6 +366,7 @@ TEST(LobeIncremental, ShippedAndRandomLobeStrokesBuildOnlyTheRegionsTheyChangeAn
         changed_only += lobe.last_kept().built_changed_only ? 1 : 0;
     };
     for (const char* name : {"table1-1lobe-5strokes", "table1-3lobes-16strokes", "table1-4lobes-22strokes", "pinch-edit"}) {
+        if (test::source_data(std::string("recordings/") + name + ".lrec").empty()) return;
         const Document doc = test::replay_document(name);
         for (const LobeRecord& rec : doc.lobes) {
             Lobe lobe(lobe_options_from(doc.settings));
@@ -566,6 +553,7 @@ Document first_strokes(Document doc, std::size_t k)
 
 TEST(LobeIncremental, AKeptBuildGivesTheLobesAndWarningsOfABuildFromScratchAndRebuildsOnlyWhatChanged)
 {
+    if (test::source_data("recordings/table1-3lobes-16strokes.lrec").empty()) return;
     const Document full = test::replay_document("table1-3lobes-16strokes");
     ASSERT_EQ(full.lobes.size(), 3u);
     std::size_t most = 0;

@@ -9,6 +9,7 @@
 
 #include "core/errors.h"
 #include "meshing/lobe_transform.h"
+#include "tests/support/expect_throw.h"
 
 using namespace lobe;
 
@@ -31,15 +32,7 @@ void expect_identity(const glm::dmat4& m)
         for (int r = 0; r < 4; ++r) EXPECT_EQ(m[c][r], c == r ? 1.0 : 0.0) << c << "," << r;
 }
 
-template <class F> void expect_invalid_one_line(F&& f)
-{
-    try {
-        f();
-        ADD_FAILURE() << "no exception";
-    } catch (const InvalidInput& e) {
-        EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
-    }
-}
+template <class F> void expect_invalid_one_line(F&& f) { test::expect_one_line_throw<InvalidInput>(f); }
 
 const glm::dvec3 kCentre(0.05, 1.40, -0.42);
 

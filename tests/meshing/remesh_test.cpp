@@ -22,79 +22,17 @@
 #include "meshing/remesh.h"
 #include "meshing/repair.h"
 #include "tests/support/hole_meshes.h"
+#include "tests/support/shapes.h"
+#include "tests/support/test_data.h"
 #include "tests/support/test_paths.h"
 
 using namespace lobe;
 using lobe::test::dome_with_wavy_base;
+using lobe::test::icosphere;
 using lobe::test::sphere_with_slit;
+using lobe::test::uv_sphere;
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
-/// Icosphere of radius r (outward oriented), `levels` rounds of 4-to-1 subdivision.
-TriangleMesh icosphere(int levels, double r, glm::dvec3 centre = glm::dvec3(0.0))
-{
-    const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-    std::vector<glm::dvec3> p = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                                 {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-    std::vector<std::array<int, 3>> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
-                                         {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
-                                         {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
-                                         {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
-    for (int l = 0; l < levels; ++l) {
-        std::map<std::pair<int, int>, int> mid;
-        auto midpoint = [&](int a, int b) {
-            const auto key = std::make_pair(std::min(a, b), std::max(a, b));
-            auto it = mid.find(key);
-            if (it != mid.end()) return it->second;
-            p.push_back(0.5 * (p[static_cast<std::size_t>(a)] + p[static_cast<std::size_t>(b)]));
-            return mid[key] = static_cast<int>(p.size()) - 1;
-        };
-        std::vector<std::array<int, 3>> g;
-        for (const auto& tri : f) {
-            const int ab = midpoint(tri[0], tri[1]), bc = midpoint(tri[1], tri[2]), ca = midpoint(tri[2], tri[0]);
-            g.push_back({tri[0], ab, ca});
-            g.push_back({tri[1], bc, ab});
-            g.push_back({tri[2], ca, bc});
-            g.push_back({ab, bc, ca});
-        }
-        f = std::move(g);
-    }
-    TriangleMesh m;
-    for (const auto& q : p) m.positions.emplace_back(centre + r * glm::normalize(q));
-    m.triangles = f;
-    return m;
-}
-
-/// UV sphere of radius r with `rings` latitude bands (even: the equator is a ring of mesh
-/// edges) and `segments` longitudes; returns the equator loop in `equator`.
-TriangleMesh uv_sphere(int rings, int segments, double r, std::vector<int>& equator)
-{
-    TriangleMesh m;
-    m.positions.emplace_back(0.f, static_cast<float>(r), 0.f);
-    for (int i = 1; i < rings; ++i) {
-        const double th = kPi * i / rings;
-        for (int j = 0; j < segments; ++j) {
-            const double ph = 2.0 * kPi * j / segments;
-            m.positions.emplace_back(glm::dvec3(r * std::sin(th) * std::cos(ph), r * std::cos(th), r * std::sin(th) * std::sin(ph)));
-        }
-    }
-    m.positions.emplace_back(0.f, static_cast<float>(-r), 0.f);
-    const int south = static_cast<int>(m.positions.size()) - 1;
-    auto at = [&](int ring, int j) { return 1 + (ring - 1) * segments + (j % segments); };
-    for (int j = 0; j < segments; ++j) m.triangles.push_back({0, at(1, j + 1), at(1, j)});
-    for (int i = 1; i + 1 < rings; ++i)
-        for (int j = 0; j < segments; ++j) {
-            m.triangles.push_back({at(i, j), at(i, j + 1), at(i + 1, j + 1)});
-            m.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i + 1, j)});
-        }
-    for (int j = 0; j < segments; ++j) m.triangles.push_back({south, at(rings - 1, j), at(rings - 1, j + 1)});
-    equator.clear();
-    for (int j = 0; j < segments; ++j) equator.push_back(at(rings / 2, j));
-    for (int j = 0; j < segments; ++j) m.feature_edges.push_back({equator[static_cast<std::size_t>(j)], equator[static_cast<std::size_t>((j + 1) % segments)]});
-    return m;
-}
 
 double segment_distance(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b)
 {
@@ -155,10 +93,12 @@ struct ModelCase {
     std::size_t max_lt_15;
 };
 
-/// Runs read → repair → normalize → remesh and checks every lobe property.
-void check_model(const ModelCase& c, RepairReport* report_out = nullptr)
+/// Runs read → repair → normalize → remesh and checks every lobe property; false when the
+/// model is missing (the test has then failed with one line).
+bool check_model(const ModelCase& c, RepairReport* report_out = nullptr)
 {
-    const std::string path = test::shared_path(std::string("data/models/") + c.file);
+    const std::string path = test::shared_data(std::string("data/models/") + c.file);
+    if (path.empty()) return false;
     RepairReport report;
     using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();
@@ -219,6 +159,7 @@ void check_model(const ModelCase& c, RepairReport* report_out = nullptr)
     EXPECT_LT(vertex_distance, 0.001) << c.file;
     EXPECT_LT(hausdorff, 0.015) << c.file;
     if (report_out) *report_out = report;
+    return true;
 }
 
 } // namespace
@@ -320,10 +261,17 @@ TriangleMesh repaired_keeping_every_triangle(const TriangleMesh& in, RepairRepor
     return out;
 }
 
-/// The mesh the hole_fill fuzz target makes of its seed `name` (fuzz/corpus/hole_fill/).
-TriangleMesh hole_fill_seed(const std::string& name)
+/// The path of the hole_fill fuzz target's seed `name` (fuzz/corpus/hole_fill/); empty when it
+/// is missing (the test has then failed with one line).
+std::string hole_fill_seed_path(const std::string& name, const char* file = __builtin_FILE(), int line = __builtin_LINE())
 {
-    const std::string bytes = read_file_limited(test::source_path("fuzz/corpus/hole_fill/" + name), 4096);
+    return test::source_data("fuzz/corpus/hole_fill/" + name, file, line);
+}
+
+/// The mesh the hole_fill fuzz target makes of the seed at `path`.
+TriangleMesh hole_fill_seed(const std::string& path)
+{
+    const std::string bytes = read_file_limited(path, 4096);
     return lobe::test::hole_fill_mesh(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size());
 }
 
@@ -388,7 +336,9 @@ TEST(Repair, ALargeBumpyHoleThatIsNoPolygonInItsPlaneGetsTheSearchedPatchNotAFan
     // runs over itself in its plane. A fan crossed the surface so often that the
     // self-intersection removal took 23 s (`lobesketch lobes`, release; over 30 s under
     // ASan); over the Delaunay search's patch, 0.6 s.
-    const TriangleMesh dome = hole_fill_seed("dome-300-edges-bumped");
+    const std::string seed = hole_fill_seed_path("dome-300-edges-bumped");
+    if (seed.empty()) return;
+    const TriangleMesh dome = hole_fill_seed(seed);
     ASSERT_TRUE(self_intersects(dome));
     RepairReport r;
     repaired_closed(dome, r);
@@ -402,8 +352,10 @@ TEST(Repair, ASteepZigZagHoleIsTestedForCrossingsBeforeItIsTriangulatedInItsPlan
     // CGAL's triangulate_face refuses such a polygon only after constructing every crossing
     // exactly (over 30 s under ASan); a sweep tests it first, and the hole gets the searched
     // patch (5.8 s under ASan, 1.2 s in `lobesketch lobes`).
+    const std::string seed = hole_fill_seed_path("dome-400-edges-steep-zigzag");
+    if (seed.empty()) return;
     RepairReport r;
-    repaired_closed(hole_fill_seed("dome-400-edges-steep-zigzag"), r);
+    repaired_closed(hole_fill_seed(seed), r);
     EXPECT_EQ(r.holes_fanned, 0u);
 }
 
@@ -430,8 +382,10 @@ TEST(Repair, ADomeWithAShiftedBaseHasItsCrossingsCutOutAndTheHolesFilled)
     // base of a 316-edge dome shifted into its first band. CGAL's experimental removal
     // smoothed one region for minutes (3.5 min in `lobesketch lobes`, release); cutting out
     // the crossings and filling the holes clears it in three steps (0.24 s).
+    const std::string seed = hole_fill_seed_path("dome-316-edges-shifted-base");
+    if (seed.empty()) return;
     RepairReport r;
-    repaired_without_crossings(hole_fill_seed("dome-316-edges-shifted-base"), r);
+    repaired_without_crossings(hole_fill_seed(seed), r);
 }
 
 TEST(Repair, ADomeFoldedThroughItsFirstBandIsCutClearAndKeepsItsUpperHalf)
@@ -442,8 +396,10 @@ TEST(Repair, ADomeFoldedThroughItsFirstBandIsCutClearAndKeepsItsUpperHalf)
     // over the fuzzer's 30 s under ASan; the cuts take 1.1 s in release. What is cut is the
     // folded band and its patch: the dome above the equator (a unit sphere's upper half,
     // 2π/3 m³) is kept whole.
+    const std::string seed = hole_fill_seed_path("dome-638-edges-folded-and-shifted");
+    if (seed.empty()) return;
     RepairReport r;
-    const TriangleMesh out = repaired_without_crossings(hole_fill_seed("dome-638-edges-folded-and-shifted"), r);
+    const TriangleMesh out = repaired_without_crossings(hole_fill_seed(seed), r);
     EXPECT_GT(measure_quality(out).signed_volume_m3, 2.0 * 3.14159265 / 3.0);
 }
 
@@ -463,7 +419,9 @@ TEST(Repair, ALongThinBandFoldedThroughItselfIsBisectedBeforeTheCutSoTheDomeKeep
     // too: the repaired dome ended at y = −0.64 of the input's −0.99 (volume 3.46 m³). The
     // cut region is now bisected into rungs about six times as long as the triangles are
     // wide, and the dome keeps its height and 92 % of a unit ball's volume.
-    const TriangleMesh dome = hole_fill_seed("dome-400-edges-folding");
+    const std::string seed = hole_fill_seed_path("dome-400-edges-folding");
+    if (seed.empty()) return;
+    const TriangleMesh dome = hole_fill_seed(seed);
     RepairReport r;
     const TriangleMesh out = repaired_without_crossings(dome, r);
     EXPECT_GT(r.bisected_edges, 0u);
@@ -481,8 +439,10 @@ TEST(Repair, TheFifthFindingsDomeKeepsItsLowerHalfWhenItsThinBandsAreBisectedBef
     // next step cuts one ring wider). Cut by rings of whole triangles 22° tall, only a cap
     // 0.08 tall above y = 0.92 was left (0.3 % of a unit ball's volume); bisected first, the
     // dome reaches below its equator (y = −0.32) and encloses 31 %.
+    const std::string seed = hole_fill_seed_path("dome-700-edges-93-waves-moved");
+    if (seed.empty()) return;
     RepairReport r;
-    const TriangleMesh out = repaired_without_crossings(hole_fill_seed("dome-700-edges-93-waves-moved"), r);
+    const TriangleMesh out = repaired_without_crossings(hole_fill_seed(seed), r);
     EXPECT_LT(lowest_y(out), -0.25);
     EXPECT_GT(measure_quality(out).signed_volume_m3, 0.25 * 4.0 * 3.14159265 / 3.0);
 }
@@ -544,7 +504,9 @@ TEST(Repair, TheCowKeepsItsTailWhenItsSelfIntersectionsAreCutOut)
     // 5 %; cutting out only the crossing triangles and a ring round them keeps it, so the
     // repaired cow spans the input's box to within 1.5 % (its rear end is 0.9 % shorter:
     // the cut and refilled region reaches it).
-    const TriangleMesh cow = read_mesh(test::shared_path("data/models/cow.obj"));
+    const std::string cow_path = test::shared_data("data/models/cow.obj");
+    if (cow_path.empty()) return;
+    const TriangleMesh cow = read_mesh(cow_path);
     RepairReport r;
     const TriangleMesh out = repair_mesh(cow, &r);
     EXPECT_GT(r.crossing_pairs, 0u);
@@ -573,10 +535,18 @@ TEST(Repair, ADomeASlitTheCowAndTheBunnyRepairToTheSameMeshWhateverWasRepairedBe
     // slit-247-degrees-searched, whose border runs over itself in its plane and gets the
     // searched patch (repair_cgal.cpp now does both itself: triangulate_in_plane,
     // search_hole_patch). The bunny's holes and the cow's cut go through the search too.
-    const TriangleMesh cow = read_mesh(test::shared_path("data/models/cow.obj"));
-    const TriangleMesh bunny = read_mesh(test::shared_path("data/models/stanford-bunny.obj"));
-    const TriangleMesh dome = hole_fill_seed("dome-400-edges-folding");
-    const TriangleMesh slit = hole_fill_seed("slit-247-degrees-searched");
+    const std::string cow_path = test::shared_data("data/models/cow.obj");
+    if (cow_path.empty()) return;
+    const std::string bunny_path = test::shared_data("data/models/stanford-bunny.obj");
+    if (bunny_path.empty()) return;
+    const std::string dome_path = hole_fill_seed_path("dome-400-edges-folding");
+    if (dome_path.empty()) return;
+    const std::string slit_path = hole_fill_seed_path("slit-247-degrees-searched");
+    if (slit_path.empty()) return;
+    const TriangleMesh cow = read_mesh(cow_path);
+    const TriangleMesh bunny = read_mesh(bunny_path);
+    const TriangleMesh dome = hole_fill_seed(dome_path);
+    const TriangleMesh slit = hole_fill_seed(slit_path);
     RepairReport r;
     const TriangleMesh dome_first = repair_mesh(dome, &r);
     ASSERT_GT(r.bisected_edges, 0u); // the dome went through the cuts and their fills
@@ -614,8 +584,10 @@ TEST(Repair, ALongHoleWhoseBorderRunsOverItselfInItsPlaneIsFilledByAFanFromItsCe
 
 TEST(Repair, SplitsTheCowsNonManifoldVertex)
 {
+    const std::string cow_path = test::shared_data("data/models/cow.obj");
+    if (cow_path.empty()) return;
     RepairReport r;
-    const TriangleMesh out = repair_mesh(read_mesh(test::shared_path("data/models/cow.obj")), &r);
+    const TriangleMesh out = repair_mesh(read_mesh(cow_path), &r);
     EXPECT_GE(r.split_non_manifold_vertices, 1u);
     const MeshQuality q = measure_quality(out);
     EXPECT_TRUE(q.closed && q.manifold && q.outward);
@@ -927,14 +899,14 @@ TEST(Remesh, RejectsNonManifoldAndBadOptions)
 TEST(LobeFromModel, StanfordBunnyWithHolesInItsBase)
 {
     RepairReport r;
-    check_model({"stanford-bunny.obj", 0.95, 0}, &r);
+    if (!check_model({"stanford-bunny.obj", 0.95, 0}, &r)) return;
     EXPECT_GE(r.holes_filled, 1u);
 }
 
 TEST(LobeFromModel, CowWithANonManifoldVertex)
 {
     RepairReport r;
-    check_model({"cow.obj", 0.95, 0}, &r);
+    if (!check_model({"cow.obj", 0.95, 0}, &r)) return;
     EXPECT_GE(r.split_non_manifold_vertices, 1u);
 }
 
@@ -942,8 +914,8 @@ TEST(LobeFromModel, Nefertiti500UnitsAcross) { check_model({"nefertiti.obj", 0.9
 
 TEST(LobeFromModel, SpotThroughTheOneCall)
 {
-    check_model({"spot.obj", 0.95, 0});
-    const TriangleMesh lobe = lobe_from_model(test::shared_path("data/models/spot.obj"));
+    if (!check_model({"spot.obj", 0.95, 0})) return;
+    const TriangleMesh lobe = lobe_from_model(test::shared_data("data/models/spot.obj"));
     const MeshQuality q = measure_quality(lobe);
     EXPECT_TRUE(q.closed && q.manifold && q.outward);
     EXPECT_NEAR(q.edge_mean_m, 0.03, 0.008);

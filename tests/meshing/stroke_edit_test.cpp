@@ -13,6 +13,7 @@
 
 #include "core/errors.h"
 #include "meshing/stroke_edit.h"
+#include "tests/support/expect_throw.h"
 
 using namespace lobe;
 
@@ -57,21 +58,14 @@ double arc(const Stroke& s, const std::vector<int>& idx, std::size_t from, std::
     return len;
 }
 
+/// Calls f, expects an InvalidInput of one line that starts "stroke edit: ", and returns it.
 template <class F> std::string expect_invalid_one_line(F&& f)
 {
-    try {
-        f();
-    } catch (const InvalidInput& e) {
-        const std::string what = e.what();
-        EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    const std::string what = test::expect_one_line_throw<InvalidInput>(f);
+    if (!what.empty()) {
         EXPECT_EQ(what.rfind("stroke edit: ", 0), 0u) << what;
-        return what;
-    } catch (const std::exception& e) {
-        ADD_FAILURE() << "wrong exception type: " << e.what();
-        return {};
     }
-    ADD_FAILURE() << "no exception";
-    return {};
+    return what;
 }
 
 void expect_same_stroke(const Stroke& a, const Stroke& b)

@@ -1,7 +1,8 @@
 #pragma once
 // A shipped recording replayed into a session document (through the same input pipeline,
 // session builder and edit hooks as `lobesketch replay`) and its lobes, for tests and
-// benchmarks of what comes after.
+// benchmarks of what comes after. These read recordings/<name>.lrec as it is (a missing one
+// throws FileError): a test asks for it with source_data (tests/support/test_data.h) first.
 #include <string>
 #include <vector>
 

@@ -26,6 +26,7 @@
 #include "app/session/session_builder.h"
 #include "input/tools.h"
 #include "tests/support/cli_run.h"
+#include "tests/support/test_data.h"
 #include "tests/support/test_paths.h"
 
 namespace lobe {
@@ -34,7 +35,6 @@ namespace {
 namespace fs = std::filesystem;
 using test::cli_path;
 using test::run_cli;
-using test::source_path;
 using test::temp_dir;
 
 constexpr int kW = 640, kH = 360;
@@ -555,6 +555,8 @@ TEST(DesktopSession, RecordingReplaysToTheSameDocument)
 
 TEST(DesktopSession, ImportedMeshIsALobeAtTheFingertipAndTheRecordingReplaysIt)
 {
+    const std::string spot = test::shared_data("data/models/spot.obj");
+    if (spot.empty()) return;
     const std::string dir = temp_dir("desktop_import");
     Document live;
     glm::vec3 tip(0.0f);
@@ -565,7 +567,7 @@ TEST(DesktopSession, ImportedMeshIsALobeAtTheFingertipAndTheRecordingReplaysIt)
         d.step(3);
         EXPECT_FALSE(s.import_mesh(dir + "/missing.obj"));
         EXPECT_EQ(s.status().last_message.rfind("import: ", 0), 0u) << s.status().last_message;
-        ASSERT_TRUE(s.import_mesh(test::shared_path("data/models/spot.obj"), 0.5)) << s.status().last_message;
+        ASSERT_TRUE(s.import_mesh(spot, 0.5)) << s.status().last_message;
         // Made on its own thread: it goes in with the first frame after it is done.
         EXPECT_TRUE(s.status().importing);
         EXPECT_TRUE(s.document().lobes.empty());
@@ -609,6 +611,8 @@ TEST(DesktopSession, ImportedMeshIsALobeAtTheFingertipAndTheRecordingReplaysIt)
 
 TEST(DesktopSession, AnImportIsMadeBesideTheFramesOneAtATimeAndABadFileIsReportedWhenItEnds)
 {
+    const std::string cow = test::shared_data("data/models/cow.obj");
+    if (cow.empty()) return;
     const std::string dir = temp_dir("desktop_import_async");
     DesktopSession s(Document{}, quiet_options(dir));
     Driver d{s};
@@ -622,7 +626,7 @@ TEST(DesktopSession, AnImportIsMadeBesideTheFramesOneAtATimeAndABadFileIsReporte
     }
     ASSERT_TRUE(s.import_mesh(bad));
     // One import at a time: a second one while the first is being made is refused.
-    EXPECT_FALSE(s.import_mesh(test::shared_path("data/models/cow.obj")));
+    EXPECT_FALSE(s.import_mesh(cow));
     EXPECT_EQ(s.status().last_message, "import: another import is still being made");
     s.wait_for_import();
     d.step(2);
@@ -631,7 +635,7 @@ TEST(DesktopSession, AnImportIsMadeBesideTheFramesOneAtATimeAndABadFileIsReporte
     EXPECT_EQ(s.status().last_message.find('\n'), std::string::npos);
     EXPECT_TRUE(s.document().lobes.empty());
     // The next import works; frames drawn while it is being made go on as usual.
-    ASSERT_TRUE(s.import_mesh(test::shared_path("data/models/cow.obj"), 0.8)) << s.status().last_message;
+    ASSERT_TRUE(s.import_mesh(cow, 0.8)) << s.status().last_message;
     const std::uint64_t revision = s.status().revision;
     while (s.status().importing) {
         d.step();
@@ -715,10 +719,12 @@ std::vector<nlohmann::json> read_marks(const std::string& path)
 TEST(DesktopApp, ScriptedMouseSessionInAWindowExercisesEveryToolAndReplaysAlike)
 {
     if (!have_xvfb()) GTEST_SKIP() << "xvfb-run is missing (scripts/setup.sh installs package xvfb)";
+    const std::string script = test::source_data("tests/data/desktop_every_tool.script");
+    if (script.empty()) return;
     const std::string dir = temp_dir("desktop_app");
     const std::string session = dir + "/tree.json";
     const test::CliRun r = run_shell(xvfb(session + " --size 720x360 --software --samples 1 --script " +
-                                          source_path("tests/data/desktop_every_tool.script") + " --script-log " + dir +
+                                          script + " --script-log " + dir +
                                           "/marks.jsonl --record " + dir + "/tree.lrec --screenshot " + dir + "/shot.png"));
     ASSERT_EQ(r.code, 0) << r.out;
     const auto marks = read_marks(dir + "/marks.jsonl");
@@ -783,6 +789,8 @@ TEST(DesktopApp, ScriptedMouseSessionInAWindowExercisesEveryToolAndReplaysAlike)
 TEST(DesktopApp, CorruptSessionOffersTheAutosaveAndOverwritesNothing)
 {
     if (!have_xvfb()) GTEST_SKIP() << "xvfb-run is missing (scripts/setup.sh installs package xvfb)";
+    const std::string script = test::source_data("tests/data/desktop_save.script");
+    if (script.empty()) return;
     const std::string dir = temp_dir("desktop_corrupt");
     const std::string session = dir + "/tree.json";
     const std::string corrupt = "{\"version\": 1, \"strokes\": [ {\"id\": 1, \"points\": [[0, 1,";
@@ -799,7 +807,7 @@ TEST(DesktopApp, CorruptSessionOffersTheAutosaveAndOverwritesNothing)
     EXPECT_EQ(read_file_limited(session, 1u << 20), corrupt) << "the damaged file is left as it was";
 
     const test::CliRun rec = run_shell(xvfb(session + " --recover --size 320x240 --software --frames 3 --script " +
-                                            source_path("tests/data/desktop_save.script")));
+                                            script));
     ASSERT_EQ(rec.code, 0) << rec.out;
     EXPECT_EQ(read_file_limited(session, 1u << 20), corrupt);
     const Document recovered = load_document(dir + "/tree.recovered.json");

