@@ -10,16 +10,9 @@
 #include <glm/geometric.hpp>
 #include <glm/trigonometric.hpp>
 
-#include "app/live/autosave.h"
-#include "app/session/edit_hooks.h"
 #include "app/render/render_scene.h"
 #include "app/render/scene_parts.h"
-#include "app/export/tree_output.h"
 #include "core/errors.h"
-#include "app/session/edit_ops.h"
-#include "meshing/mesh_io.h"
-#include "meshing/mesh_quality.h"
-#include "meshing/model_import.h"
 
 namespace lobe {
 
@@ -27,7 +20,6 @@ namespace {
 
 constexpr float kOrbitDegPerPixel = 0.3f;
 constexpr float kDepthStepM = 0.02f; ///< fingertip plane step per wheel notch at 2 m
-constexpr std::size_t kMaxMessages = 200;
 constexpr std::uint64_t kDynamicKey = 9ull << 56;
 
 /// Colours of the simulated hand and the stroke being drawn (linear RGB).
@@ -73,33 +65,19 @@ glm::vec3 OrbitCamera::ray(glm::vec2 pixel, int width, int height) const
 
 // ---------------------------------------------------------------------------------------------
 DesktopSession::DesktopSession(Document doc, DesktopOptions options)
-    : options_(std::move(options)), pipeline_(doc.settings.input)
 {
-    if (!options_.record_path.empty()) {
-        RecordingHeader header;
-        header.source = "lobesketch desktop";
-        header.device = "mouse (simulated right hand)";
-        header.nominal_rate_hz = 60.0;
-        // Flushed every 6 frames (0.1 s at 60 Hz): a crash loses at most that much input.
-        recording_ = std::make_unique<RecordingWriter>(options_.record_path, header, 6);
-        doc.source_recording = std::filesystem::absolute(options_.record_path).lexically_normal().string();
-    }
-    // A loaded document's position in its old recording no longer holds; the saves of this
-    // session stamp theirs (at_recording_position).
-    doc.recording_frames.reset();
-    doc.recording_finished = false;
-    EditHooks hooks = meshing_edit_hooks();
-    // Imports of this session, by number (the recording's ImportMesh events).
-    hooks.import_model = [this](int n) {
-        const auto it = imports_.find(n);
-        if (it == imports_.end()) throw InvalidInput("import " + std::to_string(n) + " was not made in this session");
-        return it->second;
-    };
-    builder_ = std::make_unique<SessionBuilder>(std::move(doc), EditPickOptions{}, std::move(hooks));
-    if (!options_.autosave_path.empty()) autosaver_ = std::make_unique<AutosaveWriter>(options_.autosave_path);
-    worker_ = std::make_unique<RegrowWorker>();
-    if (!document().strokes.empty()) request_regrowth();
-    rebuild_static_scene();
+    LiveSessionOptions o;
+    o.session_path = std::move(options.session_path);
+    o.autosave_path = std::move(options.autosave_path);
+    o.record_path = std::move(options.record_path);
+    o.export_path = std::move(options.export_path);
+    o.recording_header.source = "lobesketch desktop";
+    o.recording_header.device = "mouse (simulated right hand)";
+    o.recording_header.nominal_rate_hz = 60.0;
+    o.recording_flush_frames = 6; // 0.1 s at 60 Hz
+    o.background_regrowth = options.background_regrowth;
+    o.lod = 0; // the whole tree; the window lowers it when frames take too long
+    live_ = std::make_unique<LiveSession>(std::move(doc), std::move(o));
     frame_view_on_scene();
 }
 
@@ -110,18 +88,6 @@ DesktopSession::~DesktopSession()
     } catch (const Error&) {
         // A recording that cannot be flushed at exit: nothing more can be done here.
     }
-}
-
-void DesktopSession::note(std::string line)
-{
-    status_.last_message = line;
-    messages_.push_back(std::move(line));
-    while (messages_.size() > kMaxMessages) messages_.pop_front();
-}
-
-void DesktopSession::record(const InputEvent& e)
-{
-    if (recording_) recording_->append(e);
 }
 
 void DesktopSession::mouse_move(float x, float y)
@@ -173,74 +139,22 @@ void DesktopSession::setting(int id, std::int64_t lobe_id, double value)
 
 bool DesktopSession::import_mesh(const std::string& path, double size_m)
 {
-    const Document& doc = document();
-    LobeFromModelOptions o;
-    o.size_m = size_m;
-    o.target_edge_length_m = doc.settings.lobes.edge_length_m;
-    o.iterations = static_cast<unsigned>(doc.settings.lobes.remesh_iterations);
-    try {
-        if (import_) throw InvalidInput("another import is still being made");
-        if (!(size_m > 0.01 && size_m <= 100.0)) throw InvalidInput("the size must be in (0.01, 100] m");
-        std::error_code ec;
-        if (!std::filesystem::is_regular_file(path, ec)) throw FileError(path, "not found, or not a file");
-    } catch (const Error& e) {
-        note(std::string("import: ") + e.what());
-        return false;
-    }
-    const int n = static_cast<int>(imports_.size()) + 1;
-    // Beside the recording, so that replaying it imports the same mesh.
-    const std::string beside = recording_ ? import_mesh_path(options_.record_path, n) : std::string();
-    auto make = [path, o, beside]() {
-        TriangleMesh mesh = lobe_from_model(path, o);
-        // Centred on the origin; the import event places it at the fingertip.
-        glm::dvec3 lo, hi;
-        bounding_box(mesh, lo, hi);
-        const glm::dvec3 centre = 0.5 * (lo + hi);
-        for (glm::vec3& p : mesh.positions) p = glm::vec3(glm::dvec3(p) - centre);
-        std::string source = std::filesystem::path(path).filename().string();
-        if (!beside.empty()) {
-            write_ply(beside, mesh);
-            source = std::filesystem::path(beside).filename().string();
-        }
-        return std::make_shared<const LobeModel>(LobeModel{source, std::move(mesh)});
-    };
-    try {
-        import_ = PendingImport{n, path, std::async(std::launch::async, std::move(make))};
-    } catch (const std::system_error& e) {
-        note(std::string("import: no thread to make it on: ") + e.what());
-        return false;
-    }
-    status_.importing = true;
-    note("importing " + path + " ...");
-    return true;
+    const bool started = live_->import_mesh(path, size_m);
+    status_.importing = live_->importing();
+    status_.last_message = live_->last_message();
+    return started;
 }
 
 void DesktopSession::take_import(bool wait)
 {
-    if (!import_) return;
-    if (!wait && import_->model.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
-    PendingImport done = std::move(*import_);
-    import_.reset();
-    status_.importing = false;
-    try {
-        imports_[done.number] = done.model.get();
-    } catch (const Error& e) {
-        note(std::string("import: ") + e.what());
-        return;
-    } catch (const std::exception& e) {
-        note("import: " + one_line_message(done.path + ": " + e.what()));
-        return;
-    }
-    InputEvent e;
-    e.kind = InputEventKind::ImportMesh;
-    e.code = done.number;
-    pending_.push_back(e);
-    note("imported " + done.path + " as a lobe at the fingertip");
+    // A finished import goes in with this frame's input, placed at the fingertip.
+    if (std::optional<InputEvent> e = live_->take_import(wait)) pending_.push_back(*e);
+    status_.importing = live_->importing();
 }
 
 void DesktopSession::wait_for_import() { take_import(true); }
 
-void DesktopSession::handle(const InputEvent& e, int width, int height)
+void DesktopSession::handle(const InputEvent& e, int height)
 {
     using namespace desktop_keys;
     switch (e.kind) {
@@ -287,21 +201,24 @@ void DesktopSession::handle(const InputEvent& e, int width, int height)
         break;
     default: break;
     }
-    (void)width;
 }
 
 void DesktopSession::frame(double time, int width, int height)
 {
-    if (finished_) return;
+    if (live_->finished()) return;
     time_ = time > time_ ? time : time_ + 1e-4;
-    take_import(false); // a finished import goes in with this frame's input
+    take_import(false);
+    // Where the ground is drawn while nothing is: around the point the camera circles.
+    Bounds around;
+    around.add(orbit_.target - glm::vec3(0.5f));
+    around.add(orbit_.target + glm::vec3(0.5f));
+    live_->view().set_empty_area(around);
     std::vector<int> commands;
     for (InputEvent& e : pending_) {
         e.time = time_;
-        handle(e, width, height);
-        record(e);
+        handle(e, height);
         if (e.kind == InputEventKind::Key && e.value == 1) commands.push_back(e.code);
-        pipeline_.push_event(e); // the pipeline acts on key presses and settings only
+        live_->push_event(e); // recorded; the pipeline acts on key presses and settings only
     }
     pending_.clear();
 
@@ -312,12 +229,8 @@ void DesktopSession::frame(double time, int width, int height)
     pose.tip = orbit_.eye() + ray * (depth / std::max(0.05f, glm::dot(ray, pose.forward)));
     pose.pinched = pinch_;
     const HandFrame hand_frame = desktop_frame(time_, pose, cursor_seen_ && cursor_inside_);
-    pipeline_.push_frame(hand_frame);
-    if (recording_) {
-        recording_->append(hand_frame);
-        ++frames_recorded_;
-    }
-    apply_actions();
+    live_->push_frame(hand_frame);
+    live_->apply_actions();
 
     for (int code : commands) {
         if (code == desktop_keys::kSave) save();
@@ -325,193 +238,43 @@ void DesktopSession::frame(double time, int width, int height)
         if (code == desktop_keys::kFrame) frame_view_on_scene();
         if (code == desktop_keys::kQuit) quit_ = true;
     }
+    live_->update();
 
-    if (options_.background_regrowth) take_regrowth(worker_->take());
-    report_autosave_failures();
-
-    const HandGesture& g = pipeline_.gestures().hand(Hand::Right);
-    status_.tool = pipeline_.tool();
-    status_.grown = grown_;
+    const InputPipeline& pipeline = live_->pipeline();
+    const HandGesture& g = pipeline.gestures().hand(Hand::Right);
+    status_.tool = pipeline.tool();
+    status_.grown = live_->grown();
     status_.pinching = g.pinching;
-    status_.drawing = pipeline_.drawing(Hand::Right);
-    status_.regrowing = requested_generation_ > 0 && (!built_ || built_->generation < requested_generation_);
+    status_.drawing = pipeline.drawing(Hand::Right);
+    status_.regrowing = live_->regrowing();
+    status_.importing = live_->importing();
     status_.depth_m = depth;
     status_.tip = pose.tip;
     status_.strokes = document().strokes.size();
     status_.lobes = document().lobes.size();
     status_.edits = document().edits.size();
-    status_.revision = revision_;
+    status_.revision = live_->revision();
+    status_.last_message = live_->last_message();
+    status_.tree_error = live_->tree_error();
+    status_.lod = live_->view().lod_shown();
+    status_.tree_triangles = live_->view().tree_triangles();
     last_hand_ = hand_frame.hand(Hand::Right);
-    update_live_edits();
-    add_dynamic_items();
+    add_frame_items();
 }
 
-void DesktopSession::update_live_edits()
+void DesktopSession::add_frame_items()
 {
-    // The lobes and the tree follow an editing drag at the regrowth's pace; when it ends
-    // without an edit, the document's own are grown again.
-    DragPreview::Step preview = drag_preview_.update(pipeline_, *builder_, !worker_->has_waiting());
-    if (preview.preview) submit_preview(std::move(*preview.preview));
-    else if (preview.ended && preview_generation_ > requested_generation_) request_regrowth();
-
-    const std::uint64_t have = built_ ? built_->generation : 0;
-    const std::vector<BuiltLobe>* lobes = built_ ? &built_->tree.lobes : nullptr;
-    const bool pinch = live_pinch_.update(pipeline_, *builder_, lobes, have, requested_generation_);
-    const bool moved = live_transform_.update(pipeline_, *builder_, lobes, have, requested_generation_);
-    if (live_stroke_edit_.update(pipeline_, *builder_)) {
-        // A bent stroke's tube alone; the document's strokes again when the drag is over.
-        const Stroke* bent = live_stroke_edit_.stroke();
-        if (!bent || !replace_stroke_item(scene_, *bent)) {
-            rebuild_static_scene();
-            return;
-        }
-    }
-    if (!pinch && !moved) return;
-    // Only the lobe's item (and a moved lobe's strokes) change while it is dragged; when the
-    // edit ends, the lobes and strokes as built.
-    bool shown = false;
-    if (built_)
-        for (std::size_t i = 0; i < built_->tree.lobes.size(); ++i)
-            if (const TriangleMesh* m = live_lobe(built_->tree.lobes[i].lobe_id)) {
-                shown = replace_lobe_item(scene_, i, *m);
-                break;
-            }
-    if (shown && moved) {
-        if (live_transform_.strokes().empty()) shown = false; // released: the document's strokes again
-        for (const Stroke& st : live_transform_.strokes()) shown = replace_stroke_item(scene_, st) && shown;
-    }
-    if (!shown) rebuild_static_scene();
-}
-
-const TriangleMesh* DesktopSession::live_lobe(std::int64_t lobe_id) const
-{
-    const std::uint64_t have = built_ ? built_->generation : 0;
-    if (const TriangleMesh* m = live_pinch_.mesh_for(lobe_id, pipeline_, have, requested_generation_)) return m;
-    return live_transform_.mesh_for(lobe_id, have, requested_generation_);
-}
-
-void DesktopSession::apply_actions()
-{
-    bool changed = false;
-    for (const InputAction& a : pipeline_.take_actions()) {
-        if (a.type == InputAction::Type::StrokeDiscarded) note("stroke discarded: " + a.message);
-        if (a.type == InputAction::Type::Grow && !grown_) {
-            grown_ = true;
-            note("growing the tree");
-            request_regrowth();
-        }
-        if (builder_->apply(a)) changed = true;
-    }
-    const auto& builder_messages = builder_->messages();
-    for (; builder_messages_seen_ < builder_messages.size(); ++builder_messages_seen_)
-        note(builder_messages[builder_messages_seen_]);
-    if (changed) document_changed();
-}
-
-void DesktopSession::document_changed()
-{
-    ++revision_;
-    autosave();
-    request_regrowth();
-    rebuild_static_scene(); // strokes show at once; lobes and the tree follow the regrowth
-}
-
-void DesktopSession::autosave()
-{
-    if (!autosaver_) return;
-    // As in the VR session: the recording flushed here, the JSON and the disk on the writer's
-    // thread, so the window never waits for them (docs/crash-safety.md). Without background
-    // regrowth (scripted runs) it is on disk before the frame ends.
-    const std::string why = autosaver_->submit_after_change(recording_.get(), document(), frames_recorded_, finished_,
-                                                            !options_.background_regrowth);
-    if (!why.empty()) note("autosave failed: " + why);
-}
-
-void DesktopSession::report_autosave_failures()
-{
-    if (!autosaver_) return;
-    for (const std::string& why : autosaver_->take_failures()) note("autosave failed: " + why);
-}
-
-void DesktopSession::request_regrowth()
-{
-    requested_generation_ = worker_->submit(document(), grown_);
-    if (!options_.background_regrowth) take_regrowth(worker_->wait_for(requested_generation_));
-}
-
-void DesktopSession::wait_for_regrowth()
-{
-    if (built_ && built_->generation >= requested_generation_) return;
-    if (requested_generation_ == 0) return;
-    take_regrowth(worker_->wait_for(requested_generation_));
-}
-
-void DesktopSession::submit_preview(Document doc)
-{
-    preview_generation_ = worker_->submit(std::move(doc), grown_);
-    if (!options_.background_regrowth) take_regrowth(worker_->wait_for(preview_generation_));
-}
-
-void DesktopSession::take_regrowth(std::optional<RegrowResult> result)
-{
-    if (!result) return;
-    if (built_ && result->generation < built_->generation) return;
-    // A drag preview's result (asked for after the last change of the document) is shown; what
-    // it reports goes to the status line alone (preview_report).
-    if (result->generation <= requested_generation_) {
-        status_.tree_error = result->error;
-        if (!result->error.empty()) note("tree: " + result->error);
-        for (const std::string& w : result->tree.warnings) note(w);
-    } else if (std::string report = preview_report(*result); !report.empty()) {
-        status_.last_message = std::move(report);
-    }
-    built_ = std::move(result);
-    rebuild_static_scene();
-}
-
-void DesktopSession::rebuild_static_scene()
-{
-    std::vector<TriangleMesh> lobes;
-    const TreeGeometry empty;
-    const TreeGeometry* geometry = &empty;
-    if (built_) {
-        for (const BuiltLobe& l : built_->tree.lobes) {
-            const TriangleMesh* live = live_lobe(l.lobe_id);
-            lobes.push_back(live ? *live : l.mesh);
-        }
-        if (built_->grown && grown_ && !built_->geometry.lods.empty()) geometry = &built_->geometry;
-    }
-    RenderContent content;
-    content.tree = content.leaves = geometry != &empty;
-    content.lobes = content.strokes = true;
-    content.lod = content.tree ? std::min(lod_, int(geometry->lods.size()) - 1) : 0;
-    status_.lod = content.lod;
-    status_.tree_triangles = content.tree ? lod_triangles(geometry->lods[std::size_t(content.lod)]) : 0;
-    std::vector<Stroke> strokes = effective_strokes(document());
-    live_transform_.apply_to(strokes);
-    live_stroke_edit_.apply_to(strokes);
-    scene_ = tree_render_scene(*geometry, lobes, strokes, 0.0f, content);
-    Bounds area = scene_bounds(scene_);
-    if (area.empty()) {
-        area.add(orbit_.target - glm::vec3(0.5f));
-        area.add(orbit_.target + glm::vec3(0.5f));
-    }
-    scene_.ground_area = area;
-    static_items_ = scene_.items.size();
-}
-
-void DesktopSession::add_dynamic_items()
-{
-    scene_.items.resize(static_items_);
+    RenderScene& scene = live_->begin_frame_items();
+    const std::size_t first = scene.items.size();
     auto add = [&](RenderMaterial material, std::array<float, 4> color, SurfaceGeometry g) {
         if (g.triangles.empty()) return;
         RenderItem item;
-        item.key = kDynamicKey | (scene_.items.size() - static_items_);
+        item.key = kDynamicKey | (scene.items.size() - first);
         item.version = ++dynamic_version_;
         item.material = material;
         item.color = color;
         item.geometry = std::move(g);
-        scene_.items.push_back(std::move(item));
+        scene.items.push_back(std::move(item));
     };
     if (last_hand_.active) {
         SurfaceGeometry hand = hand_geometry(last_hand_);
@@ -521,7 +284,7 @@ void DesktopSession::add_dynamic_items()
         add(RenderMaterial::Stroke, tool_color(status_.tool), std::move(marker));
     }
     if (status_.drawing) {
-        const Stroke& s = pipeline_.current_stroke(Hand::Right);
+        const Stroke& s = live_->pipeline().current_stroke(Hand::Right);
         std::vector<glm::vec3> pts;
         for (const StrokePoint& p : s.points) pts.push_back(p.position);
         const Tool t = status_.tool;
@@ -532,91 +295,50 @@ void DesktopSession::add_dynamic_items()
 
 bool DesktopSession::save()
 {
-    if (options_.session_path.empty()) {
-        note("save: no session file (start with `lobesketch desktop SESSION.json`)");
-        return false;
-    }
-    try {
-        if (recording_ && !finished_) recording_->flush(); // closed once finished
-        save_document(options_.session_path,
-                      at_recording_position(document(), recording_ != nullptr, frames_recorded_, finished_));
-        note("saved " + options_.session_path);
-        return true;
-    } catch (const Error& e) {
-        note(std::string("save failed: ") + e.what());
-        return false;
-    }
+    const bool ok = live_->save();
+    status_.last_message = live_->last_message();
+    return ok;
 }
 
 bool DesktopSession::export_tree()
 {
-    if (!grown_) {
-        note("export: grow the tree first (G)");
-        return false;
-    }
-    wait_for_regrowth();
-    if (!built_ || !built_->grown || built_->geometry.lods.empty()) {
-        note("export: there is no tree to export" + (status_.tree_error.empty() ? "" : ": " + status_.tree_error));
-        return false;
-    }
-    if (options_.export_path.empty()) {
-        note("export: no export file");
-        return false;
-    }
-    try {
-        ExportOptions o;
-        o.include_lobes = o.include_strokes = true;
-        write_tree_file(options_.export_path, document(), built_->tree, built_->geometry, o);
-        note("exported " + options_.export_path + " (" + lod_triangle_summary(built_->geometry) + ")");
-        return true;
-    } catch (const Error& e) {
-        note(std::string("export failed: ") + e.what());
-        return false;
-    }
+    const bool ok = live_->export_tree();
+    status_.last_message = live_->last_message();
+    return ok;
 }
 
 void DesktopSession::set_lod(int lod)
 {
-    lod = std::clamp(lod, 0, 7);
-    if (lod == lod_) return;
-    lod_ = lod;
-    rebuild_static_scene();
-    add_dynamic_items();
+    live_->set_lod(lod);
+    status_.lod = live_->view().lod_shown();
+    status_.tree_triangles = live_->view().tree_triangles();
+    add_frame_items();
 }
 
 void DesktopSession::frame_view_on_scene()
 {
     Bounds b;
-    for (std::size_t i = 0; i < std::min(static_items_, scene_.items.size()); ++i)
-        for (const glm::vec3& p : scene_.items[i].geometry.positions) b.add(p);
+    const RenderScene& scene = live_->scene();
+    for (std::size_t i = 0; i < std::min(live_->view().static_items(), scene.items.size()); ++i)
+        for (const glm::vec3& p : scene.items[i].geometry.positions) b.add(p);
     if (b.empty()) return; // nothing drawn yet: keep the default view
     const Camera c = frame_view(b, {orbit_.azimuth_deg, orbit_.elevation_deg}, 1.6f, orbit_.fov_y_deg, 0.1f);
     orbit_.target = c.target;
     orbit_.distance_m = std::max(0.2f, glm::length(c.eye - c.target));
 }
 
+void DesktopSession::wait_for_regrowth() { live_->wait_for_regrowth(); }
+
 void DesktopSession::finish(double time)
 {
-    if (finished_) return;
+    if (live_->finished()) return;
     take_import(true); // an import still being made goes in last, not lost
     for (InputEvent& e : pending_) {
         e.time = std::max(time, time_);
-        record(e);
-        pipeline_.push_event(e);
+        live_->push_event(e);
     }
     pending_.clear();
-    pipeline_.finish();
-    finished_ = true; // an autosave from here on holds the end of the recording too
-    const std::uint64_t revision = revision_;
-    apply_actions();
-    // The end changed nothing: the last autosave still says so, for `recover` to see that
-    // nothing of the recording is left to replay.
-    if (revision_ == revision && revision_ > 0) autosave();
-    if (autosaver_) {
-        autosaver_->wait();
-        report_autosave_failures();
-    }
-    if (recording_) recording_->close();
+    live_->close(live_->finish_input());
 }
 
 } // namespace lobe

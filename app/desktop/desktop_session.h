@@ -1,15 +1,15 @@
 #pragma once
 /// \file desktop_session.h
-/// The desktop app without its window: an orbit camera, the mouse as a simulated fingertip
-/// on a camera-facing plane, the same input pipeline and session builder as replay, the
-/// session's recording, save and autosave, live regrowth off the drawing thread, and the
-/// scene to draw. `lobesketch desktop` (app/cli/cli_desktop.cpp) feeds it GLFW's input and
-/// presents its scene; tests feed it directly. Controls: docs/desktop.md.
+/// The desktop app without its window: a thin adapter around the live session both apps
+/// share (app/live/live_session.h: pipeline, session builder, recording, autosave, regrowth
+/// off the drawing thread, live edits, save and export). What is the desktop's own: an orbit
+/// camera, the mouse as a simulated fingertip on a camera-facing plane, the keys the desktop
+/// handles itself, the status its panel shows. The window (app/desktop/desktop_window.h)
+/// feeds it GLFW's input and presents its scene; tests feed it directly. Controls:
+/// docs/desktop.md.
 
 #include <cstdint>
 #include <deque>
-#include <future>
-#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -18,18 +18,11 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
-#include "app/live/autosave.h"
-#include "app/live/drag_preview.h"
-#include "app/live/live_pinch.h"
-#include "app/live/live_stroke_edit.h"
-#include "app/live/live_transform.h"
-#include "app/live/regrow_worker.h"
+#include "app/live/live_session.h"
 #include "app/render/renderer.h"
 #include "core/document.h"
 #include "input/desktop_hand.h"
 #include "input/pipeline.h"
-#include "input/recording.h"
-#include "app/session/session_builder.h"
 
 namespace lobe {
 
@@ -125,13 +118,13 @@ public:
 
     /// The scene to draw now (the tree or lobes last built, the strokes, the hand, the stroke
     /// being drawn). Valid until the next frame().
-    const RenderScene& scene() const { return scene_; }
+    const RenderScene& scene() const { return live_->scene(); }
     Camera camera() const { return orbit_.camera(); }
     OrbitCamera& orbit() { return orbit_; }
-    const Document& document() const { return builder_->document(); }
+    const Document& document() const { return live_->document(); }
     const DesktopStatus& status() const { return status_; }
     /// Every warning and result line so far, oldest first (at most the last 200).
-    const std::deque<std::string>& messages() const { return messages_; }
+    const std::deque<std::string>& messages() const { return live_->messages(); }
     /// True once the Quit key was pressed.
     bool quit_requested() const { return quit_; }
 
@@ -142,7 +135,7 @@ public:
     /// Level of detail the tree is drawn at (clamped to the LODs it has); the app lowers it
     /// when frames take too long.
     void set_lod(int lod);
-    int lod() const { return lod_; }
+    int lod() const { return live_->view().lod(); }
     /// Frames the camera on everything drawn (the strokes when nothing is built).
     void frame_view_on_scene();
     /// Waits until the lobes/tree of the current document are built (scripted runs).
@@ -151,65 +144,22 @@ public:
     void finish(double time);
 
 private:
-    void handle(const InputEvent& e, int width, int height);
-    void apply_actions();
-    void document_changed();
-    void autosave();
-    void report_autosave_failures();
-    void request_regrowth();
-    void take_regrowth(std::optional<RegrowResult> result);
-    void rebuild_static_scene();
-    void update_live_edits();
-    void submit_preview(Document doc);
-    /// The lobe shown in place of lobe `lobe_id` while it is edited live (pinched, moved); null: the built one.
-    const TriangleMesh* live_lobe(std::int64_t lobe_id) const;
-    void add_dynamic_items();
-    void note(std::string line);
-    void record(const InputEvent& e);
+    void handle(const InputEvent& e, int height);
     void take_import(bool wait);
+    void add_frame_items();
 
-    DesktopOptions options_;
     OrbitCamera orbit_;
-    InputPipeline pipeline_;
-    std::unique_ptr<SessionBuilder> builder_;
-    std::unique_ptr<RecordingWriter> recording_;
-    std::unique_ptr<AutosaveWriter> autosaver_; ///< writes the autosaves beside the frames (app/live/autosave.h)
-    std::unique_ptr<RegrowWorker> worker_;
-
+    std::unique_ptr<LiveSession> live_;
     std::vector<InputEvent> pending_;
-    std::map<int, std::shared_ptr<const LobeModel>> imports_; ///< this session's imports by number
-    /// The import being made on its own thread: its number, file and result.
-    struct PendingImport {
-        int number = 0;
-        std::string path;
-        std::future<std::shared_ptr<const LobeModel>> model;
-    };
-    std::optional<PendingImport> import_;
     glm::vec2 cursor_{0.0f};
     bool cursor_seen_ = false, cursor_inside_ = true, ui_capture_ = false;
     bool left_down_ = false, right_down_ = false, middle_down_ = false, shift_ = false, pinch_ = false;
-    bool quit_ = false, finished_ = false;
+    bool quit_ = false;
     float depth_m_ = 0.0f; ///< fingertip plane distance from the eye (0: through the orbit target)
     double time_ = 0.0;
-    std::uint64_t frames_recorded_ = 0; ///< hand frames appended to the recording (Document::recording_frames)
-
-    bool grown_ = false;
-    int lod_ = 0;
-    std::uint64_t revision_ = 0, requested_generation_ = 0;
-    std::optional<RegrowResult> built_; ///< the newest regrowth result
-    std::size_t builder_messages_seen_ = 0;
-
-    LivePinchView live_pinch_; ///< the lobe being deformed while the pinch is dragged
-    LiveTransformView live_transform_; ///< the lobe being moved, turned or scaled while dragged
-    LiveStrokeEditView live_stroke_edit_; ///< the stroke being bent while dragged
-    DragPreview drag_preview_; ///< the document as an editing drag would leave it, regrown while it goes on
-    std::uint64_t preview_generation_ = 0; ///< the regrowth last asked for a drag preview
     HandState last_hand_; ///< the simulated hand of the last frame (drawn)
-    RenderScene scene_;
-    std::size_t static_items_ = 0;
     std::uint64_t dynamic_version_ = 0;
     DesktopStatus status_;
-    std::deque<std::string> messages_;
 };
 
 } // namespace lobe

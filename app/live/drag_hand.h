@@ -1,7 +1,7 @@
 #pragma once
 /// \file drag_hand.h
-/// Which hand's editing drag a live view follows (live_pinch.h, live_transform.h,
-/// live_stroke_edit.h, drag_preview.h): the hand it already follows while that hand still
+/// Which hand's editing drag a live view follows (live_edit_view.h,
+/// drag_preview.h): the hand it already follows while that hand still
 /// drags, else the first of right and left whose drag `wanted` accepts; and where that drag
 /// ends now.
 

@@ -5,7 +5,7 @@
 /// operation the session builder would append for the drag so far (the path's first point to
 /// the fingertip). The desktop and VR sessions hand it to their regrowth worker, so the lobes
 /// and the tree follow the drag at the worker's pace, not only after the release; the live
-/// views (live_pinch.h, live_transform.h, live_stroke_edit.h) follow it every frame.
+/// edit views (live_edit_view.h) follow it every frame.
 /// Nothing of it enters the document, the recording or the autosave.
 
 #include <optional>

@@ -10,36 +10,18 @@
 #include <glm/gtc/constants.hpp>
 #include <glm/mat3x3.hpp>
 
-#include "app/live/autosave.h"
-#include "app/session/edit_hooks.h"
 #include "app/export/export_scene.h"
-#include "app/live/drag_preview.h"
-#include "app/live/live_pinch.h"
-#include "app/live/live_stroke_edit.h"
-#include "app/live/live_transform.h"
 #include "app/render/render_scene.h"
 #include "app/render/scene_parts.h"
-#include "app/export/tree_output.h"
 #include "core/errors.h"
 
 namespace lobe {
 
 namespace {
 
-constexpr std::size_t kMaxMessages = 200;
 constexpr std::uint64_t kDynamicKey = 10ull << 56;
 constexpr std::uint64_t kPanelKey = kDynamicKey | (1ull << 40);
 constexpr std::uint64_t kPhotoKey = kDynamicKey | (2ull << 40);
-
-/// What a stroke's tube is made from (its points, round again when closed), hashed.
-std::uint64_t stroke_fingerprint(const Stroke& st)
-{
-    std::vector<glm::vec3> pts;
-    pts.reserve(st.points.size() + 1);
-    for (const StrokePoint& p : st.points) pts.push_back(p.position);
-    if (st.closed && pts.size() > 2) pts.push_back(pts.front());
-    return bytes_hash(pts.data(), pts.size() * sizeof(glm::vec3));
-}
 
 // Panel geometry (metres) and poke thresholds. A fingertip presses a button when it reaches
 // kPressDepth in front of the board (or goes through it) inside the button, having come from
@@ -161,41 +143,22 @@ VrPanel vr_panel_layout(const Pose& head)
     }
     return panel;
 }
-
-/// The regrowth's part of the VR scene (lobes; the tree's middle LOD once grown: the full one
-/// is for export and pictures, docs/vr.md), made on the regrowth worker's thread
-/// (RegrowWorker's prepare hook) with its bounds in ground_area, so that taking a new tree
-/// costs the frame only moves.
-void prepare_grown_scene(RegrowResult& r)
-{
-    std::vector<TriangleMesh> lobes;
-    lobes.reserve(r.tree.lobes.size());
-    for (const BuiltLobe& l : r.tree.lobes) lobes.push_back(l.mesh);
-    RenderContent content;
-    content.tree = content.leaves = r.grown && !r.geometry.lods.empty();
-    content.lobes = true;
-    content.strokes = false;
-    content.lod = content.tree ? std::min(1, int(r.geometry.lods.size()) - 1) : 0;
-    r.scene = tree_render_scene(r.geometry, lobes, {}, 0.0f, content);
-    r.scene.ground_area = scene_bounds(r.scene);
-}
-
 // ---------------------------------------------------------------------------------------------
+/// What is the VR app's own around the live session: the recording's clock and event track,
+/// the panel and its pokes, the two-handed scene grab, the reference photo, the hands and
+/// labels drawn each frame.
 struct VrSession::Impl {
     VrSession& self;
+    LiveSession& live;
+    const InputPipeline& pipeline;
     VrOptions options;
-    InputPipeline pipeline;
-    std::unique_ptr<RecordingWriter> recording;
-    std::unique_ptr<AutosaveWriter> autosaver;
-    std::unique_ptr<RegrowWorker> worker;
 
     std::vector<InputEvent> pending;  ///< panel presses and scene moves, applied by the next frame
     std::size_t next_replay_event = 0; ///< into options.events
     std::size_t next_clock = 0;        ///< into options.clock
     bool panel_placed = false;
     double time = 0.0;
-    bool started = false, finished = false;
-    std::uint64_t frames_recorded = 0;
+    bool started = false;
 
     // Panel pokes, per hand.
     std::array<bool, kHandCount> armed{};
@@ -218,67 +181,24 @@ struct VrSession::Impl {
     glm::quat photo_orientation{1.0f, 0.0f, 0.0f, 0.0f};
     std::uint64_t photo_version = 0;
 
-    bool grown = false;
-    std::uint64_t revision = 0, requested_generation = 0, dynamic_version = 0;
-    std::optional<RegrowResult> built;
-    std::size_t builder_messages_seen = 0;
-    // The scene's items: [0, grown_items) the regrowth's lobes and tree (made on the worker),
-    // [grown_items, static_items) the strokes, then the hands, panel and labels of this frame.
-    std::size_t grown_items = 0, static_items = 0;
-    Bounds grown_bounds, stroke_bounds;
-    struct StrokeTube {
-        std::int64_t id = 0;
-        std::uint64_t fingerprint = 0; ///< of the points the tube was made from
-    };
-    /// What scene_.items[grown_items, static_items) were made from, in order: a stroke's tube
-    /// is made again only when its points changed.
-    std::vector<StrokeTube> stroke_tubes;
+    std::uint64_t dynamic_version = 0;
     HandFrame last_frame;
-    // The lobe being deformed live (app/live/live_pinch.h): which grown item shows it, and the
-    // regrowth generation whose items those are.
-    LivePinchView live_pinch;
-    LiveTransformView live_transform; ///< the lobe being moved, turned or scaled live, with its strokes
-    LiveStrokeEditView live_stroke_edit; ///< the stroke being bent live
-    DragPreview drag_preview; ///< the document as an editing drag would leave it, regrown while it goes on
-    std::uint64_t preview_generation = 0; ///< the regrowth last asked for a drag preview
-    std::optional<std::size_t> live_shown;
-    std::uint64_t live_shown_generation = 0;
 
-    Impl(VrSession& s, VrOptions o, const Document& doc) : self(s), options(std::move(o)), pipeline(doc.settings.input) {}
+    Impl(VrSession& s, LiveSession& l, VrOptions o) : self(s), live(l), pipeline(l.pipeline()), options(std::move(o)) {}
 
-    SessionBuilder& builder() { return *self.builder_; }
-    const Document& document() const { return self.builder_->document(); }
-
-    void note(std::string line)
-    {
-        self.status_.last_message = line;
-        self.messages_.push_back(std::move(line));
-        while (self.messages_.size() > kMaxMessages) self.messages_.pop_front();
-    }
+    const Document& document() const { return live.document(); }
 
     void push(const InputEvent& e, std::vector<int>& commands)
     {
-        if (recording) recording->append(e);
         if (e.kind == InputEventKind::Key && e.value == 1) commands.push_back(e.code);
-        pipeline.push_event(e);
+        live.push_event(e);
     }
 
     void frame(const HandFrame& input);
-    void apply_actions();
     void run_commands(const std::vector<int>& commands, const HandFrame& f);
     void poke_panel(const HandFrame& f);
     void press(const VrButton& b, int index);
     void grab_scene(const HandFrame& f);
-    void document_changed();
-    void request_regrowth();
-    void submit_preview(Document doc);
-    void take_regrowth(std::optional<RegrowResult> result);
-    void update_live_edits();
-    void refresh_stroke_item(const Stroke& stroke);
-    void rebuild_stroke_items();
-    void update_ground_area();
-    void autosave();
-    void report_autosave_failures();
     void add_dynamic_items();
     void update_status();
 };
@@ -310,39 +230,17 @@ void VrSession::Impl::frame(const HandFrame& input)
     }
     pending.clear();
 
-    pipeline.push_frame(f);
-    if (recording) recording->append(f);
-    ++frames_recorded;
-    apply_actions();
+    live.push_frame(f);
+    live.apply_actions();
     run_commands(commands, f);
 
     if (panel_placed) poke_panel(f);
     grab_scene(f);
 
-    if (options.background_regrowth) take_regrowth(worker->take());
-    update_live_edits();
-    report_autosave_failures();
+    live.update();
     last_frame = f;
     update_status();
     add_dynamic_items();
-}
-
-void VrSession::Impl::apply_actions()
-{
-    bool changed = false;
-    for (const InputAction& a : pipeline.take_actions()) {
-        if (a.type == InputAction::Type::StrokeDiscarded) note("stroke discarded: " + a.message);
-        if (a.type == InputAction::Type::Grow && !grown) {
-            grown = true;
-            note("growing the tree");
-            request_regrowth();
-        }
-        if (builder().apply(a)) changed = true;
-    }
-    const auto& builder_messages = builder().messages();
-    for (; builder_messages_seen < builder_messages.size(); ++builder_messages_seen)
-        note(builder_messages[builder_messages_seen]);
-    if (changed) document_changed();
 }
 
 void VrSession::Impl::run_commands(const std::vector<int>& commands, const HandFrame& f)
@@ -353,13 +251,13 @@ void VrSession::Impl::run_commands(const std::vector<int>& commands, const HandF
         if (code == vr_keys::kQuit) self.quit_ = true;
         if (code == vr_keys::kPlacePhoto) {
             if (photo.pixels.empty()) {
-                note("photo: no picture (start with --photo FILE)");
+                live.note("photo: no picture (start with --photo FILE)");
                 continue;
             }
             const HandState& right = f.hand(Hand::Right);
             const HandGesture& g = pipeline.gestures().hand(Hand::Right);
             if (!g.tracked || !right.active) {
-                note("photo: the right hand is not tracked");
+                live.note("photo: the right hand is not tracked");
                 continue;
             }
             const SceneTransform& t = pipeline.scene_transform();
@@ -368,7 +266,7 @@ void VrSession::Impl::run_commands(const std::vector<int>& commands, const HandF
             const glm::vec3 head = f.head_valid ? f.head.position : g.index_tip + glm::vec3(0, 0, 1);
             photo_orientation = glm::inverse(t.rotation()) * facing(g.index_tip, head, true);
             ++photo_version;
-            note("photo placed");
+            live.note("photo placed");
         }
     }
 }
@@ -501,207 +399,30 @@ void VrSession::Impl::grab_scene(const HandFrame& f)
     send(SceneComponent::TranslationZ, t.translation.z, now.translation.z);
 }
 
-void VrSession::Impl::document_changed()
-{
-    ++revision;
-    autosave();
-    request_regrowth();
-    rebuild_stroke_items(); // strokes show at once; lobes and the tree follow the regrowth
-}
-
-void VrSession::Impl::autosave()
-{
-    if (!autosaver) return;
-    // The recording is flushed on this thread (a write of at most 9 frames, no sync), so that
-    // whichever autosave is on disk when the program dies, the recording holds all it holds;
-    // the JSON and the disk are the writer thread's (app/live/autosave.h). Without background
-    // regrowth (tests) it is on disk before the frame ends.
-    const std::string why = autosaver->submit_after_change(recording.get(), document(), frames_recorded, finished,
-                                                           !options.background_regrowth);
-    if (!why.empty()) note("autosave failed: " + why);
-}
-
-void VrSession::Impl::report_autosave_failures()
-{
-    if (!autosaver) return;
-    for (const std::string& why : autosaver->take_failures()) note("autosave failed: " + why);
-}
-
-void VrSession::Impl::request_regrowth()
-{
-    requested_generation = worker->submit(document(), grown);
-    if (!options.background_regrowth) take_regrowth(worker->wait_for(requested_generation));
-}
-
-void VrSession::Impl::submit_preview(Document doc)
-{
-    preview_generation = worker->submit(std::move(doc), grown);
-    if (!options.background_regrowth) take_regrowth(worker->wait_for(preview_generation));
-}
-
-void VrSession::Impl::take_regrowth(std::optional<RegrowResult> result)
-{
-    if (!result) return;
-    if (built && result->generation < built->generation) return;
-    // A drag preview's result (asked for after the last change of the document) is shown; what
-    // it reports goes to the status line alone (preview_report).
-    if (result->generation <= requested_generation) {
-        self.status_.tree_error = result->error;
-        if (!result->error.empty()) note("tree: " + result->error);
-        for (const std::string& w : result->tree.warnings) note(w);
-    } else if (std::string report = preview_report(*result); !report.empty()) {
-        self.status_.last_message = std::move(report);
-    }
-    RenderScene& scene = self.scene_;
-    // The regrowth's items, made on the worker (prepare_grown_scene), replace the old ones;
-    // the strokes' items stay as they are.
-    scene.items.resize(static_items); // this frame's hands and panel are added again
-    scene.items.erase(scene.items.begin(), scene.items.begin() + std::ptrdiff_t(grown_items));
-    static_items -= grown_items;
-    grown_items = result->scene.items.size();
-    static_items += grown_items;
-    scene.items.insert(scene.items.begin(), std::make_move_iterator(result->scene.items.begin()),
-                       std::make_move_iterator(result->scene.items.end()));
-    result->scene.items.clear();
-    scene.leaf_texture = std::move(result->scene.leaf_texture);
-    scene.leaf_texture_version = result->scene.leaf_texture_version;
-    grown_bounds = result->scene.ground_area;
-    built = std::move(result);
-    update_ground_area();
-}
-
-void VrSession::Impl::update_live_edits()
-{
-    // The lobes and the tree follow an editing drag at the regrowth's pace; when it ends
-    // without an edit, the document's own are grown again.
-    DragPreview::Step preview = drag_preview.update(pipeline, builder(), !worker->has_waiting());
-    if (preview.preview) submit_preview(std::move(*preview.preview));
-    else if (preview.ended && preview_generation > requested_generation) request_regrowth();
-
-    const std::uint64_t have = built ? built->generation : 0;
-    const std::vector<BuiltLobe>* lobes = built ? &built->tree.lobes : nullptr;
-    const bool pinched = live_pinch.update(pipeline, builder(), lobes, have, requested_generation);
-    const bool moved = live_transform.update(pipeline, builder(), lobes, have, requested_generation);
-    // A bent stroke's tube and a moved lobe's strokes: as dragged, or the document's again
-    // once the drag is over.
-    std::vector<std::int64_t> put_back;
-    if (live_stroke_edit.update(pipeline, builder())) {
-        if (const Stroke* bent = live_stroke_edit.stroke()) refresh_stroke_item(*bent);
-        else put_back.push_back(live_stroke_edit.bent_stroke_id());
-    }
-    if (moved) {
-        for (const Stroke& st : live_transform.strokes()) refresh_stroke_item(st);
-        if (live_transform.strokes().empty())
-            put_back.insert(put_back.end(), live_transform.moved_stroke_ids().begin(), live_transform.moved_stroke_ids().end());
-    }
-    if (!put_back.empty())
-        for (const Stroke& st : effective_strokes(document()))
-            if (std::find(put_back.begin(), put_back.end(), st.id) != put_back.end()) refresh_stroke_item(st);
-    // A new regrowth result brought its own lobe items: the edited lobe goes into them again.
-    const bool fresh = have != live_shown_generation;
-    if (!pinched && !moved && !fresh) return;
-    RenderScene& scene = self.scene_;
-    if (live_shown && !fresh && built && *live_shown < built->tree.lobes.size())
-        replace_lobe_item(scene, *live_shown, built->tree.lobes[*live_shown].mesh);
-    live_shown.reset();
-    live_shown_generation = have;
-    if (!built) return;
-    for (std::size_t i = 0; i < built->tree.lobes.size(); ++i) {
-        const std::int64_t id = built->tree.lobes[i].lobe_id;
-        const TriangleMesh* m = live_pinch.mesh_for(id, pipeline, have, requested_generation);
-        if (!m) m = live_transform.mesh_for(id, have, requested_generation);
-        if (m) {
-            if (replace_lobe_item(scene, i, *m)) live_shown = i;
-            break;
-        }
-    }
-}
-
-void VrSession::Impl::refresh_stroke_item(const Stroke& stroke)
-{
-    // The tube and the fingerprint rebuild_stroke_items keeps for it, so that the next
-    // rebuild makes the tube again exactly when the document's points differ from these.
-    for (std::size_t i = 0; i < stroke_tubes.size(); ++i)
-        if (stroke_tubes[i].id == stroke.id && grown_items + i < self.scene_.items.size()) {
-            if (!replace_stroke_item(self.scene_, stroke)) return;
-            stroke_tubes[i].fingerprint = stroke_fingerprint(stroke);
-            return;
-        }
-}
-
-void VrSession::Impl::rebuild_stroke_items()
-{
-    // A tube only for a stroke that is new or changed (most changes add one); the others are
-    // moved from the scene's stroke items as they are.
-    RenderScene& scene = self.scene_;
-    std::map<std::int64_t, std::pair<std::uint64_t, RenderItem>> old;
-    for (std::size_t i = 0; i < stroke_tubes.size(); ++i)
-        old.emplace(stroke_tubes[i].id,
-                    std::make_pair(stroke_tubes[i].fingerprint, std::move(scene.items[grown_items + i])));
-    scene.items.resize(grown_items);
-    stroke_tubes.clear();
-    stroke_bounds = Bounds{};
-    std::vector<Stroke> strokes = effective_strokes(document());
-    live_transform.apply_to(strokes); // a lobe being moved shows its strokes where it is dragged
-    live_stroke_edit.apply_to(strokes);
-    for (const Stroke& st : strokes) {
-        const std::uint64_t fingerprint = stroke_fingerprint(st);
-        const auto it = old.find(st.id);
-        RenderItem item;
-        if (it != old.end() && it->second.first == fingerprint) item = std::move(it->second.second);
-        else {
-            RenderContent content;
-            content.tree = content.leaves = content.lobes = false;
-            content.strokes = true;
-            RenderScene one = tree_render_scene(TreeGeometry{}, {}, {st}, 0.0f, content);
-            if (one.items.empty()) continue;
-            item = std::move(one.items.front());
-        }
-        for (const glm::vec3& p : item.geometry.positions) stroke_bounds.add(p);
-        scene.items.push_back(std::move(item));
-        stroke_tubes.push_back({st.id, fingerprint});
-    }
-    static_items = scene.items.size();
-    update_ground_area();
-}
-
-void VrSession::Impl::update_ground_area()
-{
-    Bounds area = grown_bounds;
-    if (!stroke_bounds.empty()) {
-        area.add(stroke_bounds.lo);
-        area.add(stroke_bounds.hi);
-    }
-    if (area.empty()) {
-        area.add(glm::vec3(-0.5f, 0.0f, -0.5f));
-        area.add(glm::vec3(0.5f, 1.0f, 0.5f));
-    }
-    self.scene_.ground_area = area;
-}
-
 void VrSession::Impl::update_status()
 {
     VrStatus& s = self.status_;
     s.tool = pipeline.tool();
-    s.grown = grown;
+    s.grown = live.grown();
     s.drawing = pipeline.drawing(Hand::Right) || pipeline.drawing(Hand::Left);
     s.scaling = grabbing_scene;
-    s.regrowing = requested_generation > 0 && (!built || built->generation < requested_generation);
+    s.regrowing = live.regrowing();
     for (int h = 0; h < kHandCount; ++h) s.hands_tracked[h] = pipeline.gestures().hand(static_cast<Hand>(h)).tracked;
     s.strokes = document().strokes.size();
     s.lobes = document().lobes.size();
     s.edits = document().edits.size();
-    s.revision = revision;
+    s.revision = live.revision();
+    s.last_message = live.last_message();
+    s.tree_error = live.tree_error();
     std::string label = grabbing_scene ? "MOVING SCENE" : tool_label(s.tool);
     if (s.drawing) label += s.tool == Tool::DrawLobe || s.tool == Tool::DrawTrunk ? " - DRAWING" : " - DRAGGING";
-    if (grown) label += s.regrowing ? "  GROWING..." : "  TREE";
+    if (live.grown()) label += s.regrowing ? "  GROWING..." : "  TREE";
     s.label = label;
 }
 
 void VrSession::Impl::add_dynamic_items()
 {
-    RenderScene& scene = self.scene_;
-    scene.items.resize(static_items);
+    RenderScene& scene = live.begin_frame_items();
     const SceneTransform& t = pipeline.scene_transform();
     auto add = [&](std::uint64_t key, std::uint64_t version, RenderMaterial material, std::array<float, 4> color,
                    SurfaceGeometry g) {
@@ -807,37 +528,39 @@ void VrSession::Impl::add_dynamic_items()
 // ---------------------------------------------------------------------------------------------
 VrSession::VrSession(Document doc, VrOptions options)
 {
-    impl_ = std::make_unique<Impl>(*this, std::move(options), doc);
-    VrOptions& o = impl_->options;
-    std::stable_sort(o.events.begin(), o.events.end(),
+    std::stable_sort(options.events.begin(), options.events.end(),
                      [](const InputEvent& a, const InputEvent& b) { return a.time < b.time; });
-    if (!o.photo_path.empty()) {
-        impl_->photo = read_picture_file(o.photo_path);
-        scene_.photo_texture = impl_->photo;
-        scene_.photo_texture_version = 1;
+    RgbaImage photo;
+    if (!options.photo_path.empty()) photo = read_picture_file(options.photo_path);
+    LiveSessionOptions o;
+    o.session_path = options.session_path;
+    o.autosave_path = options.autosave_path;
+    o.record_path = options.record_path;
+    o.export_path = options.export_path;
+    o.recording_header.source =
+        "lobesketch vr" + (options.runtime_name.empty() ? std::string() : " (" + options.runtime_name + ")");
+    o.recording_header.device = options.device_name.empty() ? "OpenXR hand tracking" : options.device_name;
+    o.recording_header.nominal_rate_hz =
+        options.nominal_rate_hz > 0.0 && std::isfinite(options.nominal_rate_hz) ? options.nominal_rate_hz : 90.0;
+    o.recording_flush_frames = 9; // 0.1 s at 90 Hz
+    o.background_regrowth = options.background_regrowth;
+    o.lod = 1; // the tree's middle LOD: the full one is for export and pictures (docs/vr.md)
+    o.app = std::string("vr");
+    o.grow_hint = std::string("GROW on the panel");
+    o.export_file_hint = std::string("start with --export FILE.glb");
+    o.imports_refused = std::string("the VR app imports no meshes (use lobesketch desktop)");
+    live_ = std::make_unique<LiveSession>(std::move(doc), std::move(o));
+    Bounds floor;
+    floor.add(glm::vec3(-0.5f, 0.0f, -0.5f));
+    floor.add(glm::vec3(0.5f, 1.0f, 0.5f));
+    live_->view().set_empty_area(floor);
+    impl_ = std::make_unique<Impl>(*this, *live_, std::move(options));
+    if (!photo.pixels.empty()) {
+        impl_->photo = std::move(photo);
+        RenderScene& scene = live_->begin_frame_items();
+        scene.photo_texture = impl_->photo;
+        scene.photo_texture_version = 1;
     }
-    if (!o.record_path.empty()) {
-        RecordingHeader header;
-        header.source = "lobesketch vr" + (o.runtime_name.empty() ? std::string() : " (" + o.runtime_name + ")");
-        header.device = o.device_name.empty() ? "OpenXR hand tracking" : o.device_name;
-        header.nominal_rate_hz = o.nominal_rate_hz > 0.0 && std::isfinite(o.nominal_rate_hz) ? o.nominal_rate_hz : 90.0;
-        // Flushed every 9 frames (0.1 s at 90 Hz): a crash loses at most that much input.
-        impl_->recording = std::make_unique<RecordingWriter>(o.record_path, header, 9);
-        doc.source_recording = std::filesystem::absolute(o.record_path).lexically_normal().string();
-    }
-    EditHooks hooks = meshing_edit_hooks();
-    hooks.import_model = [](int n) -> std::shared_ptr<const LobeModel> {
-        throw InvalidInput("import " + std::to_string(n) + ": the VR app imports no meshes (use lobesketch desktop)");
-    };
-    // A loaded document's position in its old recording no longer holds; the saves of this
-    // session stamp theirs (at_recording_position).
-    doc.recording_frames.reset();
-    doc.recording_finished = false;
-    builder_ = std::make_unique<SessionBuilder>(std::move(doc), EditPickOptions{}, std::move(hooks));
-    if (!o.autosave_path.empty()) impl_->autosaver = std::make_unique<AutosaveWriter>(o.autosave_path);
-    impl_->worker = std::make_unique<RegrowWorker>(prepare_grown_scene);
-    if (!document().strokes.empty() || !document().lobes.empty()) impl_->request_regrowth();
-    impl_->rebuild_stroke_items();
     impl_->update_status();
 }
 
@@ -850,15 +573,19 @@ VrSession::~VrSession()
     }
 }
 
+const RenderScene& VrSession::scene() const { return live_->scene(); }
+const Document& VrSession::document() const { return live_->document(); }
+const std::deque<std::string>& VrSession::messages() const { return live_->messages(); }
+
 void VrSession::frame(const HandFrame& frame)
 {
-    if (impl_->finished) return;
+    if (live_->finished()) return;
     impl_->frame(frame);
 }
 
 EyeView VrSession::eye_in_document(const EyeView& stage_eye) const
 {
-    const SceneTransform& t = impl_->pipeline.scene_transform();
+    const SceneTransform& t = live_->pipeline().scene_transform();
     EyeView e = stage_eye;
     if (t.identity()) return e;
     e.position = t.to_document(stage_eye.position);
@@ -868,68 +595,29 @@ EyeView VrSession::eye_in_document(const EyeView& stage_eye) const
     return e;
 }
 
-const SceneTransform& VrSession::scene_transform() const { return impl_->pipeline.scene_transform(); }
+const SceneTransform& VrSession::scene_transform() const { return live_->pipeline().scene_transform(); }
 
 bool VrSession::save()
 {
-    if (impl_->options.session_path.empty()) {
-        impl_->note("save: no session file (start with `lobesketch vr SESSION.json`)");
-        return false;
-    }
-    Impl& im = *impl_;
-    try {
-        if (im.recording && !im.finished) im.recording->flush(); // closed once finished
-        save_document(im.options.session_path,
-                      at_recording_position(document(), im.recording != nullptr, im.frames_recorded, im.finished));
-        impl_->note("saved " + impl_->options.session_path);
-        return true;
-    } catch (const Error& e) {
-        impl_->note(std::string("save failed: ") + e.what());
-        return false;
-    }
+    const bool ok = live_->save();
+    status_.last_message = live_->last_message();
+    return ok;
 }
 
 bool VrSession::export_tree()
 {
-    Impl& im = *impl_;
-    if (!im.grown) {
-        im.note("export: grow the tree first (GROW on the panel)");
-        return false;
-    }
-    wait_for_regrowth();
-    if (!im.built || !im.built->grown || im.built->geometry.lods.empty()) {
-        im.note("export: there is no tree to export" + (status_.tree_error.empty() ? "" : ": " + status_.tree_error));
-        return false;
-    }
-    if (im.options.export_path.empty()) {
-        im.note("export: no export file (start with --export FILE.glb)");
-        return false;
-    }
-    try {
-        ExportOptions o;
-        o.include_lobes = o.include_strokes = true;
-        write_tree_file(im.options.export_path, document(), im.built->tree, im.built->geometry, o);
-        im.note("exported " + im.options.export_path + " (" + lod_triangle_summary(im.built->geometry) + ")");
-        return true;
-    } catch (const Error& e) {
-        im.note(std::string("export failed: ") + e.what());
-        return false;
-    }
+    const bool ok = live_->export_tree();
+    status_.last_message = live_->last_message();
+    status_.tree_error = live_->tree_error();
+    return ok;
 }
 
-void VrSession::wait_for_regrowth()
-{
-    Impl& im = *impl_;
-    if (im.requested_generation == 0) return;
-    if (im.built && im.built->generation >= im.requested_generation) return;
-    im.take_regrowth(im.worker->wait_for(im.requested_generation));
-}
+void VrSession::wait_for_regrowth() { live_->wait_for_regrowth(); }
 
 void VrSession::finish(double time)
 {
     Impl& im = *impl_;
-    if (im.finished) return;
-    im.finished = true;
+    if (live_->finished()) return;
     const double t = std::max(time, im.time);
     std::vector<int> commands;
     while (im.next_replay_event < im.options.events.size()) im.push(im.options.events[im.next_replay_event++], commands);
@@ -938,18 +626,9 @@ void VrSession::finish(double time)
         im.push(e, commands);
     }
     im.pending.clear();
-    im.pipeline.finish();
-    const std::uint64_t revision = im.revision;
-    im.apply_actions(); // autosaves from here on hold the end of the recording too
+    const std::uint64_t revision = live_->finish_input(); // autosaves from here on hold the end of the recording too
     im.run_commands(commands, im.last_frame);
-    // The end changed nothing: the last autosave still says so, for `recover` to see that
-    // nothing of the recording is left to replay.
-    if (im.revision == revision && im.revision > 0) im.autosave();
-    if (im.autosaver) {
-        im.autosaver->wait();
-        im.report_autosave_failures();
-    }
-    if (im.recording) im.recording->close();
+    live_->close(revision);
     if (!im.options.session_path.empty()) save();
 }
 

@@ -1,9 +1,10 @@
 #pragma once
 /// \file vr_session.h
-/// The VR app without OpenXR: hand frames in stage space in, a scene to draw out. It runs the
-/// same input pipeline and session builder as replay, the in-VR panel (poked with a
-/// fingertip), the two-handed grab that scales, turns and moves the whole scene, the session's
-/// recording, save and autosave, and live regrowth off the frame thread. `lobesketch vr`
+/// The VR app without OpenXR: hand frames in stage space in, a scene to draw out. A thin
+/// adapter around the live session both apps share (app/live/live_session.h: pipeline,
+/// session builder, recording, autosave, regrowth off the frame thread, live edits, save and
+/// export); what is VR's own is the in-VR panel (poked with a fingertip), the two-handed grab
+/// that scales, turns and moves the whole scene, and the reference photo. `lobesketch vr`
 /// (app/cli/cli_vr.cpp, app/vr/vr_xr.cpp) feeds it xrLocateHandJointsEXT results every frame and
 /// draws its scene into both eyes; tests feed it recorded frames directly. Gestures and
 /// panel: docs/vr.md.
@@ -20,12 +21,10 @@
 #include <glm/gtc/quaternion.hpp>
 #include <glm/vec3.hpp>
 
-#include "app/live/regrow_worker.h"
+#include "app/live/live_session.h"
 #include "app/render/renderer.h"
 #include "core/document.h"
 #include "input/pipeline.h"
-#include "input/recording.h"
-#include "app/session/session_builder.h"
 
 namespace lobe {
 
@@ -117,16 +116,16 @@ public:
 
     /// The scene to draw now, in document space (draw it through scene_transform(): see
     /// eye_in_document). Valid until the next frame().
-    const RenderScene& scene() const { return scene_; }
+    const RenderScene& scene() const;
     const SceneTransform& scene_transform() const;
     /// An eye in stage space as the same eye in document space (the picture is the same).
     EyeView eye_in_document(const EyeView& stage_eye) const;
 
-    const Document& document() const { return builder_->document(); }
+    const Document& document() const;
     const VrStatus& status() const { return status_; }
     const VrPanel& panel() const { return panel_; }
     /// Every warning and result line so far, oldest first (at most the last 200).
-    const std::deque<std::string>& messages() const { return messages_; }
+    const std::deque<std::string>& messages() const;
     /// True once the panel's Quit was pressed.
     bool quit_requested() const { return quit_; }
 
@@ -142,13 +141,10 @@ public:
 
 private:
     struct Impl;
-    std::unique_ptr<Impl> impl_;
-    // The members below are owned by Impl's functions; kept here for the inline getters.
-    std::unique_ptr<SessionBuilder> builder_;
-    RenderScene scene_;
+    std::unique_ptr<LiveSession> live_; ///< what the desktop app shares (app/live/live_session.h)
+    std::unique_ptr<Impl> impl_;        ///< the VR app's own: panel, scene grab, photo, hands drawn
     VrStatus status_;
     VrPanel panel_;
-    std::deque<std::string> messages_;
     bool quit_ = false;
 };
 

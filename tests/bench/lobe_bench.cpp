@@ -286,7 +286,7 @@ EditOperation bend_operation(const Stroke& stroke, float lift)
     return op;
 }
 
-/// A stroke bend shown live (app/live/live_stroke_edit.h, as the desktop and VR sessions run it
+/// A stroke bend shown live (app/live/live_edit_view.h, as the live session runs it
 /// every frame while the fingertip moves): the document's effective strokes with the drag's
 /// operation appended, on table1-4lobes-22strokes (22 strokes, 4 lobes); the bend picks a
 /// point of its first stroke and pulls it up to 4 cm out and back.
