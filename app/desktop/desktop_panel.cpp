@@ -1,0 +1,136 @@
+#include "app/desktop/desktop_panel.h"
+
+#include <algorithm>
+#include <cstdint>
+#include <string>
+
+#include <imgui.h>
+
+#include "app/desktop/desktop_script.h"
+#include "app/desktop/desktop_session.h"
+#include "core/document.h"
+#include "input/recording.h"
+#include "input/tools.h"
+
+namespace lobe {
+
+/// The panel: stages, tools, edits, appearance, file, status. Buttons press the keys the
+/// keyboard has (so the recording holds key events either way); settings are sent as
+/// Setting events when a slider is let go.
+void draw_desktop_panel(DesktopSession& session, const std::string& session_name, DesktopPanelState& state, float height)
+{
+    const DesktopStatus& st = session.status();
+    const Document& doc = session.document();
+    constexpr float kWidth = kDesktopPanelWidth, kHalf = 113.0f;
+    ImGui::SetNextWindowPos(ImVec2(6, 6), ImGuiCond_Always);
+    ImGui::SetNextWindowSize(ImVec2(kWidth, std::max(120.0f, height - 12.0f)), ImGuiCond_Always);
+    ImGui::PushStyleVar(ImGuiStyleVar_ItemSpacing, ImVec2(6, 3));
+    ImGui::PushStyleVar(ImGuiStyleVar_FramePadding, ImVec2(5, 2));
+    ImGui::Begin(("Lobesketch  " + session_name).c_str(), nullptr,
+                 ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoSavedSettings |
+                     ImGuiWindowFlags_NoCollapse);
+    auto press = [&](const char* action) {
+        const int key = panel_action_key(action);
+        session.key(key, true);
+        session.key(key, false);
+    };
+    // A button of half the panel's width; `active` marks the current stage or tool.
+    int column = 0;
+    auto button = [&](const char* action, bool active = false) {
+        for (const PanelAction& a : panel_actions())
+            if (std::string(a.name) == action) {
+                if (column++ % 2 == 1) ImGui::SameLine();
+                if (active) ImGui::PushStyleColor(ImGuiCol_Button, ImVec4(0.2f, 0.55f, 0.25f, 1.0f));
+                if (ImGui::Button(a.label, ImVec2(kHalf, 0))) press(action);
+                if (active) ImGui::PopStyleColor();
+            }
+    };
+    // Status first: what the hand does now.
+    ImGui::Text("%s%s", tool_name(st.tool), st.pinching ? "  - pinching" : "");
+    ImGui::Text("%zu strokes, %zu lobes, %zu edits", st.strokes, st.lobes, st.edits);
+    ImGui::Text("depth %.2f m%s%s", st.depth_m, st.regrowing ? "  building..." : "", st.importing ? "  importing..." : "");
+    if (st.tree_triangles) ImGui::Text("tree: LOD%d, %zu triangles", st.lod, st.tree_triangles);
+    if (!st.last_message.empty()) ImGui::TextWrapped("%s", st.last_message.c_str());
+
+    if (ImGui::CollapsingHeader("Stages and tools", ImGuiTreeNodeFlags_DefaultOpen)) {
+        column = 0;
+        button("draw-lobe", !st.grown && st.tool == Tool::DrawLobe);
+        button("draw-trunk", !st.grown && st.tool == Tool::DrawTrunk);
+        button("grow", st.grown);
+        button("new-lobe");
+        button("deform", st.tool == Tool::DeformLobe);
+        button("edit-stroke", st.tool == Tool::EditStroke);
+        button("move", st.tool == Tool::MoveLobe);
+        button("rotate", st.tool == Tool::RotateLobe);
+        button("scale", st.tool == Tool::ScaleLobe);
+    }
+    if (ImGui::CollapsingHeader("Edit (under the fingertip)", ImGuiTreeNodeFlags_DefaultOpen)) {
+        column = 0;
+        button("delete-stroke");
+        button("delete-lobe");
+        button("duplicate");
+        button("mirror");
+        button("undo");
+        button("redo");
+    }
+    if (ImGui::CollapsingHeader("Appearance", ImGuiTreeNodeFlags_DefaultOpen)) {
+        std::string target = state.target_lobe == 0 ? "whole tree" : "lobe " + std::to_string(state.target_lobe);
+        if (ImGui::BeginCombo("for", target.c_str())) {
+            if (ImGui::Selectable("whole tree", state.target_lobe == 0)) state.target_lobe = 0;
+            for (const LobeRecord& l : doc.lobes) {
+                const std::string label = "lobe " + std::to_string(l.id);
+                if (ImGui::Selectable(label.c_str(), state.target_lobe == l.id)) state.target_lobe = int(l.id);
+            }
+            ImGui::EndCombo();
+        }
+        const LobeRecord* lobe = nullptr;
+        for (const LobeRecord& l : doc.lobes)
+            if (l.id == state.target_lobe) lobe = &l;
+        if (!lobe) state.target_lobe = 0;
+        const auto send = [&](SettingId id, double v) { session.setting(static_cast<int>(id), state.target_lobe, v); };
+        float split = float(lobe && lobe->split_angle_deg ? *lobe->split_angle_deg : doc.settings.growth.split_angle_deg);
+        ImGui::SliderFloat("split t", &split, 5.0f, 90.0f, "%.0f deg");
+        if (ImGui::IsItemDeactivatedAfterEdit()) send(SettingId::SplitAngle, split);
+        int species = 0;
+        const std::string& current = lobe && !lobe->species.empty() ? lobe->species : doc.settings.growth.species;
+        for (int i = 0; i < kSettingSpeciesCount; ++i)
+            if (current == kSettingSpecies[i]) species = i;
+        if (ImGui::Combo("species", &species, kSettingSpecies, kSettingSpeciesCount)) send(SettingId::Species, species);
+        if (state.target_lobe == 0) {
+            // The attractor spacing is the same for every lobe (one density for the tree).
+            float spacing = float(doc.settings.lobes.edge_length_m * 100.0);
+            ImGui::SliderFloat("spacing", &spacing, 1.0f, 10.0f, "%.1f cm");
+            if (ImGui::IsItemDeactivatedAfterEdit()) send(SettingId::AttractorSpacing, spacing / 100.0);
+        }
+        // Leaves and seed: the tree's, or the lobe's own (shown: what the lobe grows with).
+        float leaf = float((lobe && lobe->leaf_length_m ? *lobe->leaf_length_m : doc.settings.leaves.length_m) * 100.0);
+        ImGui::SliderFloat("leaf size", &leaf, 1.0f, 20.0f, "%.1f cm");
+        if (ImGui::IsItemDeactivatedAfterEdit()) send(SettingId::LeafLength, leaf / 100.0);
+        int leaves = lobe && lobe->leaves_per_node ? *lobe->leaves_per_node : doc.settings.leaves.per_node;
+        ImGui::SliderInt("leaves", &leaves, 0, 16);
+        if (ImGui::IsItemDeactivatedAfterEdit()) send(SettingId::LeavesPerNode, leaves);
+        int seed = int(std::min<std::uint64_t>(lobe && lobe->seed ? *lobe->seed : doc.seed, 16777215));
+        if (ImGui::InputInt("seed", &seed, 1, 10) && seed >= 1 && seed < (1 << 24)) send(SettingId::Seed, seed);
+    }
+    if (ImGui::CollapsingHeader("Import a mesh as a lobe")) {
+        // OBJ, PLY or OFF, made on a thread of its own; the lobe appears centred on the
+        // fingertip (the cursor's point on the depth plane) when the import is done.
+        ImGui::InputText("file", state.import_path.data(), state.import_path.size());
+        ImGui::SliderFloat("size", &state.import_size_m, 0.1f, 5.0f, "%.2f m");
+        if (ImGui::Button("Import", ImVec2(kHalf, 0)) && state.import_path[0] != 0)
+            session.import_mesh(state.import_path.data(), state.import_size_m);
+    }
+    if (ImGui::CollapsingHeader("File", ImGuiTreeNodeFlags_DefaultOpen)) {
+        column = 0;
+        button("save");
+        button("export");
+        button("frame");
+    }
+    ImGui::TextDisabled("left: pinch   right: orbit");
+    ImGui::TextDisabled("middle: pan   wheel: depth");
+    ImGui::TextDisabled("shift+wheel: zoom");
+    ImGui::End();
+    ImGui::PopStyleVar(2);
+}
+
+} // namespace lobe
