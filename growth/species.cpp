@@ -3,8 +3,9 @@
 #include <algorithm>
 
 #include "core/atomic_file.h"
-#include "core/document.h"
 #include "core/errors.h"
+#include "core/settings_json.h"
+#include "core/settings_table.h"
 #include "growth/embedded_data.h"
 
 namespace lobe {
@@ -89,13 +90,13 @@ void apply_species(Settings& settings, const SpeciesPreset& preset)
 {
     Settings s = settings;
     try {
-        read_growth_settings(preset.growth, s.growth, "growth");
-        read_branch_settings(preset.branches, s.branches, "branches");
-        read_leaf_settings(preset.leaves, s.leaves, "leaves");
+        SettingsOverlay overlay;
+        read_settings_section(preset.growth, "growth", overlay, "growth");
+        read_settings_section(preset.branches, "branches", overlay, "branches");
+        read_settings_section(preset.leaves, "leaves", overlay, "leaves");
+        overlay.apply_to(s);
         s.growth.species = preset.name;
-        validate_growth_settings(s.growth);
-        validate_branch_settings(s.branches);
-        validate_leaf_settings(s.leaves);
+        for (const char* section : {"growth", "branches", "leaves"}) validate_settings_section(s, section);
     } catch (const InvalidInput& e) {
         throw InvalidInput("species '" + preset.name + "': " + e.what());
     }

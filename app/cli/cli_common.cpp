@@ -14,6 +14,8 @@
 #include "core/atomic_file.h"
 #include "core/document.h"
 #include "core/errors.h"
+#include "core/settings_json.h"
+#include "core/settings_table.h"
 #include "growth/species.h"
 #include "input/pipeline.h"
 #include "app/session/session_builder.h"
@@ -73,8 +75,8 @@ Settings load_settings_file(const std::string& path)
     if (j.is_discarded()) throw FileError(path, "not valid JSON");
     try {
         // Accept a bare settings object or a whole session document's "settings".
-        if (j.is_object() && j.contains("format") && j.contains("settings")) return settings_from_json_checked(j["settings"]);
-        return settings_from_json_checked(j);
+        if (j.is_object() && j.contains("format") && j.contains("settings")) return settings_from_json(j["settings"]);
+        return settings_from_json(j);
     } catch (const InvalidInput& e) {
         throw FileError(path, e.what());
     }

@@ -9,6 +9,7 @@
 #include "app/session/tree_pipeline.h"
 #include "core/document.h"
 #include "core/settings.h"
+#include "core/settings_json.h" // the commands that write settings as JSON (settings_json)
 #include "input/recording.h"
 
 namespace CLI {

@@ -12,6 +12,7 @@
 #include <glm/geometric.hpp>
 
 #include "core/errors.h"
+#include "core/settings_table.h"
 
 namespace lobe {
 
@@ -746,13 +747,13 @@ bool SessionBuilder::apply_setting(const InputAction& a)
         switch (c.id) {
         case SettingId::SplitAngle:
             if (lobe) {
-                GrowthSettings g = s.growth;
-                g.split_angle_deg = v;
-                validate_growth_settings(g);
+                Settings probe = s;
+                probe.growth.split_angle_deg = v;
+                validate_settings_section(probe, "growth");
                 lobe_after.split_angle_deg = v;
             } else {
                 s.growth.split_angle_deg = v;
-                validate_growth_settings(s.growth);
+                validate_settings_section(s, "growth");
             }
             break;
         case SettingId::AttractorSpacing:
@@ -760,22 +761,23 @@ bool SessionBuilder::apply_setting(const InputAction& a)
             validate_settings(s);
             break;
         case SettingId::LeafLength: {
-            LeafSettings l = s.leaves;
+            Settings probe = s;
+            LeafSettings& l = probe.leaves;
             const double ratio = l.width_m / l.length_m;
             l.length_m = v;
             l.width_m = v * ratio;
-            validate_leaf_settings(l);
+            validate_settings_section(probe, "leaves");
             if (lobe) lobe_after.leaf_length_m = v;
             else s.leaves = l;
             break;
         }
         case SettingId::LeavesPerNode: {
             if (!whole(-1e9, 1e9)) return refuse("leaves per node must be a whole number");
-            LeafSettings l = s.leaves;
-            l.per_node = static_cast<int>(v);
-            validate_leaf_settings(l);
-            if (lobe) lobe_after.leaves_per_node = l.per_node;
-            else s.leaves = l;
+            Settings probe = s;
+            probe.leaves.per_node = static_cast<int>(v);
+            validate_settings_section(probe, "leaves");
+            if (lobe) lobe_after.leaves_per_node = probe.leaves.per_node;
+            else s.leaves = probe.leaves;
             break;
         }
         case SettingId::Species: {
@@ -805,7 +807,7 @@ bool SessionBuilder::apply_setting(const InputAction& a)
                                        lobe_after.species != lobe->species ||
                                        lobe_after.leaf_length_m != lobe->leaf_length_m ||
                                        lobe_after.leaves_per_node != lobe->leaves_per_node || lobe_after.seed != lobe->seed);
-    const bool changed = seed != doc_.seed || settings_json(s) != settings_json(doc_.settings) || lobe_changed;
+    const bool changed = seed != doc_.seed || !settings_equal(s, doc_.settings) || lobe_changed;
     if (!changed) return false;
     // A slider being dragged: one undo step for the whole run.
     const bool merge = setting_run_ && setting_run_->first == c.id && setting_run_->second == c.lobe && !undo_.empty();

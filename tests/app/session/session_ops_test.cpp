@@ -16,6 +16,7 @@
 #include "app/session/edit_hooks.h"
 #include "core/document.h"
 #include "core/errors.h"
+#include "core/settings_json.h"
 #include "growth/species.h"
 #include "input/pipeline.h"
 #include "input/recording.h"
