@@ -369,7 +369,7 @@ std::string SettingInfo::allowed() const
         return out;
     }
     case SettingType::Color: return "r,g,b each in [0, 1]";
-    case SettingType::Weights: return "name:weight,… each in [0, 1e6], at most " + std::to_string(kMaxWeights);
+    case SettingType::Weights: return "up to " + std::to_string(kMaxWeights) + " name:weight in [0, 1e6]";
     }
     return {};
 }

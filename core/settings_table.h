@@ -58,7 +58,7 @@ struct SettingInfo {
     std::string doc;                  ///< one line
 
     /// What the setting accepts, in words: "[0.005, 0.5]", "\"ovate\", \"round\" or \"needle\"",
-    /// "a name of 1 to 64 characters", "r,g,b each in [0, 1]", "name:weight,… each in [0, 1e6]".
+    /// "a name of 1 to 64 characters", "r,g,b each in [0, 1]", "up to 256 name:weight in [0, 1e6]".
     std::string allowed() const;
 };
 

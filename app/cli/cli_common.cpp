@@ -82,21 +82,79 @@ Settings load_settings_file(const std::string& path)
     }
 }
 
+namespace {
+
+/// A CLI11 check of one setting's value on the command line: the settings table's parse and
+/// range, its message naming the setting.
+CLI::Validator setting_value_check(const SettingInfo& info)
+{
+    return CLI::Validator(
+        [&info](std::string& text) {
+            try {
+                Settings scratch;
+                set_setting_text(scratch, info, text);
+                return std::string();
+            } catch (const InvalidInput& e) {
+                return std::string(e.what());
+            }
+        },
+        info.allowed(), info.key);
+}
+
+/// The help of an option that sets one setting: its key and doc line.
+std::string setting_help(const SettingInfo& info) { return "Sets " + info.key + ": " + info.doc; }
+
+/// "KEY=VALUE" applied to `overlay`. \throw InvalidInput
+void add_assignment(SettingsOverlay& overlay, const std::string& assignment)
+{
+    const std::size_t eq = assignment.find('=');
+    if (eq == std::string::npos || eq == 0)
+        throw InvalidInput("expected KEY=VALUE (e.g. growth.split_angle_deg=25), not '" + assignment + "'");
+    overlay.set_text(assignment.substr(0, eq), assignment.substr(eq + 1));
+}
+
+} // namespace
+
 void add_tree_input_options(CLI::App* cmd, TreeInputOptions& o)
 {
+    const SettingInfo& split = *find_setting("growth.split_angle_deg");
+    const SettingInfo& spacing = *find_setting("lobes.edge_length_m");
     cmd->add_option("--settings", o.settings, "Settings JSON (a settings object or a session document)");
     cmd->add_option("--species", o.species,
                     "Species preset: broadleaf, conifer, willow, birch, or a preset .json file");
+    cmd->add_option("--set", o.set,
+                    "Sets one setting (repeatable): growth.split_angle_deg=25, leaves.color=0.2,0.4,0.1. Applied "
+                    "after --settings and --species, in the order given, before --split-angle and "
+                    "--attractor-spacing; `lobesketch settings` lists the keys")
+        ->type_name("KEY=VALUE")
+        ->allow_extra_args(false)
+        ->check(CLI::Validator(
+            [](std::string& text) {
+                try {
+                    SettingsOverlay scratch;
+                    add_assignment(scratch, text);
+                    return std::string();
+                } catch (const InvalidInput& e) {
+                    return std::string(e.what());
+                }
+            },
+            "", "setting assignment"));
     cmd->add_option("--seed", o.seed, "Seed of every random choice of growth (default: the session's)");
-    cmd->add_option("--split-angle", o.split_angle, "Split angle t in degrees (smaller: denser branching)")
-        ->check(CLI::Range(5.0, 180.0));
-    cmd->add_option("--attractor-spacing", o.spacing, "Attractor spacing in metres: lobes are remeshed to it")
-        ->check(CLI::Range(0.005, 0.5));
+    cmd->add_option("--split-angle", o.split_angle, setting_help(split))->check(setting_value_check(split));
+    cmd->add_option("--attractor-spacing", o.spacing, setting_help(spacing))->check(setting_value_check(spacing));
+}
+
+SettingsOverlay setting_assignments(const std::vector<std::string>& assignments)
+{
+    SettingsOverlay overlay;
+    for (const std::string& a : assignments) add_assignment(overlay, a);
+    return overlay;
 }
 
 void apply_tree_input_options(Settings& s, const TreeInputOptions& o)
 {
     if (!o.species.empty()) apply_species(s, load_species(o.species));
+    setting_assignments(o.set).apply_to(s);
     if (o.split_angle) s.growth.split_angle_deg = *o.split_angle;
     if (o.spacing) s.lobes.edge_length_m = *o.spacing;
     validate_settings(s);
