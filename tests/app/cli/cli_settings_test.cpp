@@ -2,6 +2,10 @@
 // tree options apply in, and `lobesketch settings`.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <regex>
 #include <sstream>
 #include <string>
 
@@ -109,4 +113,53 @@ TEST(CliSettings, SettingsCommandPrintsTheTableAndTheDefaultsAsASettingsFile)
     EXPECT_TRUE(j["lobes"]["remesh_iterations"].is_number_integer());
 
     EXPECT_EQ(test::run_cli("settings --json --markdown").code, 2);
+}
+
+TEST(CliSettings, DocsSettingsMdIsTheTableAsTheCommandPrintsIt)
+{
+    const test::CliRun md = test::run_cli("settings --markdown");
+    ASSERT_EQ(md.code, 0) << md.out;
+    std::ifstream in(test::source_path("docs/settings.md"), std::ios::binary);
+    ASSERT_TRUE(in) << "docs/settings.md is missing";
+    const std::string doc((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    // Line by line, so a failure shows the row that disagrees.
+    std::istringstream want(md.out), have(doc);
+    std::string w, h;
+    int line = 0;
+    while (true) {
+        const bool more_w = static_cast<bool>(std::getline(want, w)), more_h = static_cast<bool>(std::getline(have, h));
+        ++line;
+        if (!more_w && !more_h) break;
+        if (w != h || more_w != more_h) {
+            ADD_FAILURE() << "docs/settings.md:" << line << " disagrees with the settings table\n  doc:   " << h
+                          << "\n  table: " << w
+                          << "\nregenerate it: lobesketch settings --markdown > docs/settings.md";
+            break;
+        }
+    }
+    EXPECT_TRUE(doc == md.out);
+    for (const SettingInfo& info : settings_table())
+        EXPECT_NE(doc.find("| `" + info.key + "` | `"), std::string::npos) << info.key;
+}
+
+TEST(CliSettings, EverySettingTheDocsNameIsInTheTable)
+{
+    // `settings.SECTION.KEY` anywhere in the docs (session-format.md, growth.md, limits.md, …)
+    // names a setting or a section the table has, so a renamed setting cannot be left behind.
+    const std::regex mention(R"(settings\.([a-z_]+(?:\.[a-z_]+)*))");
+    std::size_t checked = 0;
+    for (const auto& f : std::filesystem::directory_iterator(test::source_path("docs"))) {
+        if (f.path().extension() != ".md") continue;
+        std::ifstream in(f.path());
+        const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        for (auto m = std::sregex_iterator(text.begin(), text.end(), mention); m != std::sregex_iterator(); ++m) {
+            const std::string key = (*m)[1];
+            if (key == "md" || key == "h") continue; // settings.md, core/settings.h
+            const bool section = std::find(settings_sections().begin(), settings_sections().end(), key) !=
+                                 settings_sections().end();
+            EXPECT_TRUE(section || find_setting(key)) << f.path().filename().string() << ": settings." << key;
+            ++checked;
+        }
+    }
+    EXPECT_GT(checked, 10u);
 }
