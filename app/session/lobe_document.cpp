@@ -13,6 +13,7 @@
 #include <glm/matrix.hpp>
 
 #include "core/errors.h"
+#include "core/settings_table.h"
 #include "app/session/edit_ops.h"
 #include "meshing/laplacian_edit.h"
 #include "app/session/lobe_cache.h"
@@ -176,7 +177,7 @@ struct LobeBuildCache::Impl {
     };
     /// A lobe after its steps: the joined strokes, what joining said, and the remeshed mesh.
     struct Entry {
-        std::array<double, 4> key{}; ///< the settings the lobe is built with (options_key)
+        std::string key;                   ///< the settings the lobe is built with (lobe_build_key)
         std::vector<Step> steps;
         Lobe lobe;
         std::vector<std::int64_t> accepted;
@@ -190,16 +191,11 @@ struct LobeBuildCache::Impl {
 };
 
 LobeBuildCache::LobeBuildCache() : impl_(std::make_unique<Impl>()) {}
+
+std::string lobe_build_key(const Settings& settings) { return settings_key(settings, "lobes"); }
 LobeBuildCache::~LobeBuildCache() = default;
 
 namespace {
-
-/// The settings a stroke lobe is built and remeshed with (lobe_options_from, RemeshOptions).
-std::array<double, 4> options_key(const Settings& settings)
-{
-    return {settings.lobes.closed_gap_fraction, settings.lobes.closed_gap_max_m, settings.lobes.edge_length_m,
-            static_cast<double>(settings.lobes.remesh_iterations)};
-}
 
 /// Every lobe of `doc`, before pinch edits and transforms; with `cache`, lobes are taken from
 /// it or continued where their strokes only grew, and it is left holding this build.
@@ -209,7 +205,7 @@ std::vector<BuiltLobe> build_lobes(const Document& doc, std::vector<std::string>
     using Entry = LobeBuildCache::Impl::Entry;
     using Step = LobeBuildCache::Impl::Step;
     const LobeOptions options = lobe_options_from(doc.settings);
-    const std::array<double, 4> key = options_key(doc.settings);
+    const std::string key = lobe_build_key(doc.settings);
     RemeshOptions remesh;
     remesh.target_edge_length_m = doc.settings.lobes.edge_length_m;
     remesh.iterations = static_cast<unsigned>(doc.settings.lobes.remesh_iterations);
