@@ -19,6 +19,7 @@
 #include "growth/species.h"
 #include "input/pipeline.h"
 #include "app/session/session_builder.h"
+#include "app/session/stage_options.h"
 #include "meshing/mesh_io.h"
 
 namespace lobe::cli {
@@ -189,18 +190,19 @@ Document replay_into_document(const std::string& path, Document doc, std::size_t
     const double duration = rec.frames.empty() ? 0.0 : rec.frames.back().time - rec.frames.front().time;
     progress("replaying " + std::to_string(rec.frames.size()) + " frames (" + std::to_string(duration).substr(0, 6) +
              " s) of " + path);
-    const InputResult result = run_input_pipeline(rec, doc.settings.input);
+    const InputResult result = run_input_pipeline(rec, input_options(doc.settings));
     for (const std::string& m : result.messages) warn(path + ": " + m);
     if (drags) *drags = result.drags.size();
     doc.source_recording = std::filesystem::absolute(path).lexically_normal().string();
-    EditHooks hooks = meshing_edit_hooks();
+    EditHooks hooks = meshing_edit_hooks(edit_apply_options(doc.settings));
     // Meshes imported during the session lie beside the recording (import_mesh_path).
     hooks.import_model = [path](int n) {
         const std::string file = import_mesh_path(path, n);
         return std::make_shared<const LobeModel>(
             LobeModel{std::filesystem::path(file).filename().string(), read_mesh(file)});
     };
-    SessionBuilder builder(std::move(doc), EditPickOptions{}, std::move(hooks));
+    const EditPickOptions pick = edit_pick_options(doc.settings);
+    SessionBuilder builder(std::move(doc), pick, std::move(hooks));
     builder.apply(result.actions);
     for (const std::string& m : builder.messages()) warn(path + ": " + m);
     return builder.take_document();
