@@ -249,6 +249,7 @@ std::string where(const SettingInfo& info) { return "settings." + info.key; }
 
 double parse_number(std::string_view text, bool& ok)
 {
+    if (text.size() > 1 && text.front() == '+' && text[1] != '-') text.remove_prefix(1); // "+25", as strtod reads it
     double v = 0.0;
     const char* end = text.data() + text.size();
     const auto [p, ec] = std::from_chars(text.data(), end, v);
@@ -457,8 +458,9 @@ void set_setting_text(Settings& s, const SettingInfo& info, std::string_view tex
         break;
     case SettingType::Integer: {
         long long i = 0;
-        const char* end = text.data() + text.size();
-        const auto [p, ec] = std::from_chars(text.data(), end, i);
+        const std::string_view digits = text.size() > 1 && text.front() == '+' && text[1] != '-' ? text.substr(1) : text;
+        const char* end = digits.data() + digits.size();
+        const auto [p, ec] = std::from_chars(digits.data(), end, i);
         if (ec != std::errc() || p != end || i < -1000000000LL || i > 1000000000LL)
             throw InvalidInput(w + ": expected an integer, not '" + std::string(text) + "'");
         value = static_cast<int>(i);

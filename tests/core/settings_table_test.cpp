@@ -203,6 +203,10 @@ TEST(SettingsTable, TextValuesParseByTypeAndBadOnesNameTheKey)
     EXPECT_EQ(setting_text(s, *find_setting("growth.subtree_weights")), "fork:3,whorl:0.5");
     set_setting_text(s, *find_setting("branches.lod_count"), "2");
     EXPECT_EQ(s.branches.lod_count, 2);
+    set_setting_text(s, *find_setting("branches.lod_count"), "+1");
+    EXPECT_EQ(s.branches.lod_count, 1);
+    set_setting_text(s, *find_setting("growth.split_angle_deg"), "+25");
+    EXPECT_EQ(s.growth.split_angle_deg, 25.0);
     EXPECT_EQ(message_of([&] { set_setting_text(s, *find_setting("branches.lod_count"), "2.5"); }),
               "settings.branches.lod_count: expected an integer, not '2.5'");
     EXPECT_EQ(message_of([&] { set_setting_text(s, *find_setting("leaves.color"), "1,2"); }),
