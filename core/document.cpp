@@ -2,15 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <limits>
-#include <type_traits>
 #include <unordered_set>
 #include <variant>
+#include <nlohmann/json.hpp>
 
 #include "core/atomic_file.h"
 #include "core/errors.h"
+#include "core/settings_json.h"
+#include "core/settings_table.h"
 
 namespace lobe {
 
@@ -24,8 +25,6 @@ std::string too_many(std::size_t n, std::size_t limit, const char* what)
     return std::to_string(n) + " " + what + ", more than the " + std::to_string(limit) + " a session may hold";
 }
 
-json rgb_json(const double (&c)[3]) { return json::array({c[0], c[1], c[2]}); }
-
 /// A JSON number as float. A number beyond the float range becomes ±infinity (casting such a
 /// double is undefined), which every caller then refuses as not finite.
 float json_float(const json& v)
@@ -33,98 +32,6 @@ float json_float(const json& v)
     const double d = v.get<double>();
     if (std::abs(d) <= static_cast<double>(std::numeric_limits<float>::max())) return static_cast<float>(d);
     return d < 0 ? -std::numeric_limits<float>::infinity() : std::numeric_limits<float>::infinity();
-}
-
-} // namespace
-
-json growth_settings_to_json(const GrowthSettings& g)
-{
-    json weights = json::object();
-    for (const auto& [name, w] : g.subtree_weights) weights[name] = w;
-    return json{{"species", g.species},
-                {"split_angle_deg", g.split_angle_deg},
-                {"alpha", g.alpha},
-                {"beta", g.beta},
-                {"growth_ratio", g.growth_ratio},
-                {"stop_distance_m", g.stop_distance_m},
-                {"kill_distance_m", g.kill_distance_m},
-                {"skeleton_spacing_m", g.skeleton_spacing_m},
-                {"max_iterations", g.max_iterations},
-                {"max_nodes", g.max_nodes},
-                {"subtree_weights", std::move(weights)}};
-}
-
-json branch_settings_to_json(const BranchSettings& b)
-{
-    return json{{"pipe_exponent", b.pipe_exponent},
-                {"tip_radius_m", b.tip_radius_m},
-                {"radial_segments", b.radial_segments},
-                {"ring_spacing_m", b.ring_spacing_m},
-                {"smoothing_iterations", b.smoothing_iterations},
-                {"bark_color", rgb_json(b.bark_color)},
-                {"lod_count", b.lod_count}};
-}
-
-json leaf_settings_to_json(const LeafSettings& l)
-{
-    return json{{"length_m", l.length_m},   {"width_m", l.width_m}, {"per_node", l.per_node},
-                {"deviation_deg", l.deviation_deg}, {"color", rgb_json(l.color)}, {"shape", l.shape}};
-}
-
-namespace {
-
-json settings_to_json(const Settings& s)
-{
-    const InputOptions& in = s.input;
-    return json{
-        {"input",
-         {{"filter",
-           {{"min_cutoff_hz", in.filter.min_cutoff_hz},
-            {"beta", in.filter.beta},
-            {"d_cutoff_hz", in.filter.d_cutoff_hz}}},
-          {"gap_filter",
-           {{"min_cutoff_hz", in.gap_filter.min_cutoff_hz},
-            {"beta", in.gap_filter.beta},
-            {"d_cutoff_hz", in.gap_filter.d_cutoff_hz}}},
-          {"pinch_start_m", in.pinch_start_m},
-          {"pinch_release_m", in.pinch_release_m},
-          {"pinch_min_hold_s", in.pinch_min_hold_s},
-          {"curl_grab", in.curl_grab},
-          {"curl_release", in.curl_release},
-          {"curl_point_index_max", in.curl_point_index_max},
-          {"min_point_distance_m", in.min_point_distance_m},
-          {"bridge_loss_s", in.bridge_loss_s},
-          {"min_stroke_length_m", in.min_stroke_length_m},
-          {"min_stroke_points", in.min_stroke_points},
-          {"max_hand_speed_mps", in.max_hand_speed_mps}}},
-        {"lobes",
-         {{"edge_length_m", s.lobes.edge_length_m},
-          {"remesh_iterations", s.lobes.remesh_iterations},
-          {"closed_gap_fraction", s.lobes.closed_gap_fraction},
-          {"closed_gap_max_m", s.lobes.closed_gap_max_m},
-          {"pinch_roi_radius_m", s.lobes.pinch_roi_radius_m},
-          {"pinch_pick_distance_m", s.lobes.pinch_pick_distance_m}}},
-        {"growth", growth_settings_to_json(s.growth)},
-        {"branches", branch_settings_to_json(s.branches)},
-        {"leaves", leaf_settings_to_json(s.leaves)},
-    };
-}
-
-template <typename T>
-void read_number(const json& obj, const char* key, T& out, const std::string& where)
-{
-    auto it = obj.find(key);
-    if (it == obj.end()) return; // missing keys keep their defaults
-    if (!it->is_number())
-        throw InvalidInput(where + "." + key + ": expected a number");
-    double v = it->get<double>();
-    if (!std::isfinite(v)) throw InvalidInput(where + "." + key + ": not a finite number");
-    if constexpr (std::is_integral_v<T>) {
-        // Casting an out-of-range double to an integer is undefined: refuse it first.
-        if (v != std::floor(v) || v < -1e9 || v > 1e9)
-            throw InvalidInput(where + "." + key + ": expected an integer in [-1e9, 1e9]");
-    }
-    out = static_cast<T>(v);
 }
 
 void check_keys(const json& obj, std::initializer_list<const char*> known, const std::string& where)
@@ -136,154 +43,12 @@ void check_keys(const json& obj, std::initializer_list<const char*> known, const
     }
 }
 
-void read_rgb(const json& obj, const char* key, double (&out)[3], const std::string& where)
-{
-    auto it = obj.find(key);
-    if (it == obj.end()) return;
-    const std::string w = where + "." + key;
-    if (!it->is_array() || it->size() != 3) throw InvalidInput(w + ": expected [r, g, b]");
-    for (int i = 0; i < 3; ++i) {
-        if (!(*it)[i].is_number()) throw InvalidInput(w + ": expected [r, g, b] numbers");
-        const double v = (*it)[i].get<double>();
-        if (!(v >= 0.0 && v <= 1.0)) throw InvalidInput(w + ": components must be in [0, 1]");
-        out[i] = v;
-    }
-}
-
 void read_string(const json& obj, const char* key, std::string& out, const std::string& where)
 {
     auto it = obj.find(key);
     if (it == obj.end()) return;
     if (!it->is_string()) throw InvalidInput(where + "." + key + ": expected a string");
     out = it->get<std::string>();
-}
-
-const json* section(const json& j, const char* key)
-{
-    auto it = j.find(key);
-    if (it == j.end()) return nullptr;
-    if (!it->is_object()) throw InvalidInput(std::string("settings.") + key + ": expected an object");
-    return &*it;
-}
-
-} // namespace
-
-void read_growth_settings(const json& g, GrowthSettings& out, const std::string& w)
-{
-    check_keys(g,
-               {"species", "split_angle_deg", "alpha", "beta", "growth_ratio", "stop_distance_m", "kill_distance_m",
-                "skeleton_spacing_m", "max_iterations", "max_nodes", "subtree_weights"},
-               w);
-    read_string(g, "species", out.species, w);
-    read_number(g, "split_angle_deg", out.split_angle_deg, w);
-    read_number(g, "alpha", out.alpha, w);
-    read_number(g, "beta", out.beta, w);
-    read_number(g, "growth_ratio", out.growth_ratio, w);
-    read_number(g, "stop_distance_m", out.stop_distance_m, w);
-    read_number(g, "kill_distance_m", out.kill_distance_m, w);
-    read_number(g, "skeleton_spacing_m", out.skeleton_spacing_m, w);
-    read_number(g, "max_iterations", out.max_iterations, w);
-    read_number(g, "max_nodes", out.max_nodes, w);
-    if (auto it = g.find("subtree_weights"); it != g.end()) {
-        if (!it->is_object()) throw InvalidInput(w + ".subtree_weights: expected an object of name: weight");
-        if (it->size() > 256) throw InvalidInput(w + ".subtree_weights: too many entries");
-        out.subtree_weights.clear();
-        for (auto e = it->begin(); e != it->end(); ++e) {
-            if (!e->is_number()) throw InvalidInput(w + ".subtree_weights." + e.key() + ": expected a number");
-            const double v = e->get<double>();
-            if (!(v >= 0.0 && v <= 1e6)) throw InvalidInput(w + ".subtree_weights." + e.key() + ": must be in [0, 1e6]");
-            out.subtree_weights[e.key()] = v;
-        }
-    }
-}
-
-void read_branch_settings(const json& b, BranchSettings& out, const std::string& w)
-{
-    check_keys(b,
-               {"pipe_exponent", "tip_radius_m", "radial_segments", "ring_spacing_m", "smoothing_iterations",
-                "bark_color", "lod_count"},
-               w);
-    read_number(b, "pipe_exponent", out.pipe_exponent, w);
-    read_number(b, "tip_radius_m", out.tip_radius_m, w);
-    read_number(b, "radial_segments", out.radial_segments, w);
-    read_number(b, "ring_spacing_m", out.ring_spacing_m, w);
-    read_number(b, "smoothing_iterations", out.smoothing_iterations, w);
-    read_rgb(b, "bark_color", out.bark_color, w);
-    read_number(b, "lod_count", out.lod_count, w);
-}
-
-void read_leaf_settings(const json& l, LeafSettings& out, const std::string& w)
-{
-    check_keys(l, {"length_m", "width_m", "per_node", "deviation_deg", "color", "shape"}, w);
-    read_number(l, "length_m", out.length_m, w);
-    read_number(l, "width_m", out.width_m, w);
-    read_number(l, "per_node", out.per_node, w);
-    read_number(l, "deviation_deg", out.deviation_deg, w);
-    read_rgb(l, "color", out.color, w);
-    read_string(l, "shape", out.shape, w);
-}
-
-namespace {
-
-Settings settings_from_json(const json& j)
-{
-    Settings s;
-    if (!j.is_object()) throw InvalidInput("settings: expected an object");
-    check_keys(j, {"input", "lobes", "growth", "branches", "leaves"}, "settings");
-    if (const json* g = section(j, "growth")) read_growth_settings(*g, s.growth, "settings.growth");
-    if (const json* b = section(j, "branches")) read_branch_settings(*b, s.branches, "settings.branches");
-    if (const json* l = section(j, "leaves")) read_leaf_settings(*l, s.leaves, "settings.leaves");
-    if (auto it = j.find("lobes"); it != j.end()) {
-        if (!it->is_object()) throw InvalidInput("settings.lobes: expected an object");
-        const std::string w = "settings.lobes";
-        check_keys(*it,
-                   {"edge_length_m", "remesh_iterations", "closed_gap_fraction", "closed_gap_max_m",
-                    "pinch_roi_radius_m", "pinch_pick_distance_m"},
-                   w);
-        LobeSettings& l = s.lobes;
-        read_number(*it, "edge_length_m", l.edge_length_m, w);
-        read_number(*it, "remesh_iterations", l.remesh_iterations, w);
-        read_number(*it, "closed_gap_fraction", l.closed_gap_fraction, w);
-        read_number(*it, "closed_gap_max_m", l.closed_gap_max_m, w);
-        read_number(*it, "pinch_roi_radius_m", l.pinch_roi_radius_m, w);
-        read_number(*it, "pinch_pick_distance_m", l.pinch_pick_distance_m, w);
-    }
-    if (auto it = j.find("input"); it != j.end()) {
-        if (!it->is_object()) throw InvalidInput("settings.input: expected an object");
-        const json& in = *it;
-        const std::string w = "settings.input";
-        check_keys(in,
-                   {"filter", "gap_filter", "pinch_start_m", "pinch_release_m", "pinch_min_hold_s", "curl_grab",
-                    "curl_release", "curl_point_index_max", "min_point_distance_m", "bridge_loss_s",
-                    "min_stroke_length_m", "min_stroke_points", "max_hand_speed_mps"},
-                   w);
-        InputOptions& o = s.input;
-        auto read_filter = [&](const char* key, OneEuroOptions& out) {
-            auto f = in.find(key);
-            if (f == in.end()) return;
-            const std::string wf = w + "." + key;
-            if (!f->is_object()) throw InvalidInput(wf + ": expected an object");
-            check_keys(*f, {"min_cutoff_hz", "beta", "d_cutoff_hz"}, wf);
-            read_number(*f, "min_cutoff_hz", out.min_cutoff_hz, wf);
-            read_number(*f, "beta", out.beta, wf);
-            read_number(*f, "d_cutoff_hz", out.d_cutoff_hz, wf);
-        };
-        read_filter("filter", o.filter);
-        read_filter("gap_filter", o.gap_filter);
-        read_number(in, "pinch_start_m", o.pinch_start_m, w);
-        read_number(in, "pinch_release_m", o.pinch_release_m, w);
-        read_number(in, "pinch_min_hold_s", o.pinch_min_hold_s, w);
-        read_number(in, "curl_grab", o.curl_grab, w);
-        read_number(in, "curl_release", o.curl_release, w);
-        read_number(in, "curl_point_index_max", o.curl_point_index_max, w);
-        read_number(in, "min_point_distance_m", o.min_point_distance_m, w);
-        read_number(in, "bridge_loss_s", o.bridge_loss_s, w);
-        read_number(in, "min_stroke_length_m", o.min_stroke_length_m, w);
-        read_number(in, "min_stroke_points", o.min_stroke_points, w);
-        read_number(in, "max_hand_speed_mps", o.max_hand_speed_mps, w);
-    }
-    validate_settings(s);
-    return s;
 }
 
 json stroke_to_json(const Stroke& s)
@@ -297,19 +62,17 @@ json stroke_to_json(const Stroke& s)
                 {"closed", s.closed}, {"points", std::move(pts)},       {"times", std::move(times)}};
 }
 
-/// An optional number of a record that must lie in [lo, hi]; a missing key leaves `out` empty.
-void read_number_in_range(const json& obj, const char* key, double lo, double hi, std::optional<double>& out,
-                          const std::string& where)
+/// A lobe's override of a tree-wide setting: an optional number in the range of `setting`
+/// (settings_table.h); a missing key leaves `out` empty.
+void read_override(const json& obj, const char* key, const char* setting, std::optional<double>& out,
+                   const std::string& where)
 {
     const auto t = obj.find(key);
     if (t == obj.end()) return;
     if (!t->is_number()) throw InvalidInput(where + "." + key + ": expected a number");
     const double v = t->get<double>();
-    if (!(v >= lo && v <= hi)) {
-        char range[64];
-        std::snprintf(range, sizeof range, "[%g, %g]", lo, hi);
-        throw InvalidInput(where + "." + key + ": must be in " + range);
-    }
+    const SettingRange& range = find_setting(setting)->range;
+    if (!range.contains(v)) throw InvalidInput(where + "." + key + ": must be in " + range.text());
     out = v;
 }
 
@@ -420,92 +183,6 @@ Stroke stroke_from_json(const json& j, const std::string& where)
 }
 
 } // namespace
-
-void validate_settings(const Settings& s)
-{
-    const InputOptions& o = s.input;
-    auto require = [](bool ok, const char* what) {
-        if (!ok) throw InvalidInput(std::string("settings.input.") + what);
-    };
-    for (const OneEuroOptions* f : {&o.filter, &o.gap_filter}) {
-        require(f->min_cutoff_hz > 0 && f->min_cutoff_hz <= 1000, "filter min_cutoff_hz must be in (0, 1000]");
-        require(f->beta >= 0 && f->beta <= 1e4, "filter beta must be in [0, 10000]");
-        require(f->d_cutoff_hz > 0 && f->d_cutoff_hz <= 1000, "filter d_cutoff_hz must be in (0, 1000]");
-    }
-    require(o.pinch_start_m > 0 && o.pinch_start_m < 0.1, "pinch_start_m must be in (0, 0.1)");
-    require(o.pinch_release_m > o.pinch_start_m && o.pinch_release_m < 0.2,
-            "pinch_release_m must be above pinch_start_m and below 0.2");
-    require(o.pinch_min_hold_s >= 0 && o.pinch_min_hold_s <= 1, "pinch_min_hold_s must be in [0, 1]");
-    require(o.curl_grab > 0 && o.curl_grab <= 1, "curl_grab must be in (0, 1]");
-    require(o.curl_release >= 0 && o.curl_release < o.curl_grab, "curl_release must be in [0, curl_grab)");
-    require(o.curl_point_index_max > 0 && o.curl_point_index_max < 1, "curl_point_index_max must be in (0, 1)");
-    require(o.min_point_distance_m >= 0.0005 && o.min_point_distance_m <= 0.1,
-            "min_point_distance_m must be in [0.0005, 0.1]");
-    require(o.bridge_loss_s >= 0 && o.bridge_loss_s <= 5, "bridge_loss_s must be in [0, 5]");
-    require(o.min_stroke_length_m >= 0 && o.min_stroke_length_m <= 10, "min_stroke_length_m must be in [0, 10]");
-    require(o.min_stroke_points >= 2 && o.min_stroke_points <= 1000, "min_stroke_points must be in [2, 1000]");
-    require(o.max_hand_speed_mps > 0.5 && o.max_hand_speed_mps <= 100, "max_hand_speed_mps must be in (0.5, 100]");
-    const LobeSettings& l = s.lobes;
-    auto require_lobes = [](bool ok, const char* what) {
-        if (!ok) throw InvalidInput(std::string("settings.lobes.") + what);
-    };
-    require_lobes(l.edge_length_m >= 0.005 && l.edge_length_m <= 0.5, "edge_length_m must be in [0.005, 0.5]");
-    require_lobes(l.remesh_iterations >= 0 && l.remesh_iterations <= 20, "remesh_iterations must be in [0, 20]");
-    require_lobes(l.closed_gap_fraction > 0 && l.closed_gap_fraction <= 0.5, "closed_gap_fraction must be in (0, 0.5]");
-    require_lobes(l.closed_gap_max_m > 0 && l.closed_gap_max_m <= 1, "closed_gap_max_m must be in (0, 1]");
-    require_lobes(l.pinch_roi_radius_m >= 0.01 && l.pinch_roi_radius_m <= 2, "pinch_roi_radius_m must be in [0.01, 2]");
-    require_lobes(l.pinch_pick_distance_m > 0 && l.pinch_pick_distance_m <= 0.5,
-                  "pinch_pick_distance_m must be in (0, 0.5]");
-    validate_growth_settings(s.growth);
-    validate_branch_settings(s.branches);
-    validate_leaf_settings(s.leaves);
-}
-
-void validate_growth_settings(const GrowthSettings& g)
-{
-    auto require = [](bool ok, const char* what) {
-        if (!ok) throw InvalidInput(std::string("settings.growth.") + what);
-    };
-    require(!g.species.empty() && g.species.size() <= 64, "species must be a name of 1 to 64 characters");
-    require(g.split_angle_deg >= 5 && g.split_angle_deg <= 180, "split_angle_deg must be in [5, 180]");
-    require(g.alpha >= -10 && g.alpha <= 10, "alpha must be in [-10, 10]");
-    require(g.beta >= -10 && g.beta <= 10, "beta must be in [-10, 10]");
-    require(g.growth_ratio > 0 && g.growth_ratio <= 1, "growth_ratio must be in (0, 1]");
-    require(g.stop_distance_m >= 0.001 && g.stop_distance_m <= 0.5, "stop_distance_m must be in [0.001, 0.5]");
-    require(g.kill_distance_m >= 0.002 && g.kill_distance_m <= 1, "kill_distance_m must be in [0.002, 1]");
-    require(g.skeleton_spacing_m >= 0.002 && g.skeleton_spacing_m <= 0.5, "skeleton_spacing_m must be in [0.002, 0.5]");
-    require(g.max_iterations >= 1 && g.max_iterations <= 1000, "max_iterations must be in [1, 1000]");
-    require(g.max_nodes >= 100 && g.max_nodes <= 5000000, "max_nodes must be in [100, 5000000]");
-}
-
-void validate_branch_settings(const BranchSettings& b)
-{
-    auto require = [](bool ok, const char* what) {
-        if (!ok) throw InvalidInput(std::string("settings.branches.") + what);
-    };
-    require(b.pipe_exponent >= 1 && b.pipe_exponent <= 4, "pipe_exponent must be in [1, 4]");
-    require(b.tip_radius_m >= 0.0001 && b.tip_radius_m <= 0.05, "tip_radius_m must be in [0.0001, 0.05]");
-    require(b.radial_segments >= 3 && b.radial_segments <= 64, "radial_segments must be in [3, 64]");
-    require(b.ring_spacing_m >= 0.002 && b.ring_spacing_m <= 1, "ring_spacing_m must be in [0.002, 1]");
-    require(b.smoothing_iterations >= 0 && b.smoothing_iterations <= 20, "smoothing_iterations must be in [0, 20]");
-    require(b.lod_count >= 1 && b.lod_count <= 6, "lod_count must be in [1, 6]");
-}
-
-void validate_leaf_settings(const LeafSettings& l)
-{
-    auto require = [](bool ok, const char* what) {
-        if (!ok) throw InvalidInput(std::string("settings.leaves.") + what);
-    };
-    require(l.length_m >= 0.002 && l.length_m <= 1, "length_m must be in [0.002, 1]");
-    require(l.width_m >= 0.001 && l.width_m <= 1, "width_m must be in [0.001, 1]");
-    require(l.per_node >= 0 && l.per_node <= 64, "per_node must be in [0, 64]");
-    require(l.deviation_deg >= 0 && l.deviation_deg <= 180, "deviation_deg must be in [0, 180]");
-    require(l.shape == "ovate" || l.shape == "round" || l.shape == "needle",
-            "shape must be \"ovate\", \"round\" or \"needle\"");
-}
-
-nlohmann::json settings_json(const Settings& s) { return settings_to_json(s); }
-Settings settings_from_json_checked(const nlohmann::json& j) { return settings_from_json(j); }
 
 void validate_lobe_model(const LobeModel& m, const std::string& w)
 {
@@ -759,7 +436,7 @@ json document_to_json(const Document& doc)
              {"version", doc.version},
                 {"source_recording", doc.source_recording},
                 {"seed", doc.seed},
-                {"settings", settings_to_json(doc.settings)},
+                {"settings", settings_json(doc.settings)},
                 {"strokes", std::move(strokes)},
                 {"lobes", std::move(lobes)},
                 {"edits", std::move(edits)},
@@ -849,17 +526,19 @@ Document document_from_json(const json& j)
                 if (!m->is_string()) throw InvalidInput(w + ".mesh: expected a file name");
                 r.mesh_file = m->get<std::string>();
             }
-            read_number_in_range(l, "split_angle_deg", 5.0, 180.0, r.split_angle_deg, w);
+            read_override(l, "split_angle_deg", "growth.split_angle_deg", r.split_angle_deg, w);
             if (auto sp = l.find("species"); sp != l.end()) {
                 if (!sp->is_string() || sp->get<std::string>().size() > 64)
                     throw InvalidInput(w + ".species: expected a name of at most 64 characters");
                 r.species = sp->get<std::string>();
             }
-            read_number_in_range(l, "leaf_length_m", 0.002, 1.0, r.leaf_length_m, w);
+            read_override(l, "leaf_length_m", "leaves.length_m", r.leaf_length_m, w);
             if (auto t = l.find("leaves_per_node"); t != l.end()) {
                 if (!t->is_number_integer()) throw InvalidInput(w + ".leaves_per_node: expected an integer");
                 const auto v = t->get<std::int64_t>();
-                if (v < 0 || v > 64) throw InvalidInput(w + ".leaves_per_node: must be in [0, 64]");
+                const SettingRange& range = find_setting("leaves.per_node")->range;
+                if (!range.contains(static_cast<double>(v)))
+                    throw InvalidInput(w + ".leaves_per_node: must be in " + range.text());
                 r.leaves_per_node = static_cast<int>(v);
             }
             if (auto t = l.find("seed"); t != l.end()) {

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include <glm/mat4x4.hpp>
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>
 
 #include "core/edits.h"
 #include "core/grower_choice.h"
@@ -99,26 +99,6 @@ struct Document {
 /// The grower of the scene's tree: the first tree's, else the default (kDefaultGrowerName).
 /// Today the scene holds one tree grown from every lobe; forests will grow one per entry.
 const GrowerChoice& scene_grower(const Document& doc);
-
-/// \throw InvalidInput naming the first setting out of its range.
-void validate_settings(const Settings& s);
-nlohmann::json settings_json(const Settings& s);
-/// Range checks of one section. \throw InvalidInput naming the setting.
-void validate_growth_settings(const GrowthSettings& g);
-void validate_branch_settings(const BranchSettings& b);
-void validate_leaf_settings(const LeafSettings& l);
-/// One section to and from JSON. The readers refuse unknown keys and wrong types (\throw
-/// InvalidInput naming `where.key`) and leave missing keys as they are, so a species preset
-/// can overlay part of a section; they do not range-check (call validate_*).
-nlohmann::json growth_settings_to_json(const GrowthSettings& g);
-nlohmann::json branch_settings_to_json(const BranchSettings& b);
-nlohmann::json leaf_settings_to_json(const LeafSettings& l);
-void read_growth_settings(const nlohmann::json& j, GrowthSettings& out, const std::string& where);
-void read_branch_settings(const nlohmann::json& j, BranchSettings& out, const std::string& where);
-void read_leaf_settings(const nlohmann::json& j, LeafSettings& out, const std::string& where);
-/// Parses a settings object (unknown keys and wrong types are refused).
-/// \throw InvalidInput
-Settings settings_from_json_checked(const nlohmann::json& j);
 
 nlohmann::json document_to_json(const Document& doc);
 /// \throw InvalidInput naming the offending field when the JSON is not a valid document.

@@ -1,7 +1,9 @@
 #pragma once
 /// \file settings.h
 /// Options structs, one per pipeline stage, with the defaults documented once here.
-/// Every field is settable from the CLI/settings files and stored in the session document.
+/// Every field is settable from the CLI/settings files and stored in the session document,
+/// through the settings table (core/settings_table.h), which lists each once with its key,
+/// range and doc (docs/settings.md). A new field needs its row there.
 
 #include <cstdint>
 #include <map>
@@ -63,7 +65,8 @@ struct LobeSettings {
     double closed_gap_max_m = 0.08;
     /// Region of interest of a pinch edit: vertices within this distance of the handle.
     double pinch_roi_radius_m = 0.08;
-    /// A pinch edit picks the lobe vertex nearest the pinch within this distance.
+    /// A pinch edit picks the lobe vertex nearest the pinch within this distance (the lobe
+    /// itself is picked by the drag, EditPickOptions::lobe_pick_distance_m).
     double pinch_pick_distance_m = 0.05;
 };
 

@@ -61,8 +61,8 @@ std::vector<BranchCurve> smooth_branch_curves(const TreeGraph& graph, const std:
 
 /// Resolution of one branch mesh.
 struct BranchMeshOptions {
-    int radial_segments = 8;        ///< vertices around each ring (3 to 1024)
-    double ring_spacing_m = 0.015;  ///< largest distance between consecutive rings along a curve (> 0)
+    int radial_segments = BranchSettings{}.radial_segments;  ///< vertices around each ring (3 to 1024)
+    double ring_spacing_m = BranchSettings{}.ring_spacing_m; ///< largest distance between rings along a curve (> 0)
     /// A curve point is skipped (no ring on it) only while the curve turns there by less than
     /// this angle; larger turns always get a ring.
     double max_turn_deg = 10.0;

@@ -33,7 +33,7 @@ class MeshRaycaster;
 struct GrowthLobe {
     std::int64_t id = 0;    ///< the lobe's id: keys its random streams
     TriangleMesh mesh;      ///< closed, outward, stage space; its vertices are the attractors
-    double split_angle_deg = 30.0;       ///< t for this lobe (the tree's, or the lobe's override)
+    double split_angle_deg = GrowthSettings{}.split_angle_deg; ///< t for this lobe (the tree's, or the lobe's override)
     std::vector<double> subtree_weights; ///< per library subtree (subtree_weights()); empty = all equal
     std::optional<std::uint64_t> seed;  ///< keys this lobe's random streams instead of the tree's seed
 };

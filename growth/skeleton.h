@@ -14,6 +14,7 @@
 #include <glm/vec3.hpp>
 
 #include "core/mesh.h"
+#include "core/settings.h"
 #include "core/tree.h"
 
 namespace lobe {
@@ -21,7 +22,7 @@ namespace lobe {
 class MeshRaycaster;
 
 struct SkeletonOptions {
-    double spacing_m = 0.02; ///< distance between skeleton nodes along a stroke
+    double spacing_m = GrowthSettings{}.skeleton_spacing_m; ///< distance between skeleton nodes along a stroke
     /// The default trunk's base lies this fraction of the lobes' total height below the
     /// lowest lobe (and never below the stage floor y = 0 when the lobes are above it).
     double default_trunk_fraction = 0.6;

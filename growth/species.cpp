@@ -2,9 +2,12 @@
 
 #include <algorithm>
 
+#include <nlohmann/json.hpp>
+
 #include "core/atomic_file.h"
-#include "core/document.h"
 #include "core/errors.h"
+#include "core/settings_json.h"
+#include "core/settings_table.h"
 #include "growth/embedded_data.h"
 
 namespace lobe {
@@ -52,16 +55,19 @@ SpeciesPreset parse_species(const std::string& text, const std::string& where)
         if (!j["description"].is_string()) throw InvalidInput(where + ": \"description\" must be a string");
         p.description = j["description"].get<std::string>();
     }
-    auto part = [&](const char* key, json& out) {
-        if (!j.contains(key)) return;
-        if (!j[key].is_object()) throw InvalidInput(where + ": \"" + key + "\" must be an object");
-        out = j[key];
-    };
-    part("growth", p.growth);
-    part("branches", p.branches);
-    part("leaves", p.leaves);
-    if (p.growth.contains("species")) throw InvalidInput(where + ": growth.species is the preset's own name");
-    // Every key and type is checked now, so a bad preset fails when it is read, not when used.
+    const char* const sections[] = {"growth", "branches", "leaves"};
+    for (const char* key : sections)
+        if (j.contains(key) && !j[key].is_object()) throw InvalidInput(where + ": \"" + key + "\" must be an object");
+    if (j.contains("growth") && j["growth"].contains("species"))
+        throw InvalidInput(where + ": growth.species is the preset's own name");
+    try {
+        for (const char* key : sections)
+            if (j.contains(key)) read_settings_section(j[key], key, p.settings, key);
+    } catch (const InvalidInput& e) {
+        throw InvalidInput(where + ": species '" + p.name + "': " + e.what());
+    }
+    // Every key and type is checked above and every range now, so a bad preset fails when it
+    // is read, not when used.
     Settings probe;
     try {
         apply_species(probe, p);
@@ -88,14 +94,10 @@ SpeciesPreset load_species(const std::string& name_or_path)
 void apply_species(Settings& settings, const SpeciesPreset& preset)
 {
     Settings s = settings;
+    preset.settings.apply_to(s);
+    s.growth.species = preset.name;
     try {
-        read_growth_settings(preset.growth, s.growth, "growth");
-        read_branch_settings(preset.branches, s.branches, "branches");
-        read_leaf_settings(preset.leaves, s.leaves, "leaves");
-        s.growth.species = preset.name;
-        validate_growth_settings(s.growth);
-        validate_branch_settings(s.branches);
-        validate_leaf_settings(s.leaves);
+        for (const char* section : {"growth", "branches", "leaves"}) validate_settings_section(s, section);
     } catch (const InvalidInput& e) {
         throw InvalidInput("species '" + preset.name + "': " + e.what());
     }

@@ -7,18 +7,17 @@
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "core/settings.h"
+#include "core/settings_table.h"
 
 namespace lobe {
 
 struct SpeciesPreset {
     std::string name;
     std::string description;
-    nlohmann::json growth = nlohmann::json::object();   ///< partial settings.growth
-    nlohmann::json branches = nlohmann::json::object(); ///< partial settings.branches
-    nlohmann::json leaves = nlohmann::json::object();   ///< partial settings.leaves
+    /// Its partial growth, branches and leaves sections, read through the settings table
+    /// (every key and type checked when the preset is parsed; ranges when it is applied).
+    SettingsOverlay settings;
 };
 
 /// Names of the presets compiled into the program, sorted.
@@ -29,8 +28,8 @@ SpeciesPreset parse_species(const std::string& text, const std::string& where);
 /// A shipped preset by name, or a preset file when `name_or_path` ends in ".json".
 /// \throw InvalidInput (unknown name, listing the known ones) or FileError (unreadable file).
 SpeciesPreset load_species(const std::string& name_or_path);
-/// Overlays `preset` on `settings` (growth, branches, leaves; growth.species = its name) and
-/// range-checks the result. Strong guarantee: on a throw `settings` is unchanged.
+/// Overlays `preset` on `settings` (its settings; growth.species = its name) and range-checks
+/// the growth, branches and leaves sections. Strong guarantee: on a throw `settings` is unchanged.
 /// \throw InvalidInput
 void apply_species(Settings& settings, const SpeciesPreset& preset);
 

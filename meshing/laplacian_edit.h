@@ -14,6 +14,7 @@
 #include <glm/vec3.hpp>
 
 #include "core/mesh.h"
+#include "core/settings.h"
 
 namespace lobe {
 
@@ -27,7 +28,7 @@ struct PinchEditOptions {
 
     /// Radius of the ROI: the vertices whose shortest-path distance along edges from the
     /// handle is at most this (metres).
-    double roi_radius_m = 0.08;
+    double roi_radius_m = LobeSettings{}.pinch_roi_radius_m;
     Weights weights = Weights::Cotangent;
     /// Rotate each vertex's Laplacian coordinate δᵢ by the rotation its 1-ring underwent
     /// (estimated from the previous solve) and solve again, so that details turn with the
@@ -48,7 +49,8 @@ struct PinchEditOptions {
 /// \return index of the nearest vertex (the lowest index on ties).
 /// \throw InvalidInput for an empty mesh, a non-finite point, or a point farther than
 ///        max_distance_m from the mesh.
-int pick_handle(const TriangleMesh& mesh, const glm::vec3& point, double max_distance_m = 0.03);
+int pick_handle(const TriangleMesh& mesh, const glm::vec3& point,
+                double max_distance_m = LobeSettings{}.pinch_pick_distance_m);
 
 /// Laplacian surface editing with hard constraints, factored once and solved per frame
 /// (the solver-object pattern of geometry-central's HeatMethodDistanceSolver).

@@ -26,6 +26,7 @@
 #include <glm/vec3.hpp>
 
 #include "core/mesh.h"
+#include "core/settings.h"
 
 namespace lobe {
 
@@ -43,7 +44,7 @@ struct LobeSurfaceOptions {
     /// of the local radius by `fill_sagitta_m` …
     double fill_sagitta_m = 0.0015;
     /// … and at most the angle of this edge length (the attractor spacing).
-    double fill_edge_m = 0.03;
+    double fill_edge_m = LobeSettings{}.edge_length_m;
     /// The fill is laid this many times coarser than the two bounds above (in angle; 1 to
     /// 4). Remeshing puts the attractors at the target spacing and lifts every vertex it makes
     /// along its ray from the centre to the distance interpolated across the fill's triangles

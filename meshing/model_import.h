@@ -9,6 +9,7 @@
 
 #include "core/mesh.h"
 #include "meshing/repair.h"
+#include "meshing/remesh.h"
 
 namespace lobe {
 
@@ -34,8 +35,8 @@ TriangleMesh cluster_vertices(const TriangleMesh& mesh, double cell);
 /// Options of lobe_from_model().
 struct LobeFromModelOptions {
     double size_m = 1.5;                 ///< largest side of the lobe's bounding box
-    double target_edge_length_m = 0.03;  ///< attractor spacing (RemeshOptions)
-    unsigned iterations = 3;             ///< remeshing rounds (RemeshOptions)
+    double target_edge_length_m = RemeshOptions{}.target_edge_length_m; ///< attractor spacing
+    unsigned iterations = RemeshOptions{}.iterations;                   ///< remeshing rounds
     /// A mesh of more triangles than this is simplified by cluster_vertices before repair,
     /// with cubes of `simplify_cell_fraction` × the target edge length at the lobe's size
     /// (the mesh's size taken from the middle 99 % of its vertices on each axis, so that a

@@ -10,16 +10,18 @@
 #include <glm/vec3.hpp>
 
 #include "core/mesh.h"
+#include "core/settings.h"
 
 namespace lobe {
 
 /// Remeshing options.
 struct RemeshOptions {
     /// Target edge length: the attractor spacing, one absolute length for every lobe
-    /// (DESIGN.md: 3 cm).
-    double target_edge_length_m = 0.03;
-    /// Rounds of split / collapse / flip / tangential relaxation / projection.
-    unsigned iterations = 3;
+    /// (settings.lobes.edge_length_m, whose default this is).
+    double target_edge_length_m = LobeSettings{}.edge_length_m;
+    /// Rounds of split / collapse / flip / tangential relaxation / projection
+    /// (settings.lobes.remesh_iterations, whose default this is).
+    unsigned iterations = static_cast<unsigned>(LobeSettings{}.remesh_iterations);
     /// Keep TriangleMesh::feature_edges: they are first split to at most the target length
     /// (so CGAL's protect_constraints precondition, < 4/3 target, holds), then neither split,
     /// collapsed, flipped nor moved. Otherwise they are ignored (and dropped in the output).

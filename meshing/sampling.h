@@ -8,6 +8,8 @@
 
 #include <glm/vec3.hpp>
 
+#include "core/settings.h"
+
 namespace lobe {
 
 /// Curvature-weighted sampling (Eq. 1). The defaults are the paper's where it gives them.
@@ -78,9 +80,9 @@ std::vector<glm::vec3> sample_by_curvature(const std::vector<glm::vec3>& raw, bo
 /// ours.
 struct ClosureOptions {
     /// Closed when the gap is below this fraction of the stroke's length …
-    double max_gap_fraction = 0.15;
+    double max_gap_fraction = LobeSettings{}.closed_gap_fraction;
     /// … and below this many metres.
-    double max_gap_m = 0.08;
+    double max_gap_m = LobeSettings{}.closed_gap_max_m;
     /// An overlapping tail is looked for within this fraction of the length at each end
     /// (at most 2,000 points each).
     double overlap_fraction = 0.25;

@@ -16,10 +16,12 @@
 #include "core/atomic_file.h"
 #include "core/document.h"
 #include "core/errors.h"
+#include "core/settings_json.h"
+#include "core/settings_table.h"
 #include "growth/grower.h"
 #include "growth/species.h"
 #include "input/pipeline.h"
-
+#include "app/session/stage_options.h"
 #include "meshing/mesh_io.h"
 
 namespace lobe::cli {
@@ -76,15 +78,50 @@ Settings load_settings_file(const std::string& path)
     if (j.is_discarded()) throw FileError(path, "not valid JSON");
     try {
         // Accept a bare settings object or a whole session document's "settings".
-        if (j.is_object() && j.contains("format") && j.contains("settings")) return settings_from_json_checked(j["settings"]);
-        return settings_from_json_checked(j);
+        if (j.is_object() && j.contains("format") && j.contains("settings")) return settings_from_json(j["settings"]);
+        return settings_from_json(j);
     } catch (const InvalidInput& e) {
         throw FileError(path, e.what());
     }
 }
 
+namespace {
+
+/// A CLI11 check of one setting's value on the command line: the settings table's parse and
+/// range, its message naming the setting.
+CLI::Validator setting_value_check(const SettingInfo& info)
+{
+    return CLI::Validator(
+        [&info](std::string& text) {
+            try {
+                Settings scratch;
+                set_setting_text(scratch, info, text);
+                return std::string();
+            } catch (const InvalidInput& e) {
+                return std::string(e.what());
+            }
+        },
+        info.allowed(), info.key);
+}
+
+/// The help of an option that sets one setting: its key and doc line.
+std::string setting_help(const SettingInfo& info) { return "Sets " + info.key + ": " + info.doc; }
+
+/// "KEY=VALUE" applied to `overlay`. \throw InvalidInput
+void add_assignment(SettingsOverlay& overlay, const std::string& assignment)
+{
+    const std::size_t eq = assignment.find('=');
+    if (eq == std::string::npos || eq == 0)
+        throw InvalidInput("expected KEY=VALUE (e.g. growth.split_angle_deg=25), not '" + assignment + "'");
+    overlay.set_text(assignment.substr(0, eq), assignment.substr(eq + 1));
+}
+
+} // namespace
+
 void add_tree_input_options(CLI::App* cmd, TreeInputOptions& o)
 {
+    const SettingInfo& split = *find_setting("growth.split_angle_deg");
+    const SettingInfo& spacing = *find_setting("lobes.edge_length_m");
     cmd->add_option("--settings", o.settings, "Settings JSON (a settings object or a session document)");
     cmd->add_option("--species", o.species,
                     "Species preset: broadleaf, conifer, willow, birch, or a preset .json file");
@@ -93,16 +130,39 @@ void add_tree_input_options(CLI::App* cmd, TreeInputOptions& o)
     cmd->add_option("--grower", o.grower, "Growth model: " + grower_names() + " (default: the session's, else " +
                                               std::string(kDefaultGrowerName) + ")")
         ->check(CLI::IsMember(names));
+    cmd->add_option("--set", o.set,
+                    "Sets one setting (repeatable): growth.split_angle_deg=25, leaves.color=0.2,0.4,0.1. Applied "
+                    "after --settings and --species, in the order given, before --split-angle and "
+                    "--attractor-spacing; `lobesketch settings` lists the keys")
+        ->type_name("KEY=VALUE")
+        ->allow_extra_args(false)
+        ->check(CLI::Validator(
+            [](std::string& text) {
+                try {
+                    SettingsOverlay scratch;
+                    add_assignment(scratch, text);
+                    return std::string();
+                } catch (const InvalidInput& e) {
+                    return std::string(e.what());
+                }
+            },
+            "", "setting assignment"));
     cmd->add_option("--seed", o.seed, "Seed of every random choice of growth (default: the session's)");
-    cmd->add_option("--split-angle", o.split_angle, "Split angle t in degrees (smaller: denser branching)")
-        ->check(CLI::Range(5.0, 180.0));
-    cmd->add_option("--attractor-spacing", o.spacing, "Attractor spacing in metres: lobes are remeshed to it")
-        ->check(CLI::Range(0.005, 0.5));
+    cmd->add_option("--split-angle", o.split_angle, setting_help(split))->check(setting_value_check(split));
+    cmd->add_option("--attractor-spacing", o.spacing, setting_help(spacing))->check(setting_value_check(spacing));
+}
+
+SettingsOverlay setting_assignments(const std::vector<std::string>& assignments)
+{
+    SettingsOverlay overlay;
+    for (const std::string& a : assignments) add_assignment(overlay, a);
+    return overlay;
 }
 
 void apply_tree_input_options(Settings& s, const TreeInputOptions& o)
 {
     if (!o.species.empty()) apply_species(s, load_species(o.species));
+    setting_assignments(o.set).apply_to(s);
     if (o.split_angle) s.growth.split_angle_deg = *o.split_angle;
     if (o.spacing) s.lobes.edge_length_m = *o.spacing;
     validate_settings(s);
@@ -137,18 +197,19 @@ Document replay_into_document(const std::string& path, Document doc, std::size_t
     const double duration = rec.frames.empty() ? 0.0 : rec.frames.back().time - rec.frames.front().time;
     progress("replaying " + std::to_string(rec.frames.size()) + " frames (" + std::to_string(duration).substr(0, 6) +
              " s) of " + path);
-    const InputResult result = run_input_pipeline(rec, doc.settings.input);
+    const InputResult result = run_input_pipeline(rec, input_options(doc.settings));
     for (const std::string& m : result.messages) warn(path + ": " + m);
     if (drags) *drags = result.drags.size();
     doc.source_recording = std::filesystem::absolute(path).lexically_normal().string();
-    EditHooks hooks = meshing_edit_hooks();
+    EditHooks hooks = meshing_edit_hooks(edit_apply_options(doc.settings));
     // Meshes imported during the session lie beside the recording (import_mesh_path).
     hooks.import_model = [path](int n) {
         const std::string file = import_mesh_path(path, n);
         return std::make_shared<const LobeModel>(
             LobeModel{std::filesystem::path(file).filename().string(), read_mesh(file)});
     };
-    SessionBuilder builder(std::move(doc), EditPickOptions{}, std::move(hooks));
+    const EditPickOptions pick = edit_pick_options(doc.settings);
+    SessionBuilder builder(std::move(doc), pick, std::move(hooks));
     builder.apply(result.actions);
     for (const std::string& m : builder.messages()) warn(path + ": " + m);
     return builder.take_document();

@@ -5,10 +5,13 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "app/session/tree_pipeline.h"
 #include "core/document.h"
 #include "core/settings.h"
+#include "core/settings_json.h" // the commands that write settings as JSON (settings_json)
+#include "core/settings_table.h"
 #include "input/recording.h"
 
 namespace CLI {
@@ -37,16 +40,27 @@ struct TreeInputOptions {
     std::string settings; ///< settings JSON file (empty: none)
     std::string species;  ///< preset name or .json file (empty: the settings')
     std::string grower;   ///< growth model (growth/grower.h; empty: the session's)
+    std::vector<std::string> set; ///< `--set KEY=VALUE`, in the order given
     std::optional<std::uint64_t> seed;
     std::optional<double> split_angle, spacing;
     double mesh_size = 1.5; ///< a mesh input's largest side (metres)
 };
 
-/// Registers --settings, --species, --grower, --seed, --split-angle and --attractor-spacing.
+/// Registers --settings, --species, --grower, --set, --seed, --split-angle and
+/// --attractor-spacing. The help and range checks of --set, --split-angle and
+/// --attractor-spacing come from the settings table: a bad value is a bad command line (exit
+/// 2) naming the setting.
 void add_tree_input_options(CLI::App* cmd, TreeInputOptions& o);
 
-/// Applies, in the order a person expects, the species and then the single options to `s`,
-/// and validates the result. \throw InvalidInput
+/// `--set` assignments ("growth.split_angle_deg=25"), in order, as an overlay.
+/// \throw InvalidInput naming the key (unknown, a value of the wrong form or out of range).
+SettingsOverlay setting_assignments(const std::vector<std::string>& assignments);
+
+/// Applies the options to `s` in this order, which is a contract (docs/settings.md): the
+/// settings file is the caller's (it replaces the settings first), then the species preset,
+/// then each `--set` in the order given, then --split-angle and --attractor-spacing; then the
+/// result is validated (settings that contradict each other are refused here). --seed sets
+/// the document's seed, not a setting. \throw InvalidInput
 void apply_tree_input_options(Settings& s, const TreeInputOptions& o);
 
 /// Applies the options that are the document's rather than its settings': --seed and

@@ -11,6 +11,7 @@
 #include "app/cli/cli.h"
 #include "app/cli/cli_common.h"
 #include "app/cli/outputs.h"
+#include "app/session/stage_options.h"
 #include "core/errors.h"
 #include "meshing/mesh_io.h"
 #include "meshing/mesh_quality.h"
@@ -48,11 +49,8 @@ void add_lobes_command(CLI::App& app, int& exit_code)
         if (is_mesh) {
             // A mesh becomes one lobe: repaired, scaled, remeshed (docs/lobes-from-models.md).
             if (!a->settings.empty()) doc.settings = load_settings_file(a->settings);
-            LobeFromModelOptions options;
-            options.size_m = a->size_m;
+            LobeFromModelOptions options = model_import_options(doc.settings, a->size_m);
             options.simplify_above_triangles = a->simplify_above;
-            options.target_edge_length_m = doc.settings.lobes.edge_length_m;
-            options.iterations = static_cast<unsigned>(doc.settings.lobes.remesh_iterations);
             RepairReport report;
             const TriangleMesh mesh = lobe_from_model(a->input, options, &report);
             if (!report.notes.empty()) {

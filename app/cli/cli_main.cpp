@@ -16,6 +16,8 @@ void add_recover_command(CLI::App& app, int& exit_code);
 void add_sketch_command(CLI::App& app, int& exit_code);
 // Sketching in a headset (docs/vr.md): app/cli/cli_vr.cpp.
 void add_vr_command(CLI::App& app, int& exit_code);
+// The settings table (docs/settings.md): app/cli/cli_settings.cpp.
+void add_settings_command(CLI::App& app, int& exit_code);
 } // namespace cli
 
 int run_cli(int argc, char** argv)
@@ -39,6 +41,7 @@ int run_cli(int argc, char** argv)
     cli::add_vr_command(app, exit_code);
     cli::add_recover_command(app, exit_code);
     cli::add_sketch_command(app, exit_code);
+    cli::add_settings_command(app, exit_code);
     app.parse_complete_callback([&] { cli::set_quiet(quiet); });
     try {
         app.parse(argc, argv);

@@ -12,6 +12,7 @@
 #include "app/cli/cli.h"
 #include "app/cli/cli_common.h"
 #include "app/session/edit_hooks.h"
+#include "app/session/stage_options.h"
 #include "core/document.h"
 #include "core/errors.h"
 #include "input/pipeline.h"
@@ -129,7 +130,7 @@ void add_recover_command(CLI::App& app, int& exit_code)
             // The pipeline runs over the whole recording, as the live session did, so that its
             // state (filters, gestures, the pen, the tool) is exact where the autosave stopped.
             // Actions of the first saved_frames frames are in the autosave already.
-            InputPipeline pipe(doc.settings.input);
+            InputPipeline pipe(input_options(doc.settings));
             std::vector<InputAction> tail;
             std::vector<Stroke> saved_prefix; ///< strokes completed within the saved frames
             std::size_t e = 0;
@@ -158,14 +159,15 @@ void add_recover_command(CLI::App& app, int& exit_code)
                                                   std::to_string(saved_frames) + " frames is in the autosave");
             }
 
-            EditHooks hooks = meshing_edit_hooks();
+            EditHooks hooks = meshing_edit_hooks(edit_apply_options(doc.settings));
             // Meshes imported during the session lie beside the recording (import_mesh_path).
             hooks.import_model = [rec_path](int n) {
                 const std::string file = import_mesh_path(rec_path, n);
                 return std::make_shared<const LobeModel>(
                     LobeModel{std::filesystem::path(file).filename().string(), read_mesh(file)});
             };
-            SessionBuilder builder(std::move(doc), EditPickOptions{}, std::move(hooks));
+            const EditPickOptions pick = edit_pick_options(doc.settings);
+            SessionBuilder builder(std::move(doc), pick, std::move(hooks));
             std::size_t changes = 0;
             for (const InputAction& act : tail) {
                 if (act.type == InputAction::Type::StrokeDiscarded) warn(rec_path + ": stroke discarded: " + act.message);

@@ -98,10 +98,10 @@ void add_render_command(CLI::App& app, int& exit_code)
 
         RenderScene scene;
         if (lower_extension(a->input) == ".glb") {
-            if (!a->in.settings.empty() || !a->in.species.empty() || !a->in.grower.empty() || a->in.seed ||
-                a->in.split_angle || a->in.spacing)
-                warn(a->input + ": a .glb holds a grown tree; --settings, --species, --grower, --seed, --split-angle "
-                                "and --attractor-spacing do not apply");
+            if (!a->in.settings.empty() || !a->in.species.empty() || !a->in.grower.empty() || !a->in.set.empty() ||
+                a->in.seed || a->in.split_angle || a->in.spacing)
+                warn(a->input + ": a .glb holds a grown tree; --settings, --species, --grower, --set, --seed, "
+                                "--split-angle and --attractor-spacing do not apply");
             scene = glb_render_scene(a->input, content);
         } else {
             const GrownInput grown = grow_input_tree(a->input, a->in);

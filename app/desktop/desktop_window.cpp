@@ -15,6 +15,7 @@
 #include "app/render/renderer.h"
 #include "core/errors.h"
 #include "core/document.h"
+#include "core/settings_json.h"
 #include "input/tools.h"
 
 namespace lobe {

@@ -10,6 +10,7 @@
 #include "core/errors.h"
 #include "growth/branch_geometry.h"
 #include "app/session/edit_ops.h"
+#include "app/session/stage_options.h"
 
 namespace lobe {
 
@@ -29,7 +30,7 @@ LobeLeafOverrides document_lobe_leaves(const Document& doc, const BuiltTree& tre
 
 TreeGeometry document_tree_geometry(const Document& doc, const BuiltTree& tree)
 {
-    return build_tree_geometry(tree.growth.tree, doc.settings.branches, doc.settings.leaves, doc.seed,
+    return build_tree_geometry(tree.growth.tree, branch_geometry_options(doc.settings), leaf_options(doc.settings), doc.seed,
                                doc.settings.growth.species, document_lobe_leaves(doc, tree));
 }
 

@@ -9,6 +9,7 @@
 #include "app/export/tree_output.h"
 #include "app/session/edit_hooks.h"
 #include "app/session/edit_ops.h"
+#include "app/session/stage_options.h"
 #include "core/errors.h"
 #include "meshing/mesh_io.h"
 #include "meshing/mesh_quality.h"
@@ -23,7 +24,7 @@ constexpr std::size_t kMaxMessages = 200;
 } // namespace
 
 LiveSession::LiveSession(Document doc, LiveSessionOptions options)
-    : options_(std::move(options)), pipeline_(doc.settings.input), scene_(options_.lod)
+    : options_(std::move(options)), pipeline_(input_options(doc.settings)), scene_(options_.lod)
 {
     if (!options_.record_path.empty()) {
         recording_ = std::make_unique<RecordingWriter>(options_.record_path, options_.recording_header,
@@ -34,7 +35,7 @@ LiveSession::LiveSession(Document doc, LiveSessionOptions options)
     // session stamp theirs (at_recording_position).
     doc.recording_frames.reset();
     doc.recording_finished = false;
-    EditHooks hooks = meshing_edit_hooks();
+    EditHooks hooks = meshing_edit_hooks(edit_apply_options(doc.settings));
     // Imports of this session, by number (the recording's ImportMesh events).
     hooks.import_model = [this](int n) -> std::shared_ptr<const LobeModel> {
         if (!options_.imports_refused.empty())
@@ -43,7 +44,8 @@ LiveSession::LiveSession(Document doc, LiveSessionOptions options)
         if (it == imports_.end()) throw InvalidInput("import " + std::to_string(n) + " was not made in this session");
         return it->second;
     };
-    builder_ = std::make_unique<SessionBuilder>(std::move(doc), EditPickOptions{}, std::move(hooks));
+    const EditPickOptions pick = edit_pick_options(doc.settings);
+    builder_ = std::make_unique<SessionBuilder>(std::move(doc), pick, std::move(hooks));
     if (!options_.autosave_path.empty()) autosaver_ = std::make_unique<AutosaveWriter>(options_.autosave_path);
     worker_ = std::make_unique<RegrowWorker>([this](RegrowResult& r) { scene_.prepare(r); });
     if (!document().strokes.empty() || !document().lobes.empty()) request_regrowth();
@@ -253,11 +255,7 @@ void LiveSession::place_live_lobe(bool changed)
 // ---------------------------------------------------------------------------------------------
 bool LiveSession::import_mesh(const std::string& path, double size_m)
 {
-    const Document& doc = document();
-    LobeFromModelOptions o;
-    o.size_m = size_m;
-    o.target_edge_length_m = doc.settings.lobes.edge_length_m;
-    o.iterations = static_cast<unsigned>(doc.settings.lobes.remesh_iterations);
+    const LobeFromModelOptions o = model_import_options(document().settings, size_m);
     try {
         if (!options_.imports_refused.empty()) throw InvalidInput(options_.imports_refused);
         if (import_) throw InvalidInput("another import is still being made");

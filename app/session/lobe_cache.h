@@ -44,6 +44,12 @@ private:
     Counts counts_;
 };
 
+/// What a kept lobe was built with: every setting of the lobes section, through the settings
+/// table (settings_key), so a lobes setting added later is in it without more. A lobe whose
+/// key changed is built again. (The input section does not matter: the strokes are in the
+/// document as the input pipeline made them.)
+std::string lobe_build_key(const Settings& settings);
+
 /// build_document_lobes (lobe_document.h), keeping and reusing what `cache` holds of the last
 /// build. The result and the warnings are those of a build without a cache.
 std::vector<BuiltLobe> build_document_lobes(const Document& doc, std::vector<std::string>* warnings,

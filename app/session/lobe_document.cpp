@@ -13,9 +13,11 @@
 #include <glm/matrix.hpp>
 
 #include "core/errors.h"
+#include "core/settings_table.h"
 #include "app/session/edit_ops.h"
 #include "meshing/laplacian_edit.h"
 #include "app/session/lobe_cache.h"
+#include "app/session/stage_options.h"
 #include "meshing/lobe_remesh.h"
 #include "meshing/lobe_transform.h"
 #include "meshing/mesh_quality.h"
@@ -65,8 +67,8 @@ struct FramedPinch {
     FramedPinch(const Document& doc, const TriangleMesh& mesh, const glm::vec3& stage_from, const glm::dmat4& frame)
         : back(glm::inverse(frame)), from(to_frame(stage_from))
     {
-        options.roi_radius_m = doc.settings.lobes.pinch_roi_radius_m;
-        handle = pick_handle(mesh, from, doc.settings.lobes.pinch_pick_distance_m);
+        options = pinch_edit_options(doc.settings);
+        handle = pick_handle(mesh, from, pinch_pick_distance_m(doc.settings));
     }
     glm::vec3 to_frame(const glm::vec3& p) const { return glm::vec3(back * glm::dvec4(glm::dvec3(p), 1.0)); }
     /// Where the handle goes for the pinch at `stage_to`.
@@ -115,8 +117,9 @@ double mean_edge_length(const TriangleMesh& mesh)
     return n ? sum / static_cast<double>(n) : 0.0;
 }
 
-/// A lobe imported from a mesh (LobeRecord::model): the mesh as stored, remeshed again only
-/// when the attractor spacing has since moved more than 25 % away from its edge length.
+/// A lobe imported from a mesh (LobeRecord::model): the mesh as stored, remeshed again
+/// (`remesh`: model_lobe_remesh_options) only when the attractor spacing has since moved more
+/// than 25 % away from its edge length.
 /// \throw InvalidInput when the stored mesh cannot be remeshed (not a 2-manifold).
 BuiltLobe model_document_lobe(const LobeRecord& rec, const RemeshOptions& remesh)
 {
@@ -135,10 +138,7 @@ BuiltLobe model_document_lobe(const LobeRecord& rec, const RemeshOptions& remesh
     const double edge = mean_edge_length(built.surface.mesh);
     const double target = remesh.target_edge_length_m;
     if (remesh.iterations > 0 && (edge < 0.75 * target || edge > 1.25 * target)) {
-        RemeshOptions o = remesh;
-        o.protect_feature_edges = false;
-        o.relax_feature_edges = false;
-        built.mesh = remesh_isotropic(built.surface.mesh, o);
+        built.mesh = remesh_isotropic(built.surface.mesh, remesh);
     } else {
         built.mesh = built.surface.mesh;
     }
@@ -146,18 +146,6 @@ BuiltLobe model_document_lobe(const LobeRecord& rec, const RemeshOptions& remesh
 }
 
 } // namespace
-
-LobeOptions lobe_options_from(const Settings& settings)
-{
-    LobeOptions o;
-    o.closure.max_gap_fraction = settings.lobes.closed_gap_fraction;
-    o.closure.max_gap_m = settings.lobes.closed_gap_max_m;
-    o.surface.fill_edge_m = settings.lobes.edge_length_m;
-    // Without remeshing the fill is the lobe's attractors: laid at the spacing itself.
-    if (settings.lobes.remesh_iterations <= 0) o.surface.fill_coarseness = 1.0;
-    o.sampling.seed = 0;
-    return o;
-}
 
 struct LobeBuildCache::Impl {
     /// One entry of a lobe's stroke list: the stroke as edited, or a stroke that is missing.
@@ -169,7 +157,7 @@ struct LobeBuildCache::Impl {
     };
     /// A lobe after its steps: the joined strokes, what joining said, and the remeshed mesh.
     struct Entry {
-        std::array<double, 4> key{}; ///< the settings the lobe is built with (options_key)
+        std::string key;                   ///< the settings the lobe is built with (lobe_build_key)
         std::vector<Step> steps;
         Lobe lobe;
         std::vector<std::int64_t> accepted;
@@ -183,16 +171,11 @@ struct LobeBuildCache::Impl {
 };
 
 LobeBuildCache::LobeBuildCache() : impl_(std::make_unique<Impl>()) {}
+
+std::string lobe_build_key(const Settings& settings) { return settings_key(settings, "lobes"); }
 LobeBuildCache::~LobeBuildCache() = default;
 
 namespace {
-
-/// The settings a stroke lobe is built and remeshed with (lobe_options_from, RemeshOptions).
-std::array<double, 4> options_key(const Settings& settings)
-{
-    return {settings.lobes.closed_gap_fraction, settings.lobes.closed_gap_max_m, settings.lobes.edge_length_m,
-            static_cast<double>(settings.lobes.remesh_iterations)};
-}
 
 /// Every lobe of `doc`, before pinch edits and transforms; with `cache`, lobes are taken from
 /// it or continued where their strokes only grew, and it is left holding this build.
@@ -201,12 +184,9 @@ std::vector<BuiltLobe> build_lobes(const Document& doc, std::vector<std::string>
 {
     using Entry = LobeBuildCache::Impl::Entry;
     using Step = LobeBuildCache::Impl::Step;
-    const LobeOptions options = lobe_options_from(doc.settings);
-    const std::array<double, 4> key = options_key(doc.settings);
-    RemeshOptions remesh;
-    remesh.target_edge_length_m = doc.settings.lobes.edge_length_m;
-    remesh.iterations = static_cast<unsigned>(doc.settings.lobes.remesh_iterations);
-    remesh.relax_feature_edges = true;
+    const LobeOptions options = lobe_options(doc.settings);
+    const std::string key = lobe_build_key(doc.settings);
+    const RemeshOptions remesh = stroke_lobe_remesh_options(doc.settings);
     // Strokes with their stroke edits (Bézier, Fig. 6a) applied, each lobe's in its own frame.
     std::vector<SkippedEdit> skipped;
     const std::vector<Stroke> strokes = edited_strokes(doc, {}, &skipped);
@@ -217,7 +197,7 @@ std::vector<BuiltLobe> build_lobes(const Document& doc, std::vector<std::string>
     for (const LobeRecord& rec : doc.lobes) {
         if (rec.model) {
             try {
-                out.push_back(model_document_lobe(rec, remesh));
+                out.push_back(model_document_lobe(rec, model_lobe_remesh_options(doc.settings)));
             } catch (const InvalidInput& e) {
                 if (warnings) warnings->push_back("lobe " + std::to_string(rec.id) + ": " + e.what() + "; the lobe is left out");
             }
@@ -444,7 +424,7 @@ std::size_t apply_pinch_edits(const Document& doc, std::int64_t lobe_id, Triangl
         if (op.target == 0) {
             glm::vec3 from, to;
             if (!drag_ends(op, from, to) ||
-                nearest_vertex_distance(mesh, from) > doc.settings.lobes.pinch_pick_distance_m)
+                nearest_vertex_distance(mesh, from) > pinch_pick_distance_m(doc.settings))
                 continue;
         }
         if (apply_pinch(doc, op, mesh, warnings)) ++applied;

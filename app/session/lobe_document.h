@@ -32,9 +32,6 @@ struct BuiltLobe {
 /// the first kMaxStrokesPerLobe of a lobe are left out with one warning (docs/limits.md).
 inline constexpr std::size_t kMaxStrokesPerLobe = 1000;
 
-/// The options the document's settings give.
-LobeOptions lobe_options_from(const Settings& settings);
-
 /// Rebuilds every lobe of `doc` that has at least one stroke that can join. Warnings (a
 /// stroke left out, an edit that picked nothing) are appended to `warnings` when given,
 /// one line each.

@@ -11,7 +11,9 @@
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
+#include "app/session/panel_controls.h"
 #include "core/errors.h"
+#include "core/settings_table.h"
 
 namespace lobe {
 
@@ -710,20 +712,24 @@ bool SessionBuilder::apply_setting(const InputAction& a)
         messages_.push_back(when(label.c_str(), a.time) + why);
         return false;
     };
-    if (!name) return refuse("unknown setting id " + std::to_string(static_cast<std::int32_t>(c.id)));
+    // What the panels change, and what each accepts: app/session/panel_controls.h.
+    const PanelControl* control = find_panel_control(c.id);
+    if (!name || !control) return refuse("unknown setting id " + std::to_string(static_cast<std::int32_t>(c.id)));
     const double v = c.value;
     if (!std::isfinite(v)) return refuse("the value is not a finite number");
-    // Whole numbers in [lo, hi].
+    const SettingRange accepts = control->accepts();
+    // Whole numbers the control accepts (an integer setting's range is checked by the table).
     auto whole = [&](double lo, double hi) { return v >= lo && v <= hi && v == std::floor(v); };
+    const SettingInfo* setting = control->setting();
 
     Settings s = doc_.settings;
     std::uint64_t seed = doc_.seed;
     LobeRecord* lobe = nullptr;
     LobeRecord lobe_after; // the lobe's overrides after this setting
     if (c.lobe != 0) {
-        if (c.id == SettingId::AttractorSpacing)
+        if (control->tree_wide_only)
             return refuse(std::string(name) + " is a tree-wide setting (lobe " + std::to_string(c.lobe) +
-                          " given): every lobe carries the same attractor density");
+                          " given): " + control->tree_wide_only);
         for (LobeRecord& l : doc_.lobes)
             if (l.id == c.lobe) lobe = &l;
         if (!lobe) return refuse("there is no lobe " + std::to_string(c.lobe));
@@ -731,43 +737,45 @@ bool SessionBuilder::apply_setting(const InputAction& a)
     }
     try {
         switch (c.id) {
-        case SettingId::SplitAngle:
-            if (lobe) {
-                GrowthSettings g = s.growth;
-                g.split_angle_deg = v;
-                validate_growth_settings(g);
-                lobe_after.split_angle_deg = v;
-            } else {
-                s.growth.split_angle_deg = v;
-                validate_growth_settings(s.growth);
-            }
+        case SettingId::SplitAngle: {
+            Settings probe = s;
+            set_setting(probe, *setting, v);
+            validate_settings_section(probe, "growth");
+            if (lobe) lobe_after.split_angle_deg = v;
+            else s = std::move(probe);
             break;
+        }
         case SettingId::AttractorSpacing:
-            s.lobes.edge_length_m = v;
+            set_setting(s, *setting, v);
             validate_settings(s);
             break;
         case SettingId::LeafLength: {
-            LeafSettings l = s.leaves;
+            Settings probe = s;
+            LeafSettings& l = probe.leaves;
             const double ratio = l.width_m / l.length_m;
-            l.length_m = v;
+            set_setting(probe, *setting, v);
             l.width_m = v * ratio;
-            validate_leaf_settings(l);
+            validate_settings_section(probe, "leaves");
             if (lobe) lobe_after.leaf_length_m = v;
             else s.leaves = l;
             break;
         }
         case SettingId::LeavesPerNode: {
             if (!whole(-1e9, 1e9)) return refuse("leaves per node must be a whole number");
-            LeafSettings l = s.leaves;
-            l.per_node = static_cast<int>(v);
-            validate_leaf_settings(l);
-            if (lobe) lobe_after.leaves_per_node = l.per_node;
-            else s.leaves = l;
+            Settings probe = s;
+            set_setting(probe, *setting, static_cast<int>(v));
+            validate_settings_section(probe, "leaves");
+            if (lobe) lobe_after.leaves_per_node = probe.leaves.per_node;
+            else s.leaves = probe.leaves;
             break;
         }
         case SettingId::Species: {
-            if (!whole(0, kSettingSpeciesCount - 1))
-                return refuse("the species index must be 0 to 3 (broadleaf, conifer, willow, birch)");
+            if (!whole(accepts.lo, accepts.hi)) {
+                std::string names;
+                for (int i = 0; i < kSettingSpeciesCount; ++i) names += (i ? ", " : "") + std::string(kSettingSpecies[i]);
+                return refuse("the species index must be " + number_text(accepts.lo) + " to " + number_text(accepts.hi) +
+                              " (" + names + ")");
+            }
             const std::string chosen = kSettingSpecies[static_cast<int>(v)];
             if (lobe) {
                 lobe_after.species = chosen;
@@ -775,12 +783,14 @@ bool SessionBuilder::apply_setting(const InputAction& a)
                 const std::string why = hooks_.apply_species(s, chosen);
                 if (!why.empty()) return refuse(why);
             } else {
-                s.growth.species = chosen;
+                set_setting(s, *setting, chosen);
             }
             break;
         }
         case SettingId::Seed:
-            if (!whole(1, 16777215)) return refuse("the seed must be a whole number from 1 to 16777215");
+            if (!whole(accepts.lo, accepts.hi))
+                return refuse("the seed must be a whole number from " + number_text(accepts.lo) + " to " +
+                              number_text(accepts.hi));
             if (lobe) lobe_after.seed = static_cast<std::uint64_t>(v);
             else seed = static_cast<std::uint64_t>(v);
             break;
@@ -792,7 +802,7 @@ bool SessionBuilder::apply_setting(const InputAction& a)
                                        lobe_after.species != lobe->species ||
                                        lobe_after.leaf_length_m != lobe->leaf_length_m ||
                                        lobe_after.leaves_per_node != lobe->leaves_per_node || lobe_after.seed != lobe->seed);
-    const bool changed = seed != doc_.seed || settings_json(s) != settings_json(doc_.settings) || lobe_changed;
+    const bool changed = seed != doc_.seed || !settings_equal(s, doc_.settings) || lobe_changed;
     if (!changed) return false;
     // A slider being dragged: one undo step for the whole run.
     const bool merge = setting_run_ && setting_run_->first == c.id && setting_run_->second == c.lobe && !undo_.empty();

@@ -14,20 +14,24 @@
 
 #include "core/document.h"
 #include "input/pipeline.h"
+#include "meshing/stroke_edit.h"
 
 namespace lobe {
 
 /// Where a drag picks what it edits. The paper gives no numbers; these are ours.
 struct EditPickOptions {
     /// Edit-stroke drags: the drag start (and the pointing fingertip of the other hand)
-    /// must be within this of a stroke point (metres). Recorded in the operation.
-    double stroke_pick_distance_m = 0.03;
+    /// must be within this of a stroke point (metres). Recorded in the operation; stroke
+    /// editing (meshing/stroke_edit.h) falls back to the same default for an operation
+    /// without it, so it is that default.
+    double stroke_pick_distance_m = StrokeEditOptions{}.pick_distance_m;
     /// Edit-stroke drags with one hand: arc length of the bent segment on each side of the
-    /// picked point (metres). Recorded in the operation.
-    double stroke_half_length_m = 0.08;
+    /// picked point (metres). Recorded in the operation, as stroke_pick_distance_m.
+    double stroke_half_length_m = StrokeEditOptions{}.half_length_m;
     /// Lobe drags (deform, move, rotate, scale) pick a lobe when they start within this of
     /// one of its stroke points, or inside its bounding sphere (centre: lobe_centre; radius:
-    /// its farthest stroke point).
+    /// its farthest stroke point). Another distance than settings.lobes.pinch_pick_distance_m,
+    /// which then picks the pinch's handle among the picked lobe's mesh vertices.
     double lobe_pick_distance_m = 0.05;
 };
 

@@ -7,6 +7,7 @@
 #include "growth/radii.h"
 #include "growth/species.h"
 #include "app/session/edit_ops.h"
+#include "app/session/stage_options.h"
 #include "meshing/model_import.h"
 
 namespace lobe {
@@ -14,13 +15,14 @@ namespace lobe {
 std::vector<GrowthLobe> growth_lobes(const Document& doc, const std::vector<BuiltLobe>& lobes)
 {
     const SubtreeLibrary& library = default_subtree_library();
-    const std::vector<double> tree_weights = subtree_weights(library, doc.settings.growth.subtree_weights);
+    const GrowthSettings& growth = growth_options(doc.settings);
+    const std::vector<double> tree_weights = subtree_weights(library, growth.subtree_weights);
     std::vector<GrowthLobe> out;
     for (const BuiltLobe& b : lobes) {
         GrowthLobe g;
         g.id = b.lobe_id;
         g.mesh = b.mesh;
-        g.split_angle_deg = doc.settings.growth.split_angle_deg;
+        g.split_angle_deg = growth.split_angle_deg;
         g.subtree_weights = tree_weights;
         for (const LobeRecord& r : doc.lobes) {
             if (r.id != b.lobe_id) continue;
@@ -28,8 +30,8 @@ std::vector<GrowthLobe> growth_lobes(const Document& doc, const std::vector<Buil
                 // The lobe's species brings its own split angle and subtree mix.
                 Settings s = doc.settings;
                 apply_species(s, load_species(r.species));
-                g.split_angle_deg = s.growth.split_angle_deg;
-                g.subtree_weights = subtree_weights(library, s.growth.subtree_weights);
+                g.split_angle_deg = growth_options(s).split_angle_deg;
+                g.subtree_weights = subtree_weights(library, growth_options(s).subtree_weights);
             }
             if (r.split_angle_deg) g.split_angle_deg = *r.split_angle_deg;
             g.seed = r.seed;
@@ -58,7 +60,8 @@ BuiltTree grow_document_tree(const Document& doc, std::vector<BuiltLobe> lobes)
     in.seed = doc.seed;
     in.choice = scene_grower(doc);
     t.growth = checked_grower(in.choice, "trees[0].grower").grow(in);
-    assign_pipe_radii(t.growth.tree, doc.settings.branches.pipe_exponent, doc.settings.branches.tip_radius_m);
+    const PipeRadiiOptions radii = pipe_radii_options(doc.settings);
+    assign_pipe_radii(t.growth.tree, radii.exponent, radii.tip_radius_m);
     for (const std::string& m : t.growth.messages) t.warnings.push_back("growth: " + m);
     return t;
 }
@@ -75,13 +78,9 @@ BuiltTree build_document_tree(const Document& doc)
 
 BuiltLobe model_lobe(const std::string& path, const Settings& settings, double size_m, std::int64_t id)
 {
-    LobeFromModelOptions mo;
-    mo.size_m = size_m;
-    mo.target_edge_length_m = settings.lobes.edge_length_m;
-    mo.iterations = static_cast<unsigned>(settings.lobes.remesh_iterations);
     BuiltLobe lobe;
     lobe.lobe_id = id;
-    lobe.mesh = lobe_from_model(path, mo);
+    lobe.mesh = lobe_from_model(path, model_import_options(settings, size_m));
     float lo = std::numeric_limits<float>::max(), hi = -lo;
     for (const glm::vec3& p : lobe.mesh.positions) {
         lo = std::min(lo, p.y);

@@ -21,6 +21,8 @@
 #include "app/cli/cli_common.h"
 #include "core/document.h"
 #include "core/errors.h"
+#include "core/settings_json.h"
+#include "core/settings_table.h"
 #include "growth/branch_geometry.h"
 #include "growth/grow.h"
 #include "growth/species.h"

@@ -16,6 +16,7 @@
 #include "core/atomic_file.h"
 #include "core/document.h"
 #include "core/errors.h"
+#include "core/settings_table.h"
 #include "growth/species.h"
 #include "input/importers.h"
 #include "input/recording.h"

@@ -8,6 +8,7 @@
 #include <limits>
 #include <string>
 #include <vector>
+#include <nlohmann/json.hpp>
 
 #include "core/document.h"
 #include "core/errors.h"

@@ -416,7 +416,8 @@ TEST(Species, BadPresetsAreRefusedWithOneLineAndSettingsUnchanged)
     Settings s;
     SpeciesPreset bad;
     bad.name = "bad";
-    bad.leaves = {{"per_node", 1000}};
+    bad.settings.values.leaves.per_node = 1000;
+    bad.settings.mark("leaves.per_node");
     EXPECT_THROW(apply_species(s, bad), InvalidInput);
     EXPECT_EQ(s.leaves.per_node, LeafSettings{}.per_node);
     EXPECT_EQ(s.growth.species, "broadleaf");

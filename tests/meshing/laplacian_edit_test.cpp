@@ -473,8 +473,10 @@ TEST(PinchEdit, PickHandleTakesTheNearestVertexWithinReach)
     const glm::vec3 p = mesh.positions[100] + glm::vec3(0.002f, -0.001f, 0.001f);
     EXPECT_EQ(pick_handle(mesh, p), 100);
     const glm::vec3 far = glm::vec3(kCentre + 0.29 * outward(mesh, 100)); // 4 cm off the surface
-    test::expect_one_line_throw<InvalidInput>([&] { pick_handle(mesh, far); });
+    test::expect_one_line_throw<InvalidInput>([&] { pick_handle(mesh, far, 0.03); });
     EXPECT_EQ(pick_handle(mesh, far, 0.05), 100);
+    // The default reach is the pinch pick distance setting's default.
+    EXPECT_EQ(pick_handle(mesh, far), 100);
     test::expect_one_line_throw<InvalidInput>([&] { pick_handle(TriangleMesh{}, p); });
     test::expect_one_line_throw<InvalidInput>([&] { pick_handle(mesh, glm::vec3(std::nanf(""), 0.f, 0.f)); });
 }

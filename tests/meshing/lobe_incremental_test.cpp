@@ -18,6 +18,7 @@
 #include "core/errors.h"
 #include "meshing/lobe.h"
 #include "app/session/lobe_cache.h"
+#include "app/session/stage_options.h"
 #include "meshing/lobe_regions.h"
 #include "meshing/lobe_remesh.h"
 #include "meshing/mesh_quality.h"
@@ -275,7 +276,7 @@ TEST(LobeIncremental, EveryShippedLobeStrokeRemeshesOnlyTheRegionsItChangedAndKe
         remesh.target_edge_length_m = doc.settings.lobes.edge_length_m;
         remesh.iterations = static_cast<unsigned>(doc.settings.lobes.remesh_iterations);
         for (const LobeRecord& rec : doc.lobes) {
-            Lobe lobe(lobe_options_from(doc.settings));
+            Lobe lobe(lobe_options(doc.settings));
             LobeRemeshCache cache;
             TriangleMesh before;
             for (std::int64_t id : rec.stroke_ids) {
@@ -369,7 +370,7 @@ TEST(LobeIncremental, ShippedAndRandomLobeStrokesBuildOnlyTheRegionsTheyChangeAn
         if (test::source_data(std::string("recordings/") + name + ".lrec").empty()) return;
         const Document doc = test::replay_document(name);
         for (const LobeRecord& rec : doc.lobes) {
-            Lobe lobe(lobe_options_from(doc.settings));
+            Lobe lobe(lobe_options(doc.settings));
             for (std::int64_t id : rec.stroke_ids) {
                 const auto it = std::find_if(doc.strokes.begin(), doc.strokes.end(), [&](const Stroke& s) { return s.id == id; });
                 ASSERT_NE(it, doc.strokes.end());

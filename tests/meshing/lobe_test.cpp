@@ -14,6 +14,7 @@
 #include <tuple>
 
 #include <glm/geometric.hpp>
+#include <nlohmann/json.hpp>
 
 #include "core/document.h"
 #include "core/errors.h"
@@ -27,6 +28,7 @@
 #include "app/session/edit_ops.h"
 #include "meshing/lobe.h"
 #include "app/session/lobe_document.h"
+#include "app/session/stage_options.h"
 #include "meshing/lobe_remesh.h"
 #include "meshing/mesh_quality.h"
 #include "meshing/repair.h"
@@ -407,10 +409,10 @@ TEST(Lobes, ALobeThatIsNotRemeshedKeepsItsFillAtTheAttractorSpacing)
         return n;
     };
     ASSERT_GT(doc.settings.lobes.remesh_iterations, 0);
-    EXPECT_EQ(lobe_options_from(doc.settings).surface.fill_coarseness, 2.0);
+    EXPECT_EQ(lobe_options(doc.settings).surface.fill_coarseness, 2.0);
     const auto remeshed = build_document_lobes(doc);
     doc.settings.lobes.remesh_iterations = 0;
-    EXPECT_EQ(lobe_options_from(doc.settings).surface.fill_coarseness, 1.0);
+    EXPECT_EQ(lobe_options(doc.settings).surface.fill_coarseness, 1.0);
     const auto kept = build_document_lobes(doc);
     ASSERT_EQ(remeshed.size(), 1u);
     ASSERT_EQ(kept.size(), 1u);

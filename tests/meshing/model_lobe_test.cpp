@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 #include <glm/geometric.hpp>
+#include <nlohmann/json.hpp>
 
 #include "app/session/edit_hooks.h"
 #include "core/errors.h"

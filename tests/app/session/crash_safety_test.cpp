@@ -23,6 +23,7 @@
 #include <unistd.h>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "app/live/autosave.h"
 #include "app/desktop/desktop_session.h"

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <glm/geometric.hpp>
+#include <nlohmann/json.hpp>
 
 #include "app/session/edit_hooks.h"
 #include "core/document.h"

@@ -12,10 +12,12 @@
 #include <vector>
 
 #include <glm/geometric.hpp>
+#include <nlohmann/json.hpp>
 
 #include "app/session/edit_hooks.h"
 #include "core/document.h"
 #include "core/errors.h"
+#include "core/settings_json.h"
 #include "growth/species.h"
 #include "input/pipeline.h"
 #include "input/recording.h"

@@ -28,6 +28,7 @@
 #include <sstream>
 #include <string>
 #include <vector>
+#include <nlohmann/json.hpp>
 
 #include "app/export/export_scene.h"
 #include "app/cli/outputs.h"

@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 #include <glm/gtc/constants.hpp>
+#include <nlohmann/json.hpp>
 
 #include "app/cli/cli_common.h"
 #include "app/render/render_scene.h"

@@ -14,10 +14,12 @@
 #include <regex>
 #include <string>
 #include <vector>
+#include <nlohmann/json.hpp>
 
 #include "app/export/export_scene.h"
 #include "app/vr/vr_session.h"
 #include "core/document.h"
+#include "core/settings_json.h"
 #include "input/recording.h"
 #include "tests/support/cli_run.h"
 #include "tests/support/test_data.h"

@@ -347,7 +347,7 @@ bad_settings("subtree-weight-negative.json", {"growth": {"subtree_weights": {"fo
 bad_settings("filter-wrong-type.json", {"input": {"filter": [1, 2, 3]}}, "settings.input.filter: expected an object",
              "a filter that is an array")
 bad_settings("pinch-release-below-start.json", {"input": {"pinch_start_m": 0.02, "pinch_release_m": 0.01}},
-             "settings.input.pinch_release_m must be above pinch_start_m", "settings that contradict each other")
+             "settings.input.pinch_release_m must be in (pinch_start_m, 0.2)", "settings that contradict each other")
 bad_settings("session-with-bad-settings.json", {"format": "lobesketch-session", "version": 1,
                                                 "settings": {"leaves": {"length_m": -1}}},
              "settings.leaves.length_m must be in [0.002, 1]", "a session document whose settings are out of range")

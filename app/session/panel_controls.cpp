@@ -1,0 +1,38 @@
+#include "app/session/panel_controls.h"
+
+namespace lobe {
+
+const std::vector<PanelControl>& panel_controls()
+{
+    static const std::vector<PanelControl> controls = {
+        {SettingId::SplitAngle, "growth.split_angle_deg", "split t", 5.0, 90.0, 5.0, nullptr},
+        {SettingId::AttractorSpacing, "lobes.edge_length_m", "spacing", 0.01, 0.10, 0.001,
+         "every lobe carries the same attractor density"},
+        {SettingId::LeafLength, "leaves.length_m", "leaf size", 0.01, 0.20, 0.001, nullptr},
+        {SettingId::LeavesPerNode, "leaves.per_node", "leaves", 0.0, 16.0, 1.0, nullptr},
+        {SettingId::Species, "growth.species", "species", 0.0, kSettingSpeciesCount - 1.0, 1.0, nullptr},
+        {SettingId::Seed, "seed", "seed", 1.0, 16777215.0, 1.0, nullptr},
+    };
+    return controls;
+}
+
+const PanelControl* find_panel_control(SettingId id)
+{
+    for (const PanelControl& c : panel_controls())
+        if (c.id == id) return &c;
+    return nullptr;
+}
+
+const SettingInfo* PanelControl::setting() const { return find_setting(key); }
+
+SettingRange PanelControl::accepts() const
+{
+    const SettingInfo* info = setting();
+    if (info && (info->type == SettingType::Number || info->type == SettingType::Integer)) return info->range;
+    SettingRange r;
+    r.lo = lo;
+    r.hi = hi;
+    return r;
+}
+
+} // namespace lobe
