@@ -23,6 +23,7 @@
 
 #include "app/render/renderer.h"
 #include "app/vr/vr_session.h"
+#include "app/vr/xr_check.h"
 #include "core/hand_frame.h"
 
 // OpenXR and Vulkan structures are written {type} first and filled member by member.
@@ -33,17 +34,6 @@ namespace lobe {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-const char* result_name(XrResult r)
-{
-    switch (r) {
-#define LOBE_XR_RESULT_CASE(name, value) \
-    case name: return #name;
-        XR_LIST_ENUM_XrResult(LOBE_XR_RESULT_CASE)
-#undef LOBE_XR_RESULT_CASE
-    default: return "an unknown XrResult";
-    }
-}
 
 const char* state_name(XrSessionState s)
 {
@@ -60,16 +50,8 @@ const char* state_name(XrSessionState s)
     }
 }
 
-std::string failed(const char* call, XrResult r)
-{
-    return std::string("OpenXR: ") + call + " failed with " + result_name(r) + " (" + std::to_string(int(r)) + ")";
-}
-
-void check(XrResult r, const char* call)
-{
-    if (XR_FAILED(r)) throw XrFailure(failed(call, r));
-}
-#define LOBE_XR_CHECK(call) check((call), #call)
+using xr::failed_call;
+using xr::result_name;
 
 // What each refusal tells a person to do (one line each; docs/vr.md says more).
 const char* const kRuntimesHint = "e.g. Monado, SteamVR or Meta Quest Link";
@@ -291,7 +273,7 @@ void XrHost::Impl::create_instance()
     if (r == XR_ERROR_EXTENSION_NOT_PRESENT) throw XrUnavailable(no_hands_message(""));
     if (XR_FAILED(r)) {
         instance = XR_NULL_HANDLE;
-        throw XrFailure(failed("xrCreateInstance", r));
+        throw XrFailure(failed_call("xrCreateInstance", r));
     }
     XrInstanceProperties ip{XR_TYPE_INSTANCE_PROPERTIES};
     LOBE_XR_CHECK(xrGetInstanceProperties(instance, &ip));
@@ -317,7 +299,7 @@ void XrHost::Impl::find_system()
     if (r == XR_ERROR_FORM_FACTOR_UNSUPPORTED)
         throw XrUnavailable("vr: the OpenXR runtime '" + runtime_name +
                             "' drives no head-mounted display: use a headset runtime (" + kRuntimesHint + ")");
-    check(r, "xrGetSystem");
+    xr::check(r, "xrGetSystem", __FILE__, __LINE__);
 
     XrSystemHandTrackingPropertiesEXT htp{XR_TYPE_SYSTEM_HAND_TRACKING_PROPERTIES_EXT};
     XrSystemProperties sp{XR_TYPE_SYSTEM_PROPERTIES};
@@ -375,7 +357,7 @@ void XrHost::Impl::make_renderer()
         VkResult vr = VK_SUCCESS;
         const XrResult r = create_vk_instance(instance, &ci, &vk, &vr);
         if (XR_FAILED(r)) {
-            hook_failure = failed("xrCreateVulkanInstanceKHR", r);
+            hook_failure = failed_call("xrCreateVulkanInstanceKHR", r);
             vk_result = VK_ERROR_INITIALIZATION_FAILED;
             return 0;
         }
@@ -389,7 +371,7 @@ void XrHost::Impl::make_renderer()
         VkPhysicalDevice pd = VK_NULL_HANDLE;
         const XrResult r = get_vk_device(instance, &gi, &pd);
         if (XR_FAILED(r)) {
-            hook_failure = failed("xrGetVulkanGraphicsDevice2KHR", r);
+            hook_failure = failed_call("xrGetVulkanGraphicsDevice2KHR", r);
             return 0;
         }
         return reinterpret_cast<std::uint64_t>(pd);
@@ -404,7 +386,7 @@ void XrHost::Impl::make_renderer()
         VkResult vr = VK_SUCCESS;
         const XrResult r = create_vk_device(instance, &ci, &dev, &vr);
         if (XR_FAILED(r)) {
-            hook_failure = failed("xrCreateVulkanDeviceKHR", r);
+            hook_failure = failed_call("xrCreateVulkanDeviceKHR", r);
             vk_result = VK_ERROR_INITIALIZATION_FAILED;
             return 0;
         }
@@ -579,7 +561,7 @@ bool XrHost::Impl::alive(XrResult r, const char* call)
         instance_lost = true;
         return false;
     }
-    check(r, call);
+    xr::check(r, call, __FILE__, __LINE__);
     return true;
 }
 
@@ -651,7 +633,7 @@ HandFrame XrHost::Impl::locate(XrTime t)
         }
         if (XR_FAILED(r)) {
             // One hand that cannot be located is a hand not tracked, not the end of the session.
-            if (!locate_warned) message("vr: " + failed("xrLocateHandJointsEXT", r) + "; the hand counts as not tracked");
+            if (!locate_warned) message("vr: " + failed_call("xrLocateHandJointsEXT", r) + "; the hand counts as not tracked");
             locate_warned = true;
             continue;
         }
@@ -791,7 +773,7 @@ bool XrHost::Impl::reconnect(VrSession& vr)
                     rebase_clock = true;
                     continue;
                 }
-                check(r, "xrGetSystem");
+                xr::check(r, "xrGetSystem", __FILE__, __LINE__);
                 if (again != system) {
                     disconnect(); // another system: everything is made anew
                     rebase_clock = true;
