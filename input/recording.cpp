@@ -79,6 +79,7 @@ const char* setting_name(SettingId id)
     case SettingId::LeavesPerNode: return "leaves-per-node";
     case SettingId::Species: return "species";
     case SettingId::Seed: return "seed";
+    case SettingId::Grower: return "grower";
     }
     return nullptr;
 }

@@ -9,6 +9,7 @@
 #include "app/desktop/desktop_script.h"
 #include "app/desktop/desktop_session.h"
 #include "core/document.h"
+#include "growth/grower.h"
 #include "input/recording.h"
 #include "input/tools.h"
 
@@ -72,6 +73,19 @@ void draw_desktop_panel(DesktopSession& session, const std::string& session_name
         button("mirror");
         button("undo");
         button("redo");
+    }
+    if (ImGui::CollapsingHeader("Grower", ImGuiTreeNodeFlags_DefaultOpen)) {
+        // Every growth model there is; the scene's tree grows with the one chosen.
+        const GrowerChoice& current = scene_grower(doc);
+        if (ImGui::BeginCombo("model", current.name.c_str())) {
+            for (const Grower* g : growers()) {
+                const std::string name(g->name());
+                if (ImGui::Selectable(name.c_str(), name == current.name))
+                    session.setting(static_cast<int>(SettingId::Grower), 0, g->panel_code());
+                if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", std::string(g->title()).c_str());
+            }
+            ImGui::EndCombo();
+        }
     }
     if (ImGui::CollapsingHeader("Appearance", ImGuiTreeNodeFlags_DefaultOpen)) {
         std::string target = state.target_lobe == 0 ? "whole tree" : "lobe " + std::to_string(state.target_lobe);

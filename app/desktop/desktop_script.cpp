@@ -92,6 +92,7 @@ const std::vector<PanelSetting>& panel_settings()
         {"leaves", static_cast<int>(SettingId::LeavesPerNode)},
         {"species", static_cast<int>(SettingId::Species)},
         {"seed", static_cast<int>(SettingId::Seed)},
+        {"grower", static_cast<int>(SettingId::Grower)},
     };
     return settings;
 }

@@ -1,6 +1,21 @@
 #include "app/session/panel_controls.h"
 
+#include <algorithm>
+
+#include "growth/grower.h"
+
 namespace lobe {
+
+namespace {
+
+int highest_panel_code()
+{
+    int code = 0;
+    for (const Grower* g : growers()) code = std::max(code, g->panel_code());
+    return code;
+}
+
+} // namespace
 
 const std::vector<PanelControl>& panel_controls()
 {
@@ -12,6 +27,8 @@ const std::vector<PanelControl>& panel_controls()
         {SettingId::LeavesPerNode, "leaves.per_node", "leaves", 0.0, 16.0, 1.0, nullptr},
         {SettingId::Species, "growth.species", "species", 0.0, kSettingSpeciesCount - 1.0, 1.0, nullptr},
         {SettingId::Seed, "seed", "seed", 1.0, 16777215.0, 1.0, nullptr},
+        {SettingId::Grower, "grower", "grower", 0.0, double(highest_panel_code()), 1.0,
+         "the scene's tree grows with one grower"},
     };
     return controls;
 }

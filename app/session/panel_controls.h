@@ -17,8 +17,9 @@ namespace lobe {
 
 struct PanelControl {
     SettingId id;
-    /// The settings-table key it sets ("growth.split_angle_deg"), or "seed" for
-    /// Document::seed. Species sets growth.species by an index into kSettingSpecies.
+    /// The settings-table key it sets ("growth.split_angle_deg"), "seed" for Document::seed
+    /// or "grower" for the scene's grower (by its panel code, growth/grower.h). Species sets
+    /// growth.species by an index into kSettingSpecies.
     const char* key;
     const char* label;   ///< shown on the panel
     double lo, hi, step; ///< what the widget offers, in the setting's unit (Species: the index)
@@ -28,7 +29,7 @@ struct PanelControl {
     /// The settings-table row it sets; nullptr for the seed.
     const SettingInfo* setting() const;
     /// What a Setting event's value must lie in: the setting's range in the table, or for
-    /// Species and Seed, [lo, hi] (whole numbers).
+    /// Species, Seed and Grower, [lo, hi] (whole numbers).
     SettingRange accepts() const;
 };
 

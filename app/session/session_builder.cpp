@@ -12,6 +12,8 @@
 #include <glm/geometric.hpp>
 
 #include "app/session/panel_controls.h"
+#include "app/session/session_file.h"
+#include "growth/grower.h"
 #include "core/errors.h"
 #include "core/settings_table.h"
 
@@ -726,6 +728,7 @@ bool SessionBuilder::apply_setting(const InputAction& a)
     std::uint64_t seed = doc_.seed;
     LobeRecord* lobe = nullptr;
     LobeRecord lobe_after; // the lobe's overrides after this setting
+    std::optional<GrowerChoice> grower_after; // the scene's grower, when this setting picks another
     if (c.lobe != 0) {
         if (control->tree_wide_only)
             return refuse(std::string(name) + " is a tree-wide setting (lobe " + std::to_string(c.lobe) +
@@ -787,6 +790,19 @@ bool SessionBuilder::apply_setting(const InputAction& a)
             }
             break;
         }
+        case SettingId::Grower: {
+            const Grower* chosen = nullptr;
+            for (const Grower* g : growers())
+                if (whole(accepts.lo, accepts.hi) && g->panel_code() == static_cast<int>(v)) chosen = g;
+            if (!chosen) return refuse("no grower has panel code " + number_text(v) + " (growers: " + grower_names() + ")");
+            if (chosen->name() != scene_grower(doc_).name) {
+                GrowerChoice choice;
+                choice.name = chosen->name();
+                choice.version = chosen->version();
+                grower_after = std::move(choice);
+            }
+            break;
+        }
         case SettingId::Seed:
             if (!whole(accepts.lo, accepts.hi))
                 return refuse("the seed must be a whole number from " + number_text(accepts.lo) + " to " +
@@ -802,7 +818,7 @@ bool SessionBuilder::apply_setting(const InputAction& a)
                                        lobe_after.species != lobe->species ||
                                        lobe_after.leaf_length_m != lobe->leaf_length_m ||
                                        lobe_after.leaves_per_node != lobe->leaves_per_node || lobe_after.seed != lobe->seed);
-    const bool changed = seed != doc_.seed || !settings_equal(s, doc_.settings) || lobe_changed;
+    const bool changed = seed != doc_.seed || !settings_equal(s, doc_.settings) || lobe_changed || grower_after;
     if (!changed) return false;
     // A slider being dragged: one undo step for the whole run.
     const bool merge = setting_run_ && setting_run_->first == c.id && setting_run_->second == c.lobe && !undo_.empty();
@@ -810,6 +826,7 @@ bool SessionBuilder::apply_setting(const InputAction& a)
     doc_.settings = std::move(s);
     doc_.seed = seed;
     if (lobe) *lobe = std::move(lobe_after);
+    if (grower_after) set_scene_grower(doc_, std::move(*grower_after));
     setting_run_ = std::make_pair(c.id, c.lobe);
     return true;
 }

@@ -14,6 +14,7 @@
 #include "app/render/render_scene.h"
 #include "app/render/scene_parts.h"
 #include "core/errors.h"
+#include "growth/grower.h"
 
 namespace lobe {
 
@@ -44,7 +45,7 @@ constexpr std::array<float, 4> kDragInkColor{0.25f, 0.65f, 1.0f, 1.0f};
 
 /// Setting buttons: what they change and by how much (multiplicative steps for sizes).
 enum SettingButton : int {
-    kAngleDown = 1, kAngleUp, kLeafDown, kLeafUp, kLeavesDown, kLeavesUp, kNextSpecies, kNextSeed,
+    kAngleDown = 1, kAngleUp, kLeafDown, kLeafUp, kLeavesDown, kLeavesUp, kNextSpecies, kNextSeed, kNextGrower,
 };
 
 /// The button a key or setting button is made from (positions come from the layout).
@@ -126,7 +127,7 @@ VrPanel vr_panel_layout(const Pose& head)
          setting_button("LEAF -", kLeafDown), setting_button("LEAF +", kLeafUp),
          setting_button("LEAVES -", kLeavesDown), setting_button("LEAVES +", kLeavesUp)},
         {setting_button("SPECIES", kNextSpecies), setting_button("SEED", kNextSeed),
-         key_button("DEL STROKE", keys::kDeleteStroke)},
+         key_button("DEL STROKE", keys::kDeleteStroke), setting_button("GROWER", kNextGrower)},
     };
     const float pitch_x = kButtonW + kButtonGap, pitch_y = kButtonH + kButtonGap;
     const float top = 0.5f * float(rows.size() - 1) * pitch_y;
@@ -343,6 +344,16 @@ void VrSession::Impl::press(const VrButton& b, int index)
         for (int i = 0; i < kSettingSpeciesCount; ++i)
             if (doc.settings.growth.species == kSettingSpecies[i]) current = i;
         v = (current + 1) % kSettingSpeciesCount;
+        break;
+    }
+    case kNextGrower: {
+        // The next of every grower there is (growth/grower.h), round again after the last.
+        e.code = static_cast<int>(SettingId::Grower);
+        const auto list = growers();
+        std::size_t current = 0;
+        for (std::size_t i = 0; i < list.size(); ++i)
+            if (list[i]->name() == scene_grower(doc).name) current = i;
+        v = list[(current + 1) % list.size()]->panel_code();
         break;
     }
     case kNextSeed:

@@ -612,7 +612,8 @@ TEST(RecordingSettings, SettingEventsRoundTripExactlyInBothForms)
     EXPECT_NE(encode_recording_text(rec).find("event 0.2 setting 1 0 22.5\n"), std::string::npos);
     EXPECT_STREQ(event_kind_name(InputEventKind::Setting), "setting");
     EXPECT_STREQ(setting_name(SettingId::LeavesPerNode), "leaves-per-node");
-    EXPECT_EQ(setting_name(static_cast<SettingId>(7)), nullptr);
+    EXPECT_STREQ(setting_name(SettingId::Grower), "grower");
+    EXPECT_EQ(setting_name(static_cast<SettingId>(8)), nullptr);
 }
 
 TEST(RecordingSettings, UnknownSettingIdIsSkippedWithAWarningNotACrash)

@@ -7,7 +7,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/session/panel_controls.h"
+#include "app/session/session_builder.h"
 #include "app/session/session_file.h"
+#include "growth/grower.h"
 #include "core/errors.h"
 #include "tests/support/cli_run.h"
 #include "tests/support/test_paths.h"
@@ -75,6 +78,42 @@ TEST(SessionFile, GrowWithTheDefaultGrowerNamedGivesTheSameTreeAndAnUnknownOneIs
     EXPECT_NE(bad.out.find("--grower"), std::string::npos) << bad.out;
     const test::CliRun help = test::run_cli("grow --help");
     EXPECT_NE(help.out.find(kDefaultGrowerName), std::string::npos) << help.out;
+}
+
+InputAction grower_setting(double code, std::int64_t lobe = 0)
+{
+    InputAction a;
+    a.type = InputAction::Type::SettingChanged;
+    a.time = 1.0;
+    a.setting.id = SettingId::Grower;
+    a.setting.value = code;
+    a.setting.lobe = lobe;
+    return a;
+}
+
+TEST(SessionFile, ThePanelsGrowerSettingPicksAGrowerByItsPanelCodeAndRefusesOthersInOneLine)
+{
+    const PanelControl* control = find_panel_control(SettingId::Grower);
+    ASSERT_NE(control, nullptr);
+    EXPECT_STREQ(setting_name(SettingId::Grower), "grower");
+    SessionBuilder b;
+    // Every grower listed; the one already growing the tree changes nothing (no undo step).
+    for (const Grower* g : growers()) {
+        EXPECT_GE(g->panel_code(), control->accepts().lo);
+        EXPECT_LE(g->panel_code(), control->accepts().hi);
+        if (g->name() == kDefaultGrowerName) {
+            EXPECT_FALSE(b.apply(grower_setting(g->panel_code())));
+        }
+    }
+    EXPECT_TRUE(b.document().trees.empty());
+    EXPECT_FALSE(b.apply(grower_setting(control->accepts().hi + 1)));
+    EXPECT_FALSE(b.apply(grower_setting(0.5)));
+    EXPECT_FALSE(b.apply(grower_setting(growers().front()->panel_code(), 3))); // tree-wide only
+    ASSERT_EQ(b.messages().size(), 3u);
+    EXPECT_NE(b.messages()[0].find("setting grower"), std::string::npos) << b.messages()[0];
+    EXPECT_NE(b.messages()[0].find("no grower has panel code"), std::string::npos) << b.messages()[0];
+    EXPECT_NE(b.messages()[2].find("tree-wide"), std::string::npos) << b.messages()[2];
+    for (const std::string& m : b.messages()) EXPECT_EQ(m.find('\n'), std::string::npos) << m;
 }
 
 } // namespace

@@ -79,7 +79,9 @@ TEST(VrSession, PanelLayoutStandsInFrontOfAndBelowTheFirstHeadPoseFacingIt)
     EXPECT_LT(p.origin.y, head.position.y - 0.2f); // below the eyes
     const glm::vec3 n = p.orientation * glm::vec3(0, 0, 1);
     EXPECT_GT(glm::dot(n, glm::normalize(head.position - p.origin)), 0.99f); // faces the eyes
-    EXPECT_EQ(p.buttons.size(), 27u);
+    EXPECT_EQ(p.buttons.size(), 28u);
+    EXPECT_EQ(std::count_if(p.buttons.begin(), p.buttons.end(), [](const VrButton& b) { return b.text == "GROWER"; }), 1)
+        << "the panel lists the growers";
     for (std::size_t i = 0; i < p.buttons.size(); ++i)
         for (std::size_t j = i + 1; j < p.buttons.size(); ++j)
             EXPECT_GT(glm::distance(p.buttons[i].centre, p.buttons[j].centre), 0.04f) << p.buttons[i].text;
