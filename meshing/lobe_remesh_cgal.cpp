@@ -11,20 +11,12 @@
 #include <tuple>
 #include <utility>
 
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wconversion"
-#pragma GCC diagnostic ignored "-Wshadow"
-#pragma GCC diagnostic ignored "-Wsign-conversion"
-#pragma GCC diagnostic ignored "-Wunused-parameter"
-#pragma GCC diagnostic ignored "-Wpedantic"
-#ifndef __clang__ // GCC only: Clang has no such warning and would warn about the pragma
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#endif
+#include "meshing/cgal_prelude.h"
+LOBE_CGAL_HEADERS_BEGIN
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Triangulation_face_base_with_info_2.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
-#pragma GCC diagnostic pop
+LOBE_CGAL_HEADERS_END
 
 #include <glm/geometric.hpp>
 
@@ -38,12 +30,12 @@ namespace lobe {
 namespace {
 
 using Index = std::size_t;
-using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Vb = CGAL::Triangulation_vertex_base_with_info_2<int, K>;
-using Fb0 = CGAL::Constrained_triangulation_face_base_2<K>;
-using Fb = CGAL::Triangulation_face_base_with_info_2<int, K, Fb0>;
+using cgal::Kernel;
+using Vb = CGAL::Triangulation_vertex_base_with_info_2<int, Kernel>;
+using Fb0 = CGAL::Constrained_triangulation_face_base_2<Kernel>;
+using Fb = CGAL::Triangulation_face_base_with_info_2<int, Kernel, Fb0>;
 using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
-using CDT = CGAL::Constrained_Delaunay_triangulation_2<K, Tds, CGAL::Exact_predicates_tag>;
+using CDT = CGAL::Constrained_Delaunay_triangulation_2<Kernel, Tds, CGAL::Exact_predicates_tag>;
 using Key3 = std::array<float, 3>;
 
 constexpr double kDegree = 3.14159265358979323846 / 180.0;
@@ -234,10 +226,10 @@ TriangleMesh triangulate_region(const LobeSurface& surface, const RegionInput& r
 
     auto plane_point = [&](const glm::dvec3& d) {
         const glm::dvec2 x = chart.to_plane(d);
-        return K::Point_2(x.x, x.y);
+        return Kernel::Point_2(x.x, x.y);
     };
     TriangleMesh out;
-    std::vector<std::pair<K::Point_2, int>> points;
+    std::vector<std::pair<Kernel::Point_2, int>> points;
     for (int v : region.inner) {
         points.emplace_back(plane_point(direction(mesh.positions[static_cast<Index>(v)])), static_cast<int>(out.positions.size()));
         out.positions.push_back(mesh.positions[static_cast<Index>(v)]);

@@ -21,19 +21,10 @@
 
 #include <glm/geometric.hpp>
 
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wconversion"
-#pragma GCC diagnostic ignored "-Wshadow"
-#pragma GCC diagnostic ignored "-Wsign-conversion"
-#pragma GCC diagnostic ignored "-Wunused-parameter"
-#pragma GCC diagnostic ignored "-Wpedantic"
-#ifndef __clang__ // GCC only: Clang has no such warning and would warn about the pragma
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#endif
-#pragma GCC diagnostic ignored "-Wdeprecated-copy"
+#include "meshing/cgal_prelude.h"
+LOBE_CGAL_HEADERS_BEGIN
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
 #include <CGAL/Constrained_triangulation_face_base_2.h>
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Spatial_sort_traits_adapter_2.h>
 #include <CGAL/property_map.h>
 #include <CGAL/spatial_sort.h>
@@ -42,7 +33,7 @@
 #include <Eigen/Dense>
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
-#pragma GCC diagnostic pop
+LOBE_CGAL_HEADERS_END
 
 #include "core/errors.h"
 #include "meshing/lobe_regions.h"
@@ -54,7 +45,7 @@ namespace lobe {
 
 namespace {
 
-using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using cgal::Kernel;
 struct VertexInfo {
     int id = -1; ///< index into the node table; -1: created by CGAL at a residual crossing
 };
@@ -62,11 +53,11 @@ struct FaceInfo {
     int region = -1;  ///< region id (see mark_regions)
     bool fine = false; ///< refinement found nothing to add here; reset when the face changes
 };
-using Vb = CGAL::Triangulation_vertex_base_with_info_2<VertexInfo, K>;
-using Fb0 = CGAL::Constrained_triangulation_face_base_2<K>;
-using Fb = CGAL::Triangulation_face_base_with_info_2<FaceInfo, K, Fb0>;
+using Vb = CGAL::Triangulation_vertex_base_with_info_2<VertexInfo, Kernel>;
+using Fb0 = CGAL::Constrained_triangulation_face_base_2<Kernel>;
+using Fb = CGAL::Triangulation_face_base_with_info_2<FaceInfo, Kernel, Fb0>;
 using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
-using CDT = CGAL::Constrained_Delaunay_triangulation_2<K, Tds, CGAL::Exact_predicates_tag>;
+using CDT = CGAL::Constrained_Delaunay_triangulation_2<Kernel, Tds, CGAL::Exact_predicates_tag>;
 using VH = CDT::Vertex_handle;
 using FH = CDT::Face_handle;
 using Index = std::size_t;
@@ -168,10 +159,10 @@ bool solver_ok(const Eigen::VectorXd& x)
 /// Sorts `order` (indices into `where`) along a space-filling curve: points inserted into
 /// the triangulation in that order stay near the last one, where points taken along a
 /// stroke, or along the Fibonacci lattice, make insertions flip long fans or walk far.
-void spatially_sort(std::vector<std::size_t>& order, std::vector<K::Point_2>& where)
+void spatially_sort(std::vector<std::size_t>& order, std::vector<Kernel::Point_2>& where)
 {
-    using Map = CGAL::Pointer_property_map<K::Point_2>::type;
-    CGAL::spatial_sort(order.begin(), order.end(), CGAL::Spatial_sort_traits_adapter_2<K, Map>(CGAL::make_property_map(where)));
+    using Map = CGAL::Pointer_property_map<Kernel::Point_2>::type;
+    CGAL::spatial_sort(order.begin(), order.end(), CGAL::Spatial_sort_traits_adapter_2<Kernel, Map>(CGAL::make_property_map(where)));
 }
 
 /// The segments of all strokes, as arcs between unit directions, binned in a uniform grid
@@ -1098,7 +1089,7 @@ void Builder::plan_partial()
 VH Builder::insert_node(int id, VH hint)
 {
     const glm::dvec2 x = stereo_.to_plane(nodes_[static_cast<Index>(id)].dir);
-    const K::Point_2 p(x.x, x.y);
+    const Kernel::Point_2 p(x.x, x.y);
     VH v = hint == VH() ? cdt_.insert(p) : cdt_.insert(p, hint->face());
     // Nodes at one point (two strokes through the same sample) share the vertex: it is the
     // first node's, whatever order they went in.
@@ -1111,7 +1102,7 @@ void Builder::triangulate()
     node_vertex_.assign(nodes_.size(), VH());
     VH hint;
     {
-        std::vector<K::Point_2> where(nodes_.size());
+        std::vector<Kernel::Point_2> where(nodes_.size());
         std::vector<std::size_t> order;
         std::vector<char> seen(nodes_.size(), 0);
         if (partial_) {
@@ -1130,7 +1121,7 @@ void Builder::triangulate()
                 if (!seen[static_cast<Index>(id)]) {
                     seen[static_cast<Index>(id)] = 1;
                     const glm::dvec2 x = stereo_.to_plane(nodes_[static_cast<Index>(id)].dir);
-                    where[static_cast<Index>(id)] = K::Point_2(x.x, x.y);
+                    where[static_cast<Index>(id)] = Kernel::Point_2(x.x, x.y);
                     order.push_back(static_cast<std::size_t>(id));
                 }
         spatially_sort(order, where);
@@ -1280,7 +1271,7 @@ void Builder::insert_fill(const Node& n, const glm::dvec2& x, int region, VH& hi
 {
     const int id = add_node(n);
     node_vertex_.push_back(VH());
-    const K::Point_2 p(x.x, x.y);
+    const Kernel::Point_2 p(x.x, x.y);
     const std::size_t before = cdt_.number_of_vertices();
     VH v = hint == VH() ? cdt_.insert(p) : cdt_.insert(p, hint->face());
     if (v->info().id < 0) v->info().id = id;
@@ -1383,7 +1374,7 @@ void Builder::seed_fill(double max_edge, int& added)
     const int count = static_cast<int>(std::ceil(4.0 * M_PI / (spacing * spacing * 0.866)));
     const double golden = M_PI * (3.0 - std::sqrt(5.0));
     std::vector<glm::dvec3> lattice;
-    std::vector<K::Point_2> where;
+    std::vector<Kernel::Point_2> where;
     for (int i = 0; i < count; ++i) {
         const double z = 1.0 - (2.0 * i + 1.0) / count;
         const double rr = std::sqrt(std::max(0.0, 1.0 - z * z));
@@ -1418,7 +1409,7 @@ void Builder::seed_fill(double max_edge, int& added)
     FH hint_face;
     for (std::size_t i : order) {
         const glm::dvec3& d = lattice[i];
-        const K::Point_2& p = where[i];
+        const Kernel::Point_2& p = where[i];
         // Located before any fill vertex goes in.
         CDT::Locate_type lt;
         int li = 0;
@@ -1510,7 +1501,7 @@ void Builder::refine()
             // triangle: no stroke is crossed either way.
             const double radius = circumradius_angle(a, b, c);
             bool use_cc = radius < longest;
-            K::Point_2 cc;
+            Kernel::Point_2 cc;
             if (use_cc) {
                 cc = CGAL::circumcenter(f->vertex(0)->point(), f->vertex(1)->point(), f->vertex(2)->point());
                 CDT::Locate_type lt;
