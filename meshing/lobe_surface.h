@@ -1,7 +1,8 @@
 #pragma once
 /// \file lobe_surface.h
 /// The closed surface of one lobe through all of its strokes (§4.2, Fig. 5 and 9). CGAL
-/// works behind this plain interface (lobe_surface_cgal.cpp). See docs/lobes.md.
+/// works behind this plain interface (lobe_surface_cgal.cpp; the stages of a build are listed
+/// in lobe_surface_builder.h). See docs/lobes.md.
 ///
 /// A lobe is star-shaped around its centre: every point of a foliage envelope is seen from
 /// inside it. The strokes, seen from the centre, are curves on the sphere of directions.
@@ -84,7 +85,7 @@ struct LobeVertexOrigin {
 
 /// What a build found over all of its strokes (the pole and its search, the crossings, the
 /// radius model's normal equations per stroke), kept so that the build after one more stroke
-/// looks only at that stroke where the answer cannot differ (lobe_surface_cgal.cpp). Never
+/// looks only at that stroke where the answer cannot differ (lobe_surface_builder.h). Never
 /// changes the result.
 struct LobeBuildMemo;
 
