@@ -179,6 +179,22 @@ protected:
     bool find_crossings(bool only_new);
     void sort_crossings();
     void build_chains();
+    // build_chains' steps (lobe_surface_chains.cpp).
+    /// A crossing on a stroke: on its segment `seg` at parameter `t`, node `node`.
+    struct CrossingOnStroke {
+        int seg;
+        double t;
+        int node;
+    };
+    void add_sample_nodes();
+    void add_crossing_nodes();
+    void merge_close_crossings();
+    /// Stroke `s`'s samples and its crossings (`list`) in order, without the samples next to
+    /// a crossing. \throw InvalidInput when too few are left.
+    std::vector<int> stroke_chain(Index s, std::vector<CrossingOnStroke> list) const;
+    /// `chain` with its long segments split into pieces of at most max_piece_angle_ seen from
+    /// the centre.
+    std::vector<int> subdivided_chain(Index s, const std::vector<int>& chain);
     void plan_partial();
     glm::vec3 emitted_position(int id) const
     {
