@@ -163,6 +163,14 @@ protected:
     /// Stage 7: `built` in canonical order, the fill's radii solved, into `out`
     /// (lobe_surface_emit.cpp). `regions` (may be null): set to surface_regions of the result.
     void emit(SphereTriangles built, LobeSurface& out, SurfaceRegions* regions);
+    // emit's steps (lobe_surface_emit.cpp).
+    /// Puts the nodes in canonical order, renumbering `triangles`; returns the new id of each
+    /// old one.
+    std::vector<int> sort_nodes(std::vector<std::array<int, 3>>& triangles);
+    /// Adds to `out` the vertices of the nodes `triangles` use (and, for a build of the changed
+    /// regions, every stroke node) in the output's order; returns each node's vertex, or -1.
+    std::vector<int> emit_vertices(const std::vector<std::array<int, 3>>& triangles, const std::vector<char>& on_chain,
+                                   LobeSurface& out) const;
 
     std::string stroke_name(int s) const
     {

@@ -53,44 +53,157 @@ std::vector<std::array<int, 3>> LobeSurfaceBuilder::paper_strip(int a, int b) co
     return region;
 }
 
+namespace {
+
+/// Appends the triangles of `built` (over the sorted nodes) to out.mesh as their vertices
+/// (`out_index`) go, each starting at its lowest index (same orientation), and turns its
+/// stroke sides' flags with it.
+/// \throw InvalidInput where a triangle faces the centre: the strokes fold over each other.
+void emit_triangles(SphereTriangles& built, const std::vector<Node>& nodes, const std::vector<int>& out_index,
+                    const glm::dvec3& centre, LobeSurface& out)
+{
+    const std::vector<std::array<int, 3>>& tris = built.triangles;
+    std::vector<std::uint8_t>& tri_mask = built.stroke_sides;
+    for (const auto& t : tris) {
+        const glm::dvec3 d0 = nodes[static_cast<Index>(t[0])].dir, d1 = nodes[static_cast<Index>(t[1])].dir,
+                         d2 = nodes[static_cast<Index>(t[2])].dir;
+        const std::array<int, 3> o{out_index[static_cast<Index>(t[0])], out_index[static_cast<Index>(t[1])],
+                                   out_index[static_cast<Index>(t[2])]};
+        const glm::dvec3 p0(out.mesh.positions[static_cast<Index>(o[0])]);
+        const glm::dvec3 p1(out.mesh.positions[static_cast<Index>(o[1])]);
+        const glm::dvec3 p2(out.mesh.positions[static_cast<Index>(o[2])]);
+        const glm::dvec3 normal = glm::cross(p1 - p0, p2 - p0);
+        const glm::dvec3 mid = (p0 + p1 + p2) / 3.0 - centre;
+        if (!(orient3(d0, d1, d2) > 0.0) || !(glm::dot(normal, mid) > 0.0))
+            throw InvalidInput("the lobe's strokes fold over each other as seen from its centre (draw around the lobe)");
+        // Each triangle starts at its lowest index (same orientation), its sides' flags turned with it.
+        const Index first = static_cast<Index>(std::min_element(o.begin(), o.end()) - o.begin());
+        out.mesh.triangles.push_back({o[first], o[(first + 1) % 3], o[(first + 2) % 3]});
+        const unsigned m = tri_mask[static_cast<Index>(&t - tris.data())];
+        tri_mask[static_cast<Index>(&t - tris.data())] =
+            static_cast<std::uint8_t>(((m >> first) | (m << (3 - first))) & 7u);
+    }
+}
+
+/// Sorts out.mesh.triangles, bucketed by their first (lowest) index, each bucket (a vertex's
+/// few triangles) sorted; flags the paper strips' triangles (the first built.strip_triangles);
+/// `regions_out` (may be null) receives the regions as surface_regions finds them.
+void sort_triangles(const SphereTriangles& built, LobeSurface& out, SurfaceRegions* regions_out)
+{
+    auto& tris_out = out.mesh.triangles;
+    std::vector<int> start(out.mesh.positions.size() + 1, 0);
+    for (const auto& t : tris_out) ++start[static_cast<Index>(t[0]) + 1];
+    for (Index i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+    struct Sorted {
+        std::array<int, 3> t;
+        std::uint8_t strip, mask;
+        int region;
+    };
+    std::vector<Sorted> sorted(tris_out.size());
+    std::vector<int> next(start.begin(), start.end() - 1);
+    for (Index k = 0; k < tris_out.size(); ++k)
+        sorted[static_cast<Index>(next[static_cast<Index>(tris_out[k][0])]++)] = {
+            tris_out[k], static_cast<std::uint8_t>(k < built.strip_triangles ? 1 : 0), built.stroke_sides[k], built.region[k]};
+    for (Index i = 0; i + 1 < start.size(); ++i)
+        std::sort(sorted.begin() + start[i], sorted.begin() + start[i + 1],
+                  [](const Sorted& x, const Sorted& y) { return x.t < y.t; });
+    out.paper_strip_faces.resize(sorted.size());
+    for (Index k = 0; k < sorted.size(); ++k) {
+        tris_out[k] = sorted[k].t;
+        out.paper_strip_faces[k] = sorted[k].strip;
+    }
+    if (regions_out) {
+        // As surface_regions finds them: numbered by their first triangle, each with its
+        // stroke edges directed as its triangles run round them, sorted.
+        std::vector<int> number(static_cast<Index>(built.region_count), -1);
+        MeshRegions& mr = regions_out->regions;
+        mr = MeshRegions{};
+        mr.face_region.reserve(sorted.size());
+        auto& keys = regions_out->edges;
+        keys.clear();
+        for (const Sorted& x : sorted) {
+            int& n = number[static_cast<Index>(x.region)];
+            if (n < 0) {
+                n = mr.count++;
+                keys.emplace_back();
+            }
+            mr.face_region.push_back(n);
+            for (Index k = 0; k < 3; ++k) {
+                if (!(x.mask & (1u << k))) continue;
+                const glm::vec3& p = out.mesh.positions[static_cast<Index>(x.t[k])];
+                const glm::vec3& q = out.mesh.positions[static_cast<Index>(x.t[(k + 1) % 3])];
+                keys[static_cast<Index>(n)].push_back({p.x, p.y, p.z, q.x, q.y, q.z});
+            }
+        }
+        for (auto& k : keys) std::sort(k.begin(), k.end());
+    }
+}
+
+/// The stroke segments (split at crossings), the constraints of remeshing, as `mesh`'s
+/// feature edges (sorted).
+void emit_stroke_edges(const std::vector<std::array<int, 2>>& stroke_edges, const std::vector<int>& new_id,
+                       const std::vector<int>& out_index, TriangleMesh& mesh)
+{
+    for (const auto& [u, v] : stroke_edges) {
+        const int a = out_index[static_cast<Index>(new_id[static_cast<Index>(u)])];
+        const int b = out_index[static_cast<Index>(new_id[static_cast<Index>(v)])];
+        if (a >= 0 && b >= 0 && a != b) mesh.feature_edges.push_back({std::min(a, b), std::max(a, b)});
+    }
+    std::sort(mesh.feature_edges.begin(), mesh.feature_edges.end());
+}
+
+} // namespace
+
 void LobeSurfaceBuilder::emit(SphereTriangles built, LobeSurface& out, SurfaceRegions* regions_out)
 {
-    std::vector<std::array<int, 3>>& tris = built.triangles; // node ids, outward
-    const std::vector<int>& tri_region = built.region;
-    std::vector<std::uint8_t>& tri_mask = built.stroke_sides;
-    const std::size_t strip_count = built.strip_triangles;
-    out.paper_strip_triangles = strip_count;
+    out.paper_strip_triangles = built.strip_triangles;
+    const std::vector<int> new_id = sort_nodes(built.triangles);
+    std::vector<char> on_chain(nodes_.size(), 0);
+    for (const auto& chain : chains_)
+        for (int id : chain) on_chain[static_cast<Index>(new_id[static_cast<Index>(id)])] = 1;
+    solve_fill_radii(built.triangles, on_chain);
+    const std::vector<int> out_index = emit_vertices(built.triangles, on_chain, out);
+    emit_triangles(built, nodes_, out_index, centre_, out);
+    sort_triangles(built, out, regions_out);
+    emit_stroke_edges(built.stroke_edges, new_id, out_index, out.mesh);
+    std::vector<int> crossing_nodes;
+    for (const Crossing& c : crossings_) crossing_nodes.push_back(c.node);
+    std::sort(crossing_nodes.begin(), crossing_nodes.end());
+    out.crossings = static_cast<std::size_t>(std::unique(crossing_nodes.begin(), crossing_nodes.end()) - crossing_nodes.begin());
+}
+
+std::vector<int> LobeSurfaceBuilder::sort_nodes(std::vector<std::array<int, 3>>& tris)
+{
     // Canonical order: the stroke nodes keep theirs (it follows the strokes alone), the
     // interpolated nodes are sorted by direction, and below the triangles are sorted too, so
     // the output depends on the strokes alone and not on the order the triangulation made
     // things in (its faces, and the refinement's insertions that follow them).
     std::vector<int> new_id(nodes_.size());
-    {
-        std::vector<int> order;
-        order.reserve(nodes_.size());
-        std::vector<std::tuple<double, double, double, int>> fill; // (direction, id): ties keep id order
-        for (Index i = 0; i < nodes_.size(); ++i) {
-            const Node& n = nodes_[i];
-            if (n.origin.kind != LobeVertexKind::Fill) order.push_back(static_cast<int>(i));
-            else fill.emplace_back(n.dir.x, n.dir.y, n.dir.z, static_cast<int>(i));
-        }
-        std::sort(fill.begin(), fill.end());
-        for (const auto& f : fill) order.push_back(std::get<3>(f));
-        std::vector<Node> sorted;
-        sorted.reserve(nodes_.size());
-        for (Index k = 0; k < order.size(); ++k) {
-            new_id[static_cast<Index>(order[k])] = static_cast<int>(k);
-            sorted.push_back(nodes_[static_cast<Index>(order[k])]);
-        }
-        nodes_ = std::move(sorted);
-        for (auto& t : tris)
-            for (int& id : t) id = new_id[static_cast<Index>(id)];
+    std::vector<int> order;
+    order.reserve(nodes_.size());
+    std::vector<std::tuple<double, double, double, int>> fill; // (direction, id): ties keep id order
+    for (Index i = 0; i < nodes_.size(); ++i) {
+        const Node& n = nodes_[i];
+        if (n.origin.kind != LobeVertexKind::Fill) order.push_back(static_cast<int>(i));
+        else fill.emplace_back(n.dir.x, n.dir.y, n.dir.z, static_cast<int>(i));
     }
-    std::vector<char> on_chain(nodes_.size(), 0);
-    for (const auto& chain : chains_)
-        for (int id : chain) on_chain[static_cast<Index>(new_id[static_cast<Index>(id)])] = 1;
-    solve_fill_radii(tris, on_chain);
+    std::sort(fill.begin(), fill.end());
+    for (const auto& f : fill) order.push_back(std::get<3>(f));
+    std::vector<Node> sorted;
+    sorted.reserve(nodes_.size());
+    for (Index k = 0; k < order.size(); ++k) {
+        new_id[static_cast<Index>(order[k])] = static_cast<int>(k);
+        sorted.push_back(nodes_[static_cast<Index>(order[k])]);
+    }
+    nodes_ = std::move(sorted);
+    for (auto& t : tris)
+        for (int& id : t) id = new_id[static_cast<Index>(id)];
+    return new_id;
+}
 
+std::vector<int> LobeSurfaceBuilder::emit_vertices(const std::vector<std::array<int, 3>>& tris,
+                                                   const std::vector<char>& on_chain, LobeSurface& out) const
+{
     // Output: only nodes used by triangles; a build of the changed regions has every stroke
     // node (the kept regions use them). The stroke nodes come first in node order (samples
     // first, by stroke), then the interpolated ones by the direction of their rounded position
@@ -131,87 +244,7 @@ void LobeSurfaceBuilder::emit(SphereTriangles built, LobeSurface& out, SurfaceRe
         out.mesh.positions.emplace_back(px, py, pz);
         out.origins.push_back(nodes_[static_cast<Index>(i)].origin);
     }
-    for (const auto& t : tris) {
-        const glm::dvec3 d0 = nodes_[static_cast<Index>(t[0])].dir, d1 = nodes_[static_cast<Index>(t[1])].dir,
-                         d2 = nodes_[static_cast<Index>(t[2])].dir;
-        const std::array<int, 3> o{out_index[static_cast<Index>(t[0])], out_index[static_cast<Index>(t[1])],
-                                   out_index[static_cast<Index>(t[2])]};
-        const glm::dvec3 p0(out.mesh.positions[static_cast<Index>(o[0])]);
-        const glm::dvec3 p1(out.mesh.positions[static_cast<Index>(o[1])]);
-        const glm::dvec3 p2(out.mesh.positions[static_cast<Index>(o[2])]);
-        const glm::dvec3 normal = glm::cross(p1 - p0, p2 - p0);
-        const glm::dvec3 mid = (p0 + p1 + p2) / 3.0 - centre_;
-        if (!(orient3(d0, d1, d2) > 0.0) || !(glm::dot(normal, mid) > 0.0))
-            throw InvalidInput("the lobe's strokes fold over each other as seen from its centre (draw around the lobe)");
-        // Each triangle starts at its lowest index (same orientation), its sides' flags turned with it.
-        const Index first = static_cast<Index>(std::min_element(o.begin(), o.end()) - o.begin());
-        out.mesh.triangles.push_back({o[first], o[(first + 1) % 3], o[(first + 2) % 3]});
-        const unsigned m = tri_mask[static_cast<Index>(&t - tris.data())];
-        tri_mask[static_cast<Index>(&t - tris.data())] =
-            static_cast<std::uint8_t>(((m >> first) | (m << (3 - first))) & 7u);
-    }
-    // Sorted: bucketed by first (lowest) index, each bucket (a vertex's few triangles) sorted;
-    // the paper strips' triangles (the first strip_count) flagged.
-    {
-        auto& tris_out = out.mesh.triangles;
-        std::vector<int> start(out.mesh.positions.size() + 1, 0);
-        for (const auto& t : tris_out) ++start[static_cast<Index>(t[0]) + 1];
-        for (Index i = 1; i < start.size(); ++i) start[i] += start[i - 1];
-        struct Sorted {
-            std::array<int, 3> t;
-            std::uint8_t strip, mask;
-            int region;
-        };
-        std::vector<Sorted> sorted(tris_out.size());
-        std::vector<int> next(start.begin(), start.end() - 1);
-        for (Index k = 0; k < tris_out.size(); ++k)
-            sorted[static_cast<Index>(next[static_cast<Index>(tris_out[k][0])]++)] = {
-                tris_out[k], static_cast<std::uint8_t>(k < strip_count ? 1 : 0), tri_mask[k], tri_region[k]};
-        for (Index i = 0; i + 1 < start.size(); ++i)
-            std::sort(sorted.begin() + start[i], sorted.begin() + start[i + 1],
-                      [](const Sorted& x, const Sorted& y) { return x.t < y.t; });
-        out.paper_strip_faces.resize(sorted.size());
-        for (Index k = 0; k < sorted.size(); ++k) {
-            tris_out[k] = sorted[k].t;
-            out.paper_strip_faces[k] = sorted[k].strip;
-        }
-        if (regions_out) {
-            // As surface_regions finds them: numbered by their first triangle, each with its
-            // stroke edges directed as its triangles run round them, sorted.
-            std::vector<int> number(static_cast<Index>(built.region_count), -1);
-            MeshRegions& mr = regions_out->regions;
-            mr = MeshRegions{};
-            mr.face_region.reserve(sorted.size());
-            auto& keys = regions_out->edges;
-            keys.clear();
-            for (const Sorted& x : sorted) {
-                int& n = number[static_cast<Index>(x.region)];
-                if (n < 0) {
-                    n = mr.count++;
-                    keys.emplace_back();
-                }
-                mr.face_region.push_back(n);
-                for (Index k = 0; k < 3; ++k) {
-                    if (!(x.mask & (1u << k))) continue;
-                    const glm::vec3& p = out.mesh.positions[static_cast<Index>(x.t[k])];
-                    const glm::vec3& q = out.mesh.positions[static_cast<Index>(x.t[(k + 1) % 3])];
-                    keys[static_cast<Index>(n)].push_back({p.x, p.y, p.z, q.x, q.y, q.z});
-                }
-            }
-            for (auto& k : keys) std::sort(k.begin(), k.end());
-        }
-    }
-    // Stroke segments (split at crossings) are the constraints of remeshing.
-    for (const auto& [u, v] : built.stroke_edges) {
-        const int a = out_index[static_cast<Index>(new_id[static_cast<Index>(u)])];
-        const int b = out_index[static_cast<Index>(new_id[static_cast<Index>(v)])];
-        if (a >= 0 && b >= 0 && a != b) out.mesh.feature_edges.push_back({std::min(a, b), std::max(a, b)});
-    }
-    std::sort(out.mesh.feature_edges.begin(), out.mesh.feature_edges.end());
-    std::vector<int> crossing_nodes;
-    for (const Crossing& c : crossings_) crossing_nodes.push_back(c.node);
-    std::sort(crossing_nodes.begin(), crossing_nodes.end());
-    out.crossings = static_cast<std::size_t>(std::unique(crossing_nodes.begin(), crossing_nodes.end()) - crossing_nodes.begin());
+    return out_index;
 }
 
 } // namespace lobe_surface_detail
