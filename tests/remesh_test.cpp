@@ -571,7 +571,7 @@ TEST(Repair, ADomeASlitTheCowAndTheBunnyRepairToTheSameMeshWhateverWasRepairedBe
     // after other repairs in the same process: dome-400-edges-folding, whose base is
     // triangulated in its plane and whose folds are then cut out, and
     // slit-247-degrees-searched, whose border runs over itself in its plane and gets the
-    // searched patch (repair_cgal.cpp now does both itself: triangulate_in_plane,
+    // searched patch (hole_filling_cgal.cpp now does both itself: triangulate_in_plane,
     // search_hole_patch). The bunny's holes and the cow's cut go through the search too.
     const TriangleMesh cow = read_mesh(test::shared_path("data/models/cow.obj"));
     const TriangleMesh bunny = read_mesh(test::shared_path("data/models/stanford-bunny.obj"));
