@@ -49,7 +49,7 @@ struct LobeSurfaceOptions {
     /// 4). Remeshing puts the attractors at the target spacing and lifts every vertex it makes
     /// along its ray from the centre to the distance interpolated across the fill's triangles
     /// (RemeshOptions::radial_centre), so the remeshed lobe keeps its curvature between fill
-    /// vertices. At 2 a stroke is added in about 0.7 of the time (docs/lobes.md, "Measured").
+    /// vertices (what 2 saves: docs/lobes.md, step 6 and "Measured").
     /// A lobe that is not remeshed (remesh_iterations 0) keeps 1: its fill is its attractors.
     double fill_coarseness = 2.0;
     /// A stroke sample closer than this fraction of its stroke's median spacing to a
