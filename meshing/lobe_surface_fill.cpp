@@ -68,6 +68,130 @@ struct Adjacency {
     Range operator[](Index i) const { return {list.data() + start[i], list.data() + start[i + 1]}; }
 };
 
+
+/// The fill vertices' radii, one group of connected unknowns at a time (solve_fill_radii).
+/// The harmonic interpolation of the residuals: (Σ_j w_ij) x_i − Σ_j w_ij x_j = 0 at every
+/// free vertex, with w_ij the inverse angular length of edge ij (so long strip edges and
+/// short cap edges measure slope alike). Symmetric positive definite; only its lower
+/// triangle is stored, which is all SimplicialLDLT reads. Small groups are solved dense.
+class FillGroupSolver {
+public:
+    /// `unknown`: per node, its row (-1: known); `row_node`: per row, its node; `local`: per
+    /// row, its place in its group; `model` (when `have_model`): the radius model per node;
+    /// [lo, hi]: the strokes' radii.
+    FillGroupSolver(const Adjacency& adj, const std::vector<int>& unknown, const std::vector<int>& row_node,
+                    const std::vector<int>& local, const std::vector<double>& model, bool have_model, double lo, double hi)
+        : adj_(adj), unknown_(unknown), row_node_(row_node), local_(local), model_(model), have_model_(have_model), lo_(lo),
+          hi_(hi)
+    {
+    }
+    /// Solves the group of rows `members` (in row order) and sets their nodes' radii.
+    /// \throw InvalidInput where the system cannot be solved or gives a radius below a quarter
+    /// of the strokes' least.
+    void solve(const std::vector<int>& members, std::vector<Node>& nodes);
+
+private:
+    static constexpr Index kDense = 48; ///< groups up to this size are solved dense
+    const Adjacency& adj_;
+    const std::vector<int>& unknown_;
+    const std::vector<int>& row_node_;
+    const std::vector<int>& local_;
+    const std::vector<double>& model_;
+    bool have_model_;
+    double lo_, hi_;
+    std::vector<Eigen::Triplet<double>> entries_; ///< kept between groups, as its memory
+    Eigen::MatrixXd dense_;
+};
+
+void FillGroupSolver::solve(const std::vector<int>& members, std::vector<Node>& nodes)
+{
+    const Index m = members.size();
+    bool use_model = have_model_;
+    for (int r : members) {
+        const double v = model_[static_cast<Index>(row_node_[static_cast<Index>(r)])];
+        if (!(v >= 0.5 * lo_ && v <= 1.5 * hi_)) use_model = false;
+    }
+    auto model_at = [&](Index i) { return use_model ? model_[i] : 0.0; };
+    entries_.clear();
+    if (m <= kDense) dense_.setZero(static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(m));
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(m));
+    for (int r : members) {
+        const Index i = static_cast<Index>(row_node_[static_cast<Index>(r)]);
+        const int row = local_[static_cast<Index>(r)];
+        double sum = 0;
+        for (int j : adj_[i]) {
+            const double w = 1.0 / std::max(1e-6, angle_between(nodes[i].dir, nodes[static_cast<Index>(j)].dir));
+            sum += w;
+            const int c = unknown_[static_cast<Index>(j)];
+            if (c < 0) {
+                rhs[row] += w * (nodes[static_cast<Index>(j)].radius - model_at(static_cast<Index>(j)));
+            } else if (local_[static_cast<Index>(c)] < row) {
+                if (m <= kDense) dense_(row, local_[static_cast<Index>(c)]) = -w;
+                else entries_.emplace_back(row, local_[static_cast<Index>(c)], -w);
+            }
+        }
+        if (m <= kDense) dense_(row, row) = sum;
+        else entries_.emplace_back(row, row, sum);
+    }
+    Eigen::VectorXd x;
+    bool ok = false;
+    if (m <= kDense) {
+        const Eigen::LLT<Eigen::MatrixXd, Eigen::Lower> llt(dense_);
+        ok = llt.info() == Eigen::Success;
+        if (ok) x = llt.solve(rhs);
+    } else {
+        Eigen::SparseMatrix<double> system(static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(m));
+        system.setFromTriplets(entries_.begin(), entries_.end());
+        const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(system);
+        ok = solver.info() == Eigen::Success;
+        if (ok) x = solver.solve(rhs);
+    }
+    if (!ok || !solver_ok(x)) throw InvalidInput("the lobe's strokes leave a gap that cannot be closed around its centre");
+    for (int r : members) {
+        const Index i = static_cast<Index>(row_node_[static_cast<Index>(r)]);
+        const double radius = x[local_[static_cast<Index>(r)]] + model_at(i);
+        if (!(radius > 0.25 * lo_)) throw InvalidInput("the lobe's strokes leave a gap too wide to close around its centre");
+        nodes[i].radius = radius;
+    }
+}
+
+/// The unknowns (rows) in groups of connected ones (union–find over the rows of `adj`), each
+/// group's rows in increasing order; `local` receives each row's place in its group.
+std::vector<std::vector<int>> connected_groups(const Adjacency& adj, const std::vector<int>& unknown, int count,
+                                               std::vector<int>& local)
+{
+    std::vector<int> parent(static_cast<Index>(count));
+    for (Index r = 0; r < parent.size(); ++r) parent[r] = static_cast<int>(r);
+    auto find = [&](int x) {
+        while (parent[static_cast<Index>(x)] != x)
+            x = parent[static_cast<Index>(x)] = parent[static_cast<Index>(parent[static_cast<Index>(x)])];
+        return x;
+    };
+    for (Index i = 0; i < unknown.size(); ++i) {
+        if (unknown[i] < 0) continue;
+        for (int j : adj[i]) {
+            const int col = unknown[static_cast<Index>(j)];
+            if (col < 0) continue;
+            const int a = find(unknown[i]), b = find(col);
+            if (a != b) parent[static_cast<Index>(std::max(a, b))] = std::min(a, b);
+        }
+    }
+    // Members of each group in row order, and their place in it.
+    std::vector<int> group_of_root(static_cast<Index>(count), -1);
+    local.assign(static_cast<Index>(count), 0);
+    std::vector<std::vector<int>> groups;
+    for (int r = 0; r < count; ++r) {
+        int& g = group_of_root[static_cast<Index>(find(r))];
+        if (g < 0) {
+            g = static_cast<int>(groups.size());
+            groups.emplace_back();
+        }
+        local[static_cast<Index>(r)] = static_cast<int>(groups[static_cast<Index>(g)].size());
+        groups[static_cast<Index>(g)].push_back(r);
+    }
+    return groups;
+}
+
 } // namespace
 
 std::vector<glm::dvec3> LobeSurfaceBuilder::fill_lattice(double max_edge, double ring_angle) const
@@ -217,94 +341,13 @@ void LobeSurfaceBuilder::solve_fill_radii(const std::vector<std::array<int, 3>>&
     }
     std::vector<double> model(n, 0.0);
     const bool have_model = fit_radius_model(fit, needed, model);
-    // Groups: connected interpolated vertices (union–find over their rows).
-    std::vector<int> parent(static_cast<Index>(count));
-    for (Index r = 0; r < parent.size(); ++r) parent[r] = static_cast<int>(r);
-    auto find = [&](int x) {
-        while (parent[static_cast<Index>(x)] != x)
-            x = parent[static_cast<Index>(x)] = parent[static_cast<Index>(parent[static_cast<Index>(x)])];
-        return x;
-    };
     std::vector<int> row_node(static_cast<Index>(count));
-    for (Index i = 0; i < n; ++i) {
-        if (unknown[i] < 0) continue;
-        row_node[static_cast<Index>(unknown[i])] = static_cast<int>(i);
-        for (int j : adj[i]) {
-            const int col = unknown[static_cast<Index>(j)];
-            if (col < 0) continue;
-            const int a = find(unknown[i]), b = find(col);
-            if (a != b) parent[static_cast<Index>(std::max(a, b))] = std::min(a, b);
-        }
-    }
-    // Members of each group in row order, and their place in it.
-    std::vector<int> group_of_root(static_cast<Index>(count), -1), local(static_cast<Index>(count));
-    std::vector<std::vector<int>> groups;
-    for (int r = 0; r < count; ++r) {
-        int& g = group_of_root[static_cast<Index>(find(r))];
-        if (g < 0) {
-            g = static_cast<int>(groups.size());
-            groups.emplace_back();
-        }
-        local[static_cast<Index>(r)] = static_cast<int>(groups[static_cast<Index>(g)].size());
-        groups[static_cast<Index>(g)].push_back(r);
-    }
-    // The harmonic interpolation of the residuals: (Σ_j w_ij) x_i − Σ_j w_ij x_j = 0 at every
-    // free vertex, with w_ij the inverse angular length of edge ij (so long strip edges and
-    // short cap edges measure slope alike). Symmetric positive definite; only its lower
-    // triangle is stored, which is all SimplicialLDLT reads. Small groups are solved dense.
-    constexpr Index kDense = 48;
-    std::vector<Eigen::Triplet<double>> entries;
-    Eigen::MatrixXd dense;
-    for (const auto& members : groups) {
-        const Index m = members.size();
-        bool use_model = have_model;
-        for (int r : members) {
-            const double v = model[static_cast<Index>(row_node[static_cast<Index>(r)])];
-            if (!(v >= 0.5 * lo && v <= 1.5 * hi)) use_model = false;
-        }
-        auto model_at = [&](Index i) { return use_model ? model[i] : 0.0; };
-        entries.clear();
-        if (m <= kDense) dense.setZero(static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(m));
-        Eigen::VectorXd rhs = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(m));
-        for (int r : members) {
-            const Index i = static_cast<Index>(row_node[static_cast<Index>(r)]);
-            const int row = local[static_cast<Index>(r)];
-            double sum = 0;
-            for (int j : adj[i]) {
-                const double w = 1.0 / std::max(1e-6, angle_between(nodes_[i].dir, nodes_[static_cast<Index>(j)].dir));
-                sum += w;
-                const int c = unknown[static_cast<Index>(j)];
-                if (c < 0) {
-                    rhs[row] += w * (nodes_[static_cast<Index>(j)].radius - model_at(static_cast<Index>(j)));
-                } else if (local[static_cast<Index>(c)] < row) {
-                    if (m <= kDense) dense(row, local[static_cast<Index>(c)]) = -w;
-                    else entries.emplace_back(row, local[static_cast<Index>(c)], -w);
-                }
-            }
-            if (m <= kDense) dense(row, row) = sum;
-            else entries.emplace_back(row, row, sum);
-        }
-        Eigen::VectorXd x;
-        bool ok = false;
-        if (m <= kDense) {
-            const Eigen::LLT<Eigen::MatrixXd, Eigen::Lower> llt(dense);
-            ok = llt.info() == Eigen::Success;
-            if (ok) x = llt.solve(rhs);
-        } else {
-            Eigen::SparseMatrix<double> system(static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(m));
-            system.setFromTriplets(entries.begin(), entries.end());
-            const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(system);
-            ok = solver.info() == Eigen::Success;
-            if (ok) x = solver.solve(rhs);
-        }
-        if (!ok || !solver_ok(x)) throw InvalidInput("the lobe's strokes leave a gap that cannot be closed around its centre");
-        for (int r : members) {
-            const Index i = static_cast<Index>(row_node[static_cast<Index>(r)]);
-            const double radius = x[local[static_cast<Index>(r)]] + model_at(i);
-            if (!(radius > 0.25 * lo)) throw InvalidInput("the lobe's strokes leave a gap too wide to close around its centre");
-            nodes_[i].radius = radius;
-        }
-    }
+    for (Index i = 0; i < n; ++i)
+        if (unknown[i] >= 0) row_node[static_cast<Index>(unknown[i])] = static_cast<int>(i);
+    std::vector<int> local;
+    const std::vector<std::vector<int>> groups = connected_groups(adj, unknown, count, local);
+    FillGroupSolver solver(adj, unknown, row_node, local, model, have_model, lo, hi);
+    for (const auto& members : groups) solver.solve(members, nodes_);
 }
 
 bool LobeSurfaceBuilder::fit_radius_model(const std::vector<char>& fit, const std::vector<char>& at, std::vector<double>& model) const
