@@ -18,6 +18,7 @@
 ///  7. emit: the surface in canonical order, the fill's radii           lobe_surface_emit.cpp,
 ///     (solve_fill_radii)                                               lobe_surface_fill.cpp
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
