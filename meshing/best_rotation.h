@@ -31,9 +31,9 @@ inline Eigen::Matrix3d best_rotation_svd(const Eigen::Matrix3d& a)
 /// polynomial λ⁴ − 2‖a‖²λ² − 8 det(a) λ + det N, started above every root (at √3‖a‖ ≥
 /// σ₁ + σ₂ + σ₃), where it falls monotonically to the largest root; the eigenvector is a
 /// column of adj(N − λI) = μ q qᵀ (Theobald's QCP, Acta Cryst. A61, 2005). No trigonometry
-/// and no iteration over the matrix: about two thirds of the time of the closed-form eigen
-/// decomposition of aᵀa this replaced, and one rotation is fitted per energy row and rotation
-/// iteration on every pinch frame. The result is the best proper rotation also when det a < 0.
+/// and no iteration over the matrix (one rotation is fitted per energy row and rotation
+/// iteration on every pinch frame; timings in docs/pinch-editing.md). The result is the best
+/// proper rotation also when det a < 0.
 /// Returns false where q cannot be shown to be accurate to 1e-9 (the largest eigenvalue too
 /// close to the next one: a of rank one or less; or a not finite); the SVD decides then.
 inline bool best_rotation_horn(const Eigen::Matrix3d& a, Eigen::Matrix3d& rotation)

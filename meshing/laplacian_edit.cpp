@@ -263,13 +263,26 @@ struct PinchEditor::Impl {
         }
         return x;
     }
+
+    // The constructor's steps.
+    void find_roi(const TriangleMesh& mesh, const Incidence& inc);
+    std::vector<int> number_locally(const TriangleMesh& mesh, const Incidence& inc);
+    /// The Laplacian's rows split by the kind of their columns.
+    struct RowParts {
+        std::vector<Eigen::Triplet<double>> free_entries; ///< A_F
+        std::vector<Eigen::Vector3d> fixed_part;          ///< L_C x_C per row
+        std::vector<double> handle_column;                ///< ∂L/∂x_handle per row
+    };
+    RowParts build_rows(const TriangleMesh& mesh, const Incidence& inc, const std::vector<int>& local);
+    void factor(const RowParts& parts);
+    void prepare_first_solve(const RowParts& parts);
 };
 
-PinchEditor::PinchEditor(const TriangleMesh& mesh, int handle_vertex, const PinchEditOptions& options)
-    : impl_(std::make_unique<Impl>())
+namespace {
+
+/// \throw InvalidInput (one line) unless `mesh`, `handle_vertex` and `options` can start a pinch.
+void check_pinch(const TriangleMesh& mesh, int handle_vertex, const PinchEditOptions& options)
 {
-    Impl& m = *impl_;
-    m.options = options;
     const std::size_t nv = mesh.vertex_count();
     if (nv == 0 || mesh.triangles.empty())
         fail("the mesh is empty (" + std::to_string(nv) + " vertices, " + std::to_string(mesh.triangle_count()) +
@@ -291,33 +304,37 @@ PinchEditor::PinchEditor(const TriangleMesh& mesh, int handle_vertex, const Pinc
     for (std::size_t i = 0; i < nv; ++i)
         if (!finite(mesh.positions[i]))
             fail("vertex " + std::to_string(i) + " has a non-finite position");
+}
 
-    m.vertex_count = nv;
-    m.handle = handle_vertex;
-    m.handle_start = mesh.positions[std::size_t(handle_vertex)];
-    const Incidence inc(mesh);
-    auto for_each_neighbour = [&](int v, auto&& f) {
-        inc.for_each_triangle(v, [&](int t) {
-            for (int u : mesh.triangles[std::size_t(t)])
-                if (u != v)
-                    f(u);
-        });
-    };
+/// Calls f(u) for every vertex u of a triangle at v but v (as often as they share triangles).
+template <class F>
+void for_each_neighbour(const TriangleMesh& mesh, const Incidence& inc, int v, F&& f)
+{
+    inc.for_each_triangle(v, [&](int t) {
+        for (int u : mesh.triangles[std::size_t(t)])
+            if (u != v)
+                f(u);
+    });
+}
 
-    // ROI: Dijkstra along edges from the handle, up to roi_radius_m.
-    std::vector<double> dist(nv, std::numeric_limits<double>::infinity());
+} // namespace
+
+/// The vertices within options.roi_radius_m of the handle (Dijkstra along edges), sorted.
+void PinchEditor::Impl::find_roi(const TriangleMesh& mesh, const Incidence& inc)
+{
+    std::vector<double> dist(mesh.vertex_count(), std::numeric_limits<double>::infinity());
     using Item = std::pair<double, int>;
     std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
-    dist[std::size_t(handle_vertex)] = 0.0;
-    queue.emplace(0.0, handle_vertex);
+    dist[std::size_t(handle)] = 0.0;
+    queue.emplace(0.0, handle);
     while (!queue.empty()) {
         const double d = queue.top().first; // named copies: lambdas may not capture bindings (clang 14)
         const int v = queue.top().second;
         queue.pop();
         if (d > dist[std::size_t(v)])
             continue;
-        m.roi.push_back(v);
-        for_each_neighbour(v, [&](int u) {
+        roi.push_back(v);
+        for_each_neighbour(mesh, inc, v, [&](int u) {
             const double nd = d + glm::length(glm::dvec3(mesh.positions[std::size_t(u)]) -
                                                glm::dvec3(mesh.positions[std::size_t(v)]));
             if (nd <= options.roi_radius_m && nd < dist[std::size_t(u)]) {
@@ -326,166 +343,206 @@ PinchEditor::PinchEditor(const TriangleMesh& mesh, int handle_vertex, const Pinc
             }
         });
     }
-    std::sort(m.roi.begin(), m.roi.end());
-    if (m.roi.size() < 2)
-        fail("the ROI around vertex " + std::to_string(handle_vertex) + " has no free vertex (roi_radius_m = " +
+    std::sort(roi.begin(), roi.end());
+    if (roi.size() < 2)
+        fail("the ROI around vertex " + std::to_string(handle) + " has no free vertex (roi_radius_m = " +
              fmt(options.roi_radius_m) + " is shorter than every edge at the handle, or the vertex is isolated)");
+}
 
-    // Local numbering: free, handle, ring, outside.
-    std::vector<int> local(nv, -1);
-    for (int v : m.roi)
-        if (v != handle_vertex) {
-            local[std::size_t(v)] = int(m.local_to_global.size());
-            m.local_to_global.push_back(v);
+/// Local numbering (local_to_global): the free vertices, the handle, the fixed ring, the
+/// vertices just outside it. Returns the local number of each vertex (-1: none).
+std::vector<int> PinchEditor::Impl::number_locally(const TriangleMesh& mesh, const Incidence& inc)
+{
+    std::vector<int> local(mesh.vertex_count(), -1);
+    for (int v : roi)
+        if (v != handle) {
+            local[std::size_t(v)] = int(local_to_global.size());
+            local_to_global.push_back(v);
         }
-    m.nf = m.local_to_global.size();
-    local[std::size_t(handle_vertex)] = int(m.local_to_global.size());
-    m.local_to_global.push_back(handle_vertex);
-    for (int v : m.roi)
-        for_each_neighbour(v, [&](int u) {
+    nf = local_to_global.size();
+    local[std::size_t(handle)] = int(local_to_global.size());
+    local_to_global.push_back(handle);
+    for (int v : roi)
+        for_each_neighbour(mesh, inc, v, [&](int u) {
             if (local[std::size_t(u)] < 0) {
-                local[std::size_t(u)] = int(m.local_to_global.size());
-                m.local_to_global.push_back(u);
-                m.ring.push_back(u);
+                local[std::size_t(u)] = int(local_to_global.size());
+                local_to_global.push_back(u);
+                ring.push_back(u);
             }
         });
-    std::sort(m.ring.begin(), m.ring.end());
-    m.rows = m.local_to_global.size();
-    for (std::size_t r = m.nf + 1; r < m.rows; ++r)
-        for_each_neighbour(m.local_to_global[r], [&](int u) {
+    std::sort(ring.begin(), ring.end());
+    rows = local_to_global.size();
+    for (std::size_t r = nf + 1; r < rows; ++r)
+        for_each_neighbour(mesh, inc, local_to_global[r], [&](int u) {
             if (local[std::size_t(u)] < 0) {
-                local[std::size_t(u)] = int(m.local_to_global.size());
-                m.local_to_global.push_back(u);
+                local[std::size_t(u)] = int(local_to_global.size());
+                local_to_global.push_back(u);
             }
         });
-    const std::size_t nl = m.local_to_global.size();
+    const std::size_t nl = local_to_global.size();
     for (std::size_t l = 0; l < nl; ++l)
-        m.rest_points.push_back(to_eigen(mesh.positions[std::size_t(m.local_to_global[l])]));
+        rest_points.push_back(to_eigen(mesh.positions[std::size_t(local_to_global[l])]));
+    return local;
+}
 
-    // Rows of L (Sorkine et al. 2004, Eq. 1 with weights): L(x)ᵢ = xᵢ − Σⱼ wᵢⱼ xⱼ / Σⱼ wᵢⱼ.
-    // A vertex whose 1-ring weights add up to nothing (all triangles degenerate) has no row.
-    std::vector<Eigen::Triplet<double>> free_entries;
-    std::vector<Eigen::Vector3d> fixed_part(m.rows, Eigen::Vector3d::Zero()); // L_C x_C per row
-    std::vector<double> handle_column(m.rows, 0.0);                           // ∂L/∂x_handle per row
-    m.ring_offsets.push_back(0);
-    m.fan_offsets.push_back(0);
-    m.a_offsets.push_back(0);
-    m.delta.assign(m.rows, Eigen::Vector3d::Zero());
-    for (std::size_t r = 0; r < m.rows; ++r) {
+/// The rows of L (Sorkine et al. 2004, Eq. 1 with weights), and per row what the rotation fit
+/// needs: L(x)ᵢ = xᵢ − Σⱼ wᵢⱼ xⱼ / Σⱼ wᵢⱼ. A vertex whose 1-ring weights add up to nothing (all
+/// triangles degenerate) has no row.
+PinchEditor::Impl::RowParts PinchEditor::Impl::build_rows(const TriangleMesh& mesh, const Incidence& inc,
+                                                          const std::vector<int>& local)
+{
+    RowParts parts;
+    std::vector<Eigen::Triplet<double>>& free_entries = parts.free_entries;
+    std::vector<Eigen::Vector3d>& fixed_part = parts.fixed_part;
+    std::vector<double>& handle_column = parts.handle_column;
+    fixed_part.assign(rows, Eigen::Vector3d::Zero());
+    handle_column.assign(rows, 0.0);
+    ring_offsets.push_back(0);
+    fan_offsets.push_back(0);
+    a_offsets.push_back(0);
+    delta.assign(rows, Eigen::Vector3d::Zero());
+    for (std::size_t r = 0; r < rows; ++r) {
         const auto ri = Eigen::Index(r);
-        const auto ring = one_ring(mesh, inc, m.local_to_global[r], options.weights);
-        const Eigen::Vector3d& xi = m.rest_points[r];
+        const auto neighbours = one_ring(mesh, inc, local_to_global[r], options.weights);
+        const Eigen::Vector3d& xi = rest_points[r];
         double total = 0.0, squared_lengths = 0.0;
-        for (const auto& [j, w] : ring) {
+        for (const auto& [j, w] : neighbours) {
             total += w;
             const int lj = local[std::size_t(j)];
-            m.ring_vertices.push_back(lj);
-            m.rest_edges.push_back(m.rest_points[std::size_t(lj)] - xi);
-            squared_lengths += m.rest_edges.back().squaredNorm();
+            ring_vertices.push_back(lj);
+            rest_edges.push_back(rest_points[std::size_t(lj)] - xi);
+            squared_lengths += rest_edges.back().squaredNorm();
         }
-        m.ring_offsets.push_back(int(m.ring_vertices.size()));
+        ring_offsets.push_back(int(ring_vertices.size()));
         Eigen::Vector3d normal = Eigen::Vector3d::Zero();
-        inc.for_each_triangle(m.local_to_global[r], [&](int f) {
+        inc.for_each_triangle(local_to_global[r], [&](int f) {
             const auto& t = mesh.triangles[std::size_t(f)];
             const std::array<int, 3> lt = {local[std::size_t(t[0])], local[std::size_t(t[1])], local[std::size_t(t[2])]};
-            m.fan_triangles.push_back(lt);
-            const Eigen::Vector3d& p0 = m.rest_points[std::size_t(lt[0])];
-            normal += (m.rest_points[std::size_t(lt[1])] - p0).cross(m.rest_points[std::size_t(lt[2])] - p0);
+            fan_triangles.push_back(lt);
+            const Eigen::Vector3d& p0 = rest_points[std::size_t(lt[0])];
+            normal += (rest_points[std::size_t(lt[1])] - p0).cross(rest_points[std::size_t(lt[2])] - p0);
         });
-        m.fan_offsets.push_back(int(m.fan_triangles.size()));
-        const double mean_length = ring.empty() ? 0.0 : std::sqrt(squared_lengths / double(ring.size()));
-        m.rest_normals.push_back(normal.norm() > 0.0 ? Eigen::Vector3d(normal.normalized() * mean_length)
-                                                     : Eigen::Vector3d::Zero());
+        fan_offsets.push_back(int(fan_triangles.size()));
+        const double mean_length = neighbours.empty() ? 0.0 : std::sqrt(squared_lengths / double(neighbours.size()));
+        rest_normals.push_back(normal.norm() > 0.0 ? Eigen::Vector3d(normal.normalized() * mean_length)
+                                                   : Eigen::Vector3d::Zero());
         if (total > 0.0 && std::isfinite(total)) {
             auto add = [&](std::size_t col, double coef) {
-                m.delta[r] += coef * m.rest_points[col];
-                if (col < m.nf) {
+                delta[r] += coef * rest_points[col];
+                if (col < nf) {
                     free_entries.emplace_back(ri, Eigen::Index(col), coef);
-                    m.a_columns.push_back(int(col)); // local for now; factor order below
-                    m.a_values.push_back(coef);
-                } else if (col == m.nf) {
+                    a_columns.push_back(int(col)); // local for now; factor order below
+                    a_values.push_back(coef);
+                } else if (col == nf) {
                     handle_column[r] += coef;
                 } else {
-                    fixed_part[r] += coef * m.rest_points[col];
+                    fixed_part[r] += coef * rest_points[col];
                 }
             };
             add(r, 1.0);
-            for (const auto& [j, w] : ring)
+            for (const auto& [j, w] : neighbours)
                 add(std::size_t(local[std::size_t(j)]), -w / total);
         }
-        m.a_offsets.push_back(int(m.a_columns.size()));
+        a_offsets.push_back(int(a_columns.size()));
     }
-    Impl::SparseMatrix a_free(Eigen::Index(m.rows), Eigen::Index(m.nf));
-    a_free.setFromTriplets(free_entries.begin(), free_entries.end());
-    const Impl::SparseMatrix normal = (Impl::SparseMatrix(a_free.transpose()) * a_free).pruned();
-    const Eigen::SimplicialLDLT<Impl::SparseMatrix> ldlt(normal);
+    return parts;
+}
+
+/// LDLᵀ of A_FᵀA_F, L kept by rows and by columns.
+/// \throw SolverError where it is singular or not positive definite.
+void PinchEditor::Impl::factor(const RowParts& parts)
+{
+    SparseMatrix a_free(static_cast<Eigen::Index>(rows), static_cast<Eigen::Index>(nf));
+    a_free.setFromTriplets(parts.free_entries.begin(), parts.free_entries.end());
+    const SparseMatrix normal = (SparseMatrix(a_free.transpose()) * a_free).pruned();
+    const Eigen::SimplicialLDLT<SparseMatrix> ldlt(normal);
     if (ldlt.info() != Eigen::Success)
-        throw SolverError("pinch edit: the Laplacian system of the ROI around vertex " + std::to_string(handle_vertex) +
+        throw SolverError("pinch edit: the Laplacian system of the ROI around vertex " + std::to_string(handle) +
                           " is singular (degenerate triangles?)");
     const Eigen::VectorXd d = ldlt.vectorD();
     const double largest = d.cwiseAbs().maxCoeff();
     if (!(d.minCoeff() > 1e-13 * largest))
-        throw SolverError("pinch edit: the Laplacian system of the ROI around vertex " + std::to_string(handle_vertex) +
+        throw SolverError("pinch edit: the Laplacian system of the ROI around vertex " + std::to_string(handle) +
                           " is singular or not positive definite (degenerate triangles?)");
-    m.inverse_d.resize(m.nf);
-    for (std::size_t i = 0; i < m.nf; ++i)
-        m.inverse_d[i] = 1.0 / d(Eigen::Index(i));
+    inverse_d.resize(nf);
+    for (std::size_t i = 0; i < nf; ++i)
+        inverse_d[i] = 1.0 / d(Eigen::Index(i));
     const auto& p = ldlt.permutationP().indices();
-    m.factor_index.assign(p.data(), p.data() + p.size());
+    factor_index.assign(p.data(), p.data() + p.size());
 
     // L below the diagonal by columns (as Eigen stores it), then by rows (a counting sort).
-    const Impl::SparseMatrix& l = ldlt.matrixL().nestedExpression();
-    std::vector<int> per_row(m.nf + 1, 0);
+    const SparseMatrix& l = ldlt.matrixL().nestedExpression();
+    std::vector<int> per_row(nf + 1, 0);
     for (Eigen::Index j = 0; j < l.outerSize(); ++j) {
-        m.l_column_offsets.push_back(int(m.l_column_rows.size()));
-        for (Impl::SparseMatrix::InnerIterator it(l, j); it; ++it)
+        l_column_offsets.push_back(int(l_column_rows.size()));
+        for (SparseMatrix::InnerIterator it(l, j); it; ++it)
             if (it.row() > j) {
-                m.l_column_rows.push_back(int(it.row()));
-                m.l_column_values.push_back(it.value());
+                l_column_rows.push_back(int(it.row()));
+                l_column_values.push_back(it.value());
                 ++per_row[std::size_t(it.row()) + 1];
             }
     }
-    m.l_column_offsets.push_back(int(m.l_column_rows.size()));
-    for (std::size_t i = 1; i <= m.nf; ++i)
+    l_column_offsets.push_back(int(l_column_rows.size()));
+    for (std::size_t i = 1; i <= nf; ++i)
         per_row[i] += per_row[i - 1];
-    m.l_row_offsets = per_row;
-    m.l_row_columns.resize(m.l_column_rows.size());
-    m.l_row_values.resize(m.l_column_rows.size());
-    for (std::size_t j = 0; j < m.nf; ++j)
-        for (int q = m.l_column_offsets[j]; q < m.l_column_offsets[j + 1]; ++q) {
-            const auto slot = std::size_t(per_row[std::size_t(m.l_column_rows[std::size_t(q)])]++);
-            m.l_row_columns[slot] = int(j);
-            m.l_row_values[slot] = m.l_column_values[std::size_t(q)];
+    l_row_offsets = per_row;
+    l_row_columns.resize(l_column_rows.size());
+    l_row_values.resize(l_column_rows.size());
+    for (std::size_t j = 0; j < nf; ++j)
+        for (int q = l_column_offsets[j]; q < l_column_offsets[j + 1]; ++q) {
+            const auto slot = std::size_t(per_row[std::size_t(l_column_rows[std::size_t(q)])]++);
+            l_row_columns[slot] = int(j);
+            l_row_values[slot] = l_column_values[std::size_t(q)];
         }
+}
 
-    // A's columns in factor order, the known parts of the right-hand side, and the first
-    // (unrotated) solve as base and slope.
-    for (int& c : m.a_columns)
-        c = m.factor_index[std::size_t(c)];
-    m.known_rhs.assign(m.nf, Impl::Point4::Zero());
-    m.handle_rhs.assign(m.nf, 0.0);
-    std::vector<Impl::Point4> slope(m.nf, Impl::Point4::Zero());
-    m.first_base.assign(m.nf, Impl::Point4::Zero());
-    for (std::size_t r = 0; r < m.rows; ++r) {
-        const Impl::Point4 known(fixed_part[r].x(), fixed_part[r].y(), fixed_part[r].z(), 0.0);
-        const Impl::Point4 dr(m.delta[r].x(), m.delta[r].y(), m.delta[r].z(), 0.0);
-        for (int q = m.a_offsets[r]; q < m.a_offsets[r + 1]; ++q) {
-            const auto c = std::size_t(m.a_columns[std::size_t(q)]);
-            const double v = m.a_values[std::size_t(q)];
-            m.known_rhs[c] += v * known;
-            m.handle_rhs[c] += v * handle_column[r];
-            m.first_base[c] += v * dr;
+/// A's columns in factor order, the known parts of the right-hand side, and the first
+/// (unrotated) solve as base and slope.
+void PinchEditor::Impl::prepare_first_solve(const RowParts& parts)
+{
+    for (int& c : a_columns)
+        c = factor_index[std::size_t(c)];
+    known_rhs.assign(nf, Point4::Zero());
+    handle_rhs.assign(nf, 0.0);
+    std::vector<Point4> slope(nf, Point4::Zero());
+    first_base.assign(nf, Point4::Zero());
+    for (std::size_t r = 0; r < rows; ++r) {
+        const Point4 known(parts.fixed_part[r].x(), parts.fixed_part[r].y(), parts.fixed_part[r].z(), 0.0);
+        const Point4 dr(delta[r].x(), delta[r].y(), delta[r].z(), 0.0);
+        for (int q = a_offsets[r]; q < a_offsets[r + 1]; ++q) {
+            const auto c = std::size_t(a_columns[std::size_t(q)]);
+            const double v = a_values[std::size_t(q)];
+            known_rhs[c] += v * known;
+            handle_rhs[c] += v * parts.handle_column[r];
+            first_base[c] += v * dr;
         }
     }
-    for (std::size_t i = 0; i < m.nf; ++i) {
-        m.first_base[i] -= m.known_rhs[i];
-        slope[i] = Impl::Point4::Constant(m.handle_rhs[i]);
+    for (std::size_t i = 0; i < nf; ++i) {
+        first_base[i] -= known_rhs[i];
+        slope[i] = Point4::Constant(handle_rhs[i]);
     }
-    m.substitute(m.first_base);
-    m.substitute(slope);
-    m.first_slope.resize(m.nf);
-    for (std::size_t i = 0; i < m.nf; ++i)
-        m.first_slope[i] = slope[i](0);
+    substitute(first_base);
+    substitute(slope);
+    first_slope.resize(nf);
+    for (std::size_t i = 0; i < nf; ++i)
+        first_slope[i] = slope[i](0);
+}
+
+PinchEditor::PinchEditor(const TriangleMesh& mesh, int handle_vertex, const PinchEditOptions& options)
+    : impl_(std::make_unique<Impl>())
+{
+    check_pinch(mesh, handle_vertex, options);
+    Impl& m = *impl_;
+    m.options = options;
+    m.vertex_count = mesh.vertex_count();
+    m.handle = handle_vertex;
+    m.handle_start = mesh.positions[std::size_t(handle_vertex)];
+    const Incidence inc(mesh);
+    m.find_roi(mesh, inc);
+    const std::vector<int> local = m.number_locally(mesh, inc);
+    const Impl::RowParts parts = m.build_rows(mesh, inc, local);
+    m.factor(parts);
+    m.prepare_first_solve(parts);
 }
 
 PinchEditor::~PinchEditor() = default;

@@ -35,8 +35,8 @@ struct PinchEditOptions {
     /// surface instead of shearing (the role of Tᵢ in Sorkine et al. 2004, Eq. 5).
     bool rotation_invariant = true;
     /// Extra solves with rotated δ per frame when rotation_invariant (each one a rotation
-    /// fit per row and a back-substitution with the same factorisation). 3 is within 1% of
-    /// the converged result on the bump test; 2 leaves about 10% more detail error.
+    /// fit per row and a back-substitution with the same factorisation). Why 3: the detail
+    /// error per iteration count in docs/pinch-editing.md.
     int rotation_iterations = 3;
     /// A target farther than this from the handle's start position is refused (metres).
     double max_drag_m = 1.0;

@@ -235,29 +235,15 @@ SurfaceRegions surface_regions(const TriangleMesh& mesh)
 
 namespace {
 
-/// keep_unchanged_regions and complete_with_kept_regions: `also_keep` (may be null) flags the
-/// regions of `previous` that `next` lacks and that complete it. False when a stroke vertex of
-/// a kept region is not one of `next`'s (nothing is changed then).
-bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_regions, const std::vector<char>* also_keep,
-                  LobeSurface& next, SurfaceRegions& next_regions_out, bool next_regions_known, KeptRegions& result)
+/// The region of the result each region of `previous` becomes where it is kept: the region
+/// of `next` with the same stroke edges, or (`also_keep`) one numbered after `next`'s; -1
+/// where it is not kept. Counts them in result.kept, and all regions in result.regions.
+std::vector<int> match_kept_regions(const SurfaceRegions& previous_regions, const SurfaceRegions& next_regions_out,
+                                    const std::vector<char>* also_keep, KeptRegions& result)
 {
-    result = {};
-    const Features next_features(next.mesh);
-    if (!next_regions_known) {
-        next_regions_out.regions = regions_of(next.mesh, next_features);
-        next_regions_out.edges = region_keys(next.mesh, next_features, next_regions_out.regions);
-    }
-    const MeshRegions& next_regions = next_regions_out.regions;
-    const auto& next_keys = next_regions_out.edges;
-    result.regions = next_regions.count;
-    if (previous.centre != next.centre || previous.reference_radius != next.reference_radius ||
-        previous.mesh.triangles.empty() || previous_regions.regions.face_region.size() != previous.mesh.triangles.size())
-        return also_keep == nullptr;
-    const Features prev_features(previous.mesh);
     const MeshRegions& prev_regions = previous_regions.regions;
     const auto& prev_keys = previous_regions.edges;
-    // Region of the result each kept region of `previous` becomes: the region of `next` with
-    // the same stroke edges, or (also_keep) one after `next`'s.
+    const auto& next_keys = next_regions_out.edges;
     std::vector<int> kept_as(static_cast<Index>(prev_regions.count), -1);
     {
         // A region kept already (also_keep) is no region of `next`: only the others can match.
@@ -272,7 +258,7 @@ bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_re
             ++result.kept;
         }
     }
-    int region_count = next_regions.count;
+    int region_count = next_regions_out.regions.count;
     if (also_keep)
         for (Index r = 0; r < also_keep->size() && r < kept_as.size(); ++r)
             if ((*also_keep)[r] && kept_as[r] < 0) {
@@ -280,8 +266,37 @@ bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_re
                 ++result.kept;
             }
     result.regions = region_count;
-    if (result.kept == 0) return true;
+    return kept_as;
+}
 
+/// What keep_regions makes of `next` and the kept regions of `previous` before putting it in
+/// canonical order.
+struct MergedSurface {
+    struct Vertex {
+        glm::vec3 position;
+        LobeVertexOrigin origin;
+    };
+    /// All vertices of both surfaces that the result may use: `next`'s, then `previous`'s
+    /// inner vertices of kept regions (from index from_next on).
+    std::vector<Vertex> all;
+    Index from_next = 0;
+    /// The result's triangles (over `all`): `next`'s that are not kept (the first
+    /// tris_from_next), then the kept ones; each with its region of the result and whether it
+    /// is a paper strip's.
+    std::vector<std::array<int, 3>> tris;
+    std::vector<int> tri_region;
+    std::vector<std::uint8_t> tri_strip;
+    Index tris_from_next = 0;
+    std::vector<std::array<int, 2>> kept_features; ///< stroke edges of kept triangles (also_keep)
+};
+
+/// Merges the triangles of `next` that are not kept with the kept regions of `previous`
+/// (`kept_as`, match_kept_regions) into `m`; counts the kept triangles in `result`. False (`m`
+/// incomplete) when a stroke vertex of a kept region is not one of `next`'s.
+bool merge_kept_regions(const LobeSurface& previous, const MeshRegions& prev_regions, const Features& prev_features,
+                        const std::vector<int>& kept_as, const LobeSurface& next, const MeshRegions& next_regions,
+                        const Features& next_features, bool also_keep, MergedSurface& m, KeptRegions& result)
+{
     // Vertices on strokes are shared by position: every stroke edge of a kept region is one
     // of `next` (the keys matched; a build of the changed regions has every stroke vertex),
     // so its ends are vertices of `next` at the same place.
@@ -294,13 +309,7 @@ bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_re
     for (Index v = 0; v < next.mesh.positions.size(); ++v)
         if (on_stroke_of_next(v)) on_stroke.add(next.mesh.positions[v], static_cast<int>(v));
 
-    // All vertices of both surfaces that the result may use: `next`'s, then `previous`'s
-    // inner vertices of kept regions.
-    struct Vertex {
-        glm::vec3 position;
-        LobeVertexOrigin origin;
-    };
-    std::vector<Vertex> all;
+    std::vector<MergedSurface::Vertex>& all = m.all;
     all.reserve(next.mesh.positions.size() + previous.mesh.positions.size());
     for (Index v = 0; v < next.mesh.positions.size(); ++v) all.push_back({next.mesh.positions[v], next.origins[v]});
     std::vector<int> from_previous(previous.mesh.positions.size(), -1);
@@ -309,9 +318,12 @@ bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_re
     const bool next_strips = next.paper_strip_faces.size() == next.mesh.triangles.size();
     const bool prev_strips = previous.paper_strip_faces.size() == previous.mesh.triangles.size();
     const Index at_most = next.mesh.triangles.size() + previous.mesh.triangles.size();
-    std::vector<std::array<int, 3>> tris(at_most);
-    std::vector<int> tri_region(at_most); // region of the result each triangle belongs to
-    std::vector<std::uint8_t> tri_strip(at_most);
+    std::vector<std::array<int, 3>>& tris = m.tris;
+    std::vector<int>& tri_region = m.tri_region; // region of the result each triangle belongs to
+    std::vector<std::uint8_t>& tri_strip = m.tri_strip;
+    tris.resize(at_most);
+    tri_region.resize(at_most);
+    tri_strip.resize(at_most);
     Index tri_count = 0;
     std::vector<char> next_kept(static_cast<Index>(next_regions.count), 0);
     for (int as : kept_as)
@@ -336,11 +348,7 @@ bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_re
                 continue;
             }
             mapped = on_stroke.find(previous.mesh.positions[static_cast<Index>(v)]);
-            if (mapped < 0) {
-                if (also_keep) return false;
-                result = KeptRegions{next_regions.count, 0, 0, false};
-                return true;
-            }
+            if (mapped < 0) return false;
         }
     }
     const Index from_next = all.size();
@@ -349,7 +357,7 @@ bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_re
             from_previous[v] = static_cast<int>(all.size());
             all.push_back({previous.mesh.positions[v], previous.origins[v]});
         }
-    std::vector<std::array<int, 2>> kept_features; // stroke edges of kept triangles (also_keep)
+    std::vector<std::array<int, 2>>& kept_features = m.kept_features;
     for (Index f = 0; f < previous.mesh.triangles.size(); ++f) {
         const int as = kept_as[static_cast<Index>(prev_regions.face_region[f])];
         if (as < 0) continue;
@@ -370,8 +378,19 @@ bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_re
     tri_region.resize(tri_count);
     tri_strip.resize(tri_count);
 
-    // Canonical order, as build_lobe_surface emits it: stroke vertices in their order, then
-    // interpolated vertices by direction from the centre; only vertices some triangle uses.
+    m.from_next = from_next;
+    m.tris_from_next = tris_from_next;
+    return true;
+}
+
+/// The vertices of `m` that some triangle uses, into `out` in canonical order (as
+/// build_lobe_surface emits them: stroke vertices in their order, then interpolated vertices
+/// by direction from `centre`); returns each vertex's index there, or -1.
+std::vector<int> emit_merged_vertices(const MergedSurface& m, const glm::dvec3& centre, LobeSurface& out)
+{
+    const auto& all = m.all;
+    const auto& tris = m.tris;
+    const Index from_next = m.from_next;
     std::vector<char> used(all.size(), 0);
     for (const auto& t : tris)
         for (int v : t) used[static_cast<Index>(v)] = 1;
@@ -385,7 +404,7 @@ bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_re
             order.push_back(static_cast<int>(v));
             continue;
         }
-        fill.push_back(fill_order_key(all[v].position, next.centre, static_cast<int>(v)));
+        fill.push_back(fill_order_key(all[v].position, centre, static_cast<int>(v)));
     }
     // `next`'s interpolated vertices, then `previous`'s: each list is sorted already when it
     // came from a build or from this function (both order them so); a surface made otherwise
@@ -401,11 +420,6 @@ bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_re
     }
     for (const auto& f : fill) order.push_back(std::get<6>(f));
     std::vector<int> new_index(all.size(), -1);
-    LobeSurface out;
-    out.centre = next.centre;
-    out.reference_radius = next.reference_radius;
-    out.crossings = next.crossings;
-    out.memo = next.memo;
     out.mesh.positions.reserve(order.size());
     out.origins.reserve(order.size());
     for (int v : order) {
@@ -413,69 +427,121 @@ bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_re
         out.mesh.positions.push_back(all[static_cast<Index>(v)].position);
         out.origins.push_back(all[static_cast<Index>(v)].origin);
     }
-    {
-        // Sorted as build_lobe_surface sorts them: by first (lowest) index, then within; each
-        // with its region and whether it is a paper strip's.
-        struct Tagged {
-            std::array<int, 3> t;
-            int region;
-            std::uint8_t strip;
-        };
-        std::vector<Tagged> tagged(tris.size());
-        for (Index i = 0; i < tris.size(); ++i) {
-            const auto& t = tris[i];
-            const std::array<int, 3> o{new_index[static_cast<Index>(t[0])], new_index[static_cast<Index>(t[1])],
-                                       new_index[static_cast<Index>(t[2])]};
-            const Index first = static_cast<Index>(std::min_element(o.begin(), o.end()) - o.begin());
-            tagged[i] = {{o[first], o[(first + 1) % 3], o[(first + 2) % 3]}, tri_region[i], tri_strip[i]};
-        }
-        const auto by_corners = [](const Tagged& x, const Tagged& y) { return x.t < y.t; };
-        std::vector<Tagged> sorted(tagged.size());
-        // `next`'s triangles and the kept ones are each in order already where the vertices
-        // kept their relative order (the usual case): then a merge; else a bucket sort.
-        const auto middle = tagged.begin() + static_cast<std::ptrdiff_t>(tris_from_next);
-        if (std::is_sorted(tagged.begin(), middle, by_corners) && std::is_sorted(middle, tagged.end(), by_corners)) {
-            std::merge(tagged.begin(), middle, middle, tagged.end(), sorted.begin(), by_corners);
-        } else {
-            std::vector<int> start(out.mesh.positions.size() + 1, 0);
-            for (const auto& x : tagged) ++start[static_cast<Index>(x.t[0]) + 1];
-            for (Index i = 1; i < start.size(); ++i) start[i] += start[i - 1];
-            std::vector<int> next_slot(start.begin(), start.end() - 1);
-            for (const auto& x : tagged) sorted[static_cast<Index>(next_slot[static_cast<Index>(x.t[0])]++)] = x;
-            for (Index i = 0; i + 1 < start.size(); ++i)
-                std::sort(sorted.begin() + start[i], sorted.begin() + start[i + 1], by_corners);
-        }
-        // The result's regions, numbered again by their first triangle.
-        std::vector<int> renumber(static_cast<Index>(region_count), -1);
-        MeshRegions regions;
-        regions.face_region.resize(sorted.size());
-        out.mesh.triangles.resize(sorted.size());
-        out.paper_strip_faces.resize(sorted.size());
-        for (Index i = 0; i < sorted.size(); ++i) {
-            const Tagged& x = sorted[i];
-            int& n = renumber[static_cast<Index>(x.region)];
-            if (n < 0) n = regions.count++;
-            regions.face_region[i] = n;
-            out.mesh.triangles[i] = x.t;
-            out.paper_strip_faces[i] = x.strip;
-            out.paper_strip_triangles += x.strip;
-        }
-        std::vector<std::vector<RegionStrokeEdge>> edges(static_cast<Index>(regions.count));
-        for (Index r = 0; r < static_cast<Index>(next_regions.count); ++r)
-            if (renumber[r] >= 0) edges[static_cast<Index>(renumber[r])] = std::move(next_regions_out.edges[r]);
-        for (Index r = 0; r < kept_as.size(); ++r) {
-            const int as = kept_as[r];
-            if (as >= next_regions.count && renumber[static_cast<Index>(as)] >= 0)
-                edges[static_cast<Index>(renumber[static_cast<Index>(as)])] = prev_keys[r];
-        }
-        next_regions_out.regions = std::move(regions);
-        next_regions_out.edges = std::move(edges);
+    return new_index;
+}
+
+/// The triangles of `m` over the vertices' new indices into `out`, sorted as
+/// build_lobe_surface sorts them, and the result's regions (`next_regions_out`): numbered again by
+/// their first triangle, each with its stroke edges (`next`'s as next_regions_out held them on
+/// entry, the kept ones' from `prev_keys`).
+void emit_merged_triangles(const MergedSurface& m, const std::vector<int>& new_index, int region_count,
+                           const std::vector<int>& kept_as, const std::vector<std::vector<DirectedEdge>>& prev_keys,
+                           SurfaceRegions& next_regions_out, LobeSurface& out)
+{
+    const auto& tris = m.tris;
+    const auto& tri_region = m.tri_region;
+    const auto& tri_strip = m.tri_strip;
+    const Index tris_from_next = m.tris_from_next;
+    const int next_count = next_regions_out.regions.count;
+    // Sorted as build_lobe_surface sorts them: by first (lowest) index, then within; each
+    // with its region and whether it is a paper strip's.
+    struct Tagged {
+        std::array<int, 3> t;
+        int region;
+        std::uint8_t strip;
+    };
+    std::vector<Tagged> tagged(tris.size());
+    for (Index i = 0; i < tris.size(); ++i) {
+        const auto& t = tris[i];
+        const std::array<int, 3> o{new_index[static_cast<Index>(t[0])], new_index[static_cast<Index>(t[1])],
+                                   new_index[static_cast<Index>(t[2])]};
+        const Index first = static_cast<Index>(std::min_element(o.begin(), o.end()) - o.begin());
+        tagged[i] = {{o[first], o[(first + 1) % 3], o[(first + 2) % 3]}, tri_region[i], tri_strip[i]};
     }
+    const auto by_corners = [](const Tagged& x, const Tagged& y) { return x.t < y.t; };
+    std::vector<Tagged> sorted(tagged.size());
+    // `next`'s triangles and the kept ones are each in order already where the vertices
+    // kept their relative order (the usual case): then a merge; else a bucket sort.
+    const auto middle = tagged.begin() + static_cast<std::ptrdiff_t>(tris_from_next);
+    if (std::is_sorted(tagged.begin(), middle, by_corners) && std::is_sorted(middle, tagged.end(), by_corners)) {
+        std::merge(tagged.begin(), middle, middle, tagged.end(), sorted.begin(), by_corners);
+    } else {
+        std::vector<int> start(out.mesh.positions.size() + 1, 0);
+        for (const auto& x : tagged) ++start[static_cast<Index>(x.t[0]) + 1];
+        for (Index i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+        std::vector<int> next_slot(start.begin(), start.end() - 1);
+        for (const auto& x : tagged) sorted[static_cast<Index>(next_slot[static_cast<Index>(x.t[0])]++)] = x;
+        for (Index i = 0; i + 1 < start.size(); ++i)
+            std::sort(sorted.begin() + start[i], sorted.begin() + start[i + 1], by_corners);
+    }
+    // The result's regions, numbered again by their first triangle.
+    std::vector<int> renumber(static_cast<Index>(region_count), -1);
+    MeshRegions regions;
+    regions.face_region.resize(sorted.size());
+    out.mesh.triangles.resize(sorted.size());
+    out.paper_strip_faces.resize(sorted.size());
+    for (Index i = 0; i < sorted.size(); ++i) {
+        const Tagged& x = sorted[i];
+        int& n = renumber[static_cast<Index>(x.region)];
+        if (n < 0) n = regions.count++;
+        regions.face_region[i] = n;
+        out.mesh.triangles[i] = x.t;
+        out.paper_strip_faces[i] = x.strip;
+        out.paper_strip_triangles += x.strip;
+    }
+    std::vector<std::vector<RegionStrokeEdge>> edges(static_cast<Index>(regions.count));
+    for (Index r = 0; r < static_cast<Index>(next_count); ++r)
+        if (renumber[r] >= 0) edges[static_cast<Index>(renumber[r])] = std::move(next_regions_out.edges[r]);
+    for (Index r = 0; r < kept_as.size(); ++r) {
+        const int as = kept_as[r];
+        if (as >= next_count && renumber[static_cast<Index>(as)] >= 0)
+            edges[static_cast<Index>(renumber[static_cast<Index>(as)])] = prev_keys[r];
+    }
+    next_regions_out.regions = std::move(regions);
+    next_regions_out.edges = std::move(edges);
+}
+
+/// keep_unchanged_regions and complete_with_kept_regions: `also_keep` (may be null) flags the
+/// regions of `previous` that `next` lacks and that complete it. False when a stroke vertex of
+/// a kept region is not one of `next`'s (nothing is changed then).
+bool keep_regions(const LobeSurface& previous, const SurfaceRegions& previous_regions, const std::vector<char>* also_keep,
+                  LobeSurface& next, SurfaceRegions& next_regions_out, bool next_regions_known, KeptRegions& result)
+{
+    result = {};
+    const Features next_features(next.mesh);
+    if (!next_regions_known) {
+        next_regions_out.regions = regions_of(next.mesh, next_features);
+        next_regions_out.edges = region_keys(next.mesh, next_features, next_regions_out.regions);
+    }
+    const MeshRegions& next_regions = next_regions_out.regions;
+    result.regions = next_regions.count;
+    if (previous.centre != next.centre || previous.reference_radius != next.reference_radius ||
+        previous.mesh.triangles.empty() || previous_regions.regions.face_region.size() != previous.mesh.triangles.size())
+        return also_keep == nullptr;
+    const Features prev_features(previous.mesh);
+    const std::vector<int> kept_as = match_kept_regions(previous_regions, next_regions_out, also_keep, result);
+    const int region_count = result.regions;
+    if (result.kept == 0) return true;
+
+    MergedSurface m;
+    if (!merge_kept_regions(previous, previous_regions.regions, prev_features, kept_as, next, next_regions, next_features,
+                            also_keep != nullptr, m, result)) {
+        if (also_keep) return false;
+        result = KeptRegions{next_regions.count, 0, 0, false};
+        return true;
+    }
+    LobeSurface out;
+    out.centre = next.centre;
+    out.reference_radius = next.reference_radius;
+    out.crossings = next.crossings;
+    out.memo = next.memo;
+    const std::vector<int> new_index = emit_merged_vertices(m, next.centre, out);
+    emit_merged_triangles(m, new_index, region_count, kept_as, previous_regions.edges, next_regions_out, out);
     for (const auto& e : next.mesh.feature_edges) {
         const int a = new_index[static_cast<Index>(e[0])], b = new_index[static_cast<Index>(e[1])];
         if (a >= 0 && b >= 0) out.mesh.feature_edges.push_back({std::min(a, b), std::max(a, b)});
     }
-    for (const auto& e : kept_features) {
+    for (const auto& e : m.kept_features) {
         const int a = new_index[static_cast<Index>(e[0])], b = new_index[static_cast<Index>(e[1])];
         out.mesh.feature_edges.push_back({std::min(a, b), std::max(a, b)});
     }

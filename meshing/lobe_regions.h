@@ -107,9 +107,8 @@ ChangedRegions find_changed_regions(const LobeSurface& previous, const SurfaceRe
 /// The key interpolated vertices are ordered by (build_lobe_surface's output and
 /// complete_with_kept_regions'): the direction from `centre` of the stored (float) position,
 /// then the position, then `vertex` (ties keep vertex order).
-/// Defined out of line on purpose: GCC 12's SLP vectoriser, given the double position a float
-/// was just rounded from, used it unrounded in place of the float, so the two callers' keys
-/// differed in the last bits and their orders disagreed (GCC only; Clang rounds).
+/// Defined out of line on purpose, so that both callers key the float as stored (why:
+/// docs/lobes.md, "a compiler's rounding slip").
 FillOrderKey fill_order_key(const glm::vec3& position, const glm::dvec3& centre, int vertex);
 
 /// The second half of a build of only the changed regions: `next` has the triangles of the

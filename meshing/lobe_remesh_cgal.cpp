@@ -11,20 +11,12 @@
 #include <tuple>
 #include <utility>
 
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wconversion"
-#pragma GCC diagnostic ignored "-Wshadow"
-#pragma GCC diagnostic ignored "-Wsign-conversion"
-#pragma GCC diagnostic ignored "-Wunused-parameter"
-#pragma GCC diagnostic ignored "-Wpedantic"
-#ifndef __clang__ // GCC only: Clang has no such warning and would warn about the pragma
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#endif
+#include "meshing/cgal_prelude.h"
+LOBE_CGAL_HEADERS_BEGIN
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Triangulation_face_base_with_info_2.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
-#pragma GCC diagnostic pop
+LOBE_CGAL_HEADERS_END
 
 #include <glm/geometric.hpp>
 
@@ -38,12 +30,12 @@ namespace lobe {
 namespace {
 
 using Index = std::size_t;
-using K = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Vb = CGAL::Triangulation_vertex_base_with_info_2<int, K>;
-using Fb0 = CGAL::Constrained_triangulation_face_base_2<K>;
-using Fb = CGAL::Triangulation_face_base_with_info_2<int, K, Fb0>;
+using cgal::Kernel;
+using Vb = CGAL::Triangulation_vertex_base_with_info_2<int, Kernel>;
+using Fb0 = CGAL::Constrained_triangulation_face_base_2<Kernel>;
+using Fb = CGAL::Triangulation_face_base_with_info_2<int, Kernel, Fb0>;
 using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
-using CDT = CGAL::Constrained_Delaunay_triangulation_2<K, Tds, CGAL::Exact_predicates_tag>;
+using CDT = CGAL::Constrained_Delaunay_triangulation_2<Kernel, Tds, CGAL::Exact_predicates_tag>;
 using Key3 = std::array<float, 3>;
 
 constexpr double kDegree = 3.14159265358979323846 / 180.0;
@@ -168,17 +160,14 @@ struct RegionInput {
     std::vector<std::pair<int, bool>> pieces; ///< (piece, dangling: the region lies on both sides)
 };
 
-/// The region triangulated in its own chart from its resampled pieces and inner vertices;
-/// empty when that is not possible (then the lobe is remeshed whole).
-TriangleMesh triangulate_region(const LobeSurface& surface, const RegionInput& region, const std::vector<Piece>& pieces)
+/// The pole of a region's chart: opposite the region's mean direction from `centre` when
+/// that lies outside every triangle of the region and at least 10° from its vertices;
+/// otherwise (a strip that runs all the way round the centre has no useful mean) the
+/// direction of a fixed lattice that lies outside the region farthest from its vertices, if
+/// that is 2° or more; (0, 0, 0) where there is none.
+glm::dvec3 chart_pole(const TriangleMesh& mesh, const glm::dvec3& centre, const RegionInput& region)
 {
-    const TriangleMesh& mesh = surface.mesh;
-    const glm::dvec3 centre = surface.centre;
     auto direction = [&](const glm::vec3& p) { return glm::normalize(glm::dvec3(p) - centre); };
-    // The pole: opposite the region's mean direction when that lies outside every triangle of
-    // the region and at least 10° from its vertices; otherwise (a strip that runs all the way
-    // round the centre has no useful mean) the direction of a fixed lattice that lies outside
-    // the region farthest from its vertices, if that is 2° or more.
     std::vector<glm::dvec3> dirs;
     glm::dvec3 mean(0.0);
     for (int f : region.faces) {
@@ -229,15 +218,30 @@ TriangleMesh triangulate_region(const LobeSurface& surface, const RegionInput& r
             }
         }
     }
-    if (pole == glm::dvec3(0.0)) return {};
-    const Stereo chart(pole);
+    return pole;
+}
 
+/// A region's points in its chart: its inner vertices and its pieces' samples (a corner
+/// shared by pieces once) as the positions of `out`, the pieces' segments as its feature
+/// edges and as the triangulation's constraints, those of dangling pieces (the region on both
+/// sides) also sorted in `dangling`.
+struct ChartPoints {
+    TriangleMesh out;
+    std::vector<std::pair<Kernel::Point_2, int>> points; ///< (where in the chart, vertex of `out`)
+    std::vector<std::array<int, 2>> constraints, dangling;
+};
+
+ChartPoints chart_points(const TriangleMesh& mesh, const glm::dvec3& centre, const Stereo& chart,
+                         const RegionInput& region, const std::vector<Piece>& pieces)
+{
+    auto direction = [&](const glm::vec3& p) { return glm::normalize(glm::dvec3(p) - centre); };
     auto plane_point = [&](const glm::dvec3& d) {
         const glm::dvec2 x = chart.to_plane(d);
-        return K::Point_2(x.x, x.y);
+        return Kernel::Point_2(x.x, x.y);
     };
-    TriangleMesh out;
-    std::vector<std::pair<K::Point_2, int>> points;
+    ChartPoints cp;
+    TriangleMesh& out = cp.out;
+    std::vector<std::pair<Kernel::Point_2, int>>& points = cp.points;
     for (int v : region.inner) {
         points.emplace_back(plane_point(direction(mesh.positions[static_cast<Index>(v)])), static_cast<int>(out.positions.size()));
         out.positions.push_back(mesh.positions[static_cast<Index>(v)]);
@@ -255,7 +259,8 @@ TriangleMesh triangulate_region(const LobeSurface& surface, const RegionInput& r
         if (end) corner.emplace_back(key_of(p), i);
         return i;
     };
-    std::vector<std::array<int, 2>> constraints, dangling;
+    std::vector<std::array<int, 2>>& constraints = cp.constraints;
+    std::vector<std::array<int, 2>>& dangling = cp.dangling;
     for (const auto& [pi, both] : region.pieces) {
         const Piece& piece = pieces[static_cast<Index>(pi)];
         std::vector<int> ids;
@@ -269,7 +274,18 @@ TriangleMesh triangulate_region(const LobeSurface& surface, const RegionInput& r
     }
     std::sort(dangling.begin(), dangling.end());
     for (const auto& c : constraints) out.feature_edges.push_back({std::min(c[0], c[1]), std::max(c[0], c[1])});
+    return cp;
+}
 
+/// The triangles of the region (those inside its border in the constrained Delaunay
+/// triangulation of `cp`) into cp.out; false where they cannot be made (points that coincide
+/// in the chart, pieces that cross, a triangle facing the centre, none at all).
+bool triangulate_in_chart(ChartPoints& cp, const glm::dvec3& centre)
+{
+    TriangleMesh& out = cp.out;
+    const auto& points = cp.points;
+    const auto& constraints = cp.constraints;
+    const auto& dangling = cp.dangling;
     CDT cdt;
     std::vector<CDT::Vertex_handle> handle(out.positions.size());
     for (const auto& [x, i] : points) {
@@ -277,13 +293,13 @@ TriangleMesh triangulate_region(const LobeSurface& surface, const RegionInput& r
         v->info() = i; // a point where another already is leaves the count short (below)
         handle[static_cast<Index>(i)] = v;
     }
-    if (cdt.number_of_vertices() != out.positions.size()) return {};
+    if (cdt.number_of_vertices() != out.positions.size()) return false;
     for (const auto& c : constraints) cdt.insert_constraint(handle[static_cast<Index>(c[0])], handle[static_cast<Index>(c[1])]);
     // A piece crossing another (or an inner vertex on a piece) made a vertex of its own.
-    if (cdt.number_of_vertices() != out.positions.size()) return {};
+    if (cdt.number_of_vertices() != out.positions.size()) return false;
     // Every point on one line of the chart: no faces (a 1-dimensional triangulation's have
     // no neighbours to walk), nothing to triangulate.
-    if (cdt.dimension() < 2) return {};
+    if (cdt.dimension() < 2) return false;
 
     // Inside: reached from outside across an odd number of border constraints.
     for (auto f = cdt.all_faces_begin(); f != cdt.all_faces_end(); ++f) f->info() = -1;
@@ -310,10 +326,16 @@ TriangleMesh triangulate_region(const LobeSurface& surface, const RegionInput& r
         const std::array<int, 3> t{f->vertex(0)->info(), f->vertex(2)->info(), f->vertex(1)->info()};
         const glm::dvec3 a(out.positions[static_cast<Index>(t[0])]), b(out.positions[static_cast<Index>(t[1])]),
             c(out.positions[static_cast<Index>(t[2])]);
-        if (!(glm::dot(glm::cross(b - a, c - a), (a + b + c) / 3.0 - centre) > 0.0)) return {};
+        if (!(glm::dot(glm::cross(b - a, c - a), (a + b + c) / 3.0 - centre) > 0.0)) return false;
         out.triangles.push_back(t);
     }
-    if (out.triangles.empty()) return {};
+    if (out.triangles.empty()) return false;
+    return true;
+}
+
+/// `out` without the vertices no triangle uses; empty where a feature edge is one of them.
+TriangleMesh without_unused_vertices(TriangleMesh out)
+{
     // An inner vertex the resampled border left outside (between a piece's chord and the
     // drawn stroke) is used by no triangle: dropped, so that it becomes no attractor.
     std::vector<int> index(out.positions.size(), -1);
@@ -334,6 +356,18 @@ TriangleMesh triangulate_region(const LobeSurface& surface, const RegionInput& r
     return compact;
 }
 
+/// The region triangulated in its own chart from its resampled pieces and inner vertices;
+/// empty when that is not possible (then the lobe is remeshed whole).
+TriangleMesh triangulate_region(const LobeSurface& surface, const RegionInput& region, const std::vector<Piece>& pieces)
+{
+    const glm::dvec3 pole = chart_pole(surface.mesh, surface.centre, region);
+    if (pole == glm::dvec3(0.0)) return {};
+    const Stereo chart(pole);
+    ChartPoints cp = chart_points(surface.mesh, surface.centre, chart, region, pieces);
+    if (!triangulate_in_chart(cp, surface.centre)) return {};
+    return without_unused_vertices(std::move(cp.out));
+}
+
 TriangleMesh remesh_whole(const LobeSurface& surface, const RemeshOptions& options)
 {
     RemeshOptions o = options;
@@ -352,6 +386,159 @@ TriangleMesh remesh_whole(const LobeSurface& surface, const RemeshOptions& optio
         throw InvalidInput(buf);
     }
     return out;
+}
+
+/// Every stroke edge's piece, and whether the piece runs along it from its lower vertex.
+class EdgePieces {
+public:
+    explicit EdgePieces(const std::vector<Piece>& pieces)
+    {
+        for (Index i = 0; i < pieces.size(); ++i) {
+            const auto& v = pieces[i].vertices;
+            for (Index k = 0; k + 1 < v.size() + (pieces[i].loop ? 1 : 0); ++k) {
+                const int a = v[k], b = v[(k + 1) % v.size()];
+                edge_piece_.push_back({{std::min(a, b), std::max(a, b)}, {static_cast<int>(i), a < b}});
+            }
+        }
+        std::sort(edge_piece_.begin(), edge_piece_.end());
+    }
+    /// (piece, 1 when the piece runs from a to b, 2 when from b to a), or (−1, 0).
+    std::pair<int, int> piece_of(int a, int b) const
+    {
+        const std::array<int, 2> e{std::min(a, b), std::max(a, b)};
+        const auto it = std::lower_bound(edge_piece_.begin(), edge_piece_.end(), std::make_pair(e, std::make_pair(-1, false)));
+        if (it == edge_piece_.end() || it->first != e) return std::make_pair(-1, 0);
+        return std::make_pair(it->second.first, it->second.second == (a < b) ? 1 : 2);
+    }
+
+private:
+    std::vector<std::pair<std::array<int, 2>, std::pair<int, bool>>> edge_piece_;
+};
+
+/// Each region's faces, inner vertices (on no stroke edge) and pieces (dangling where the
+/// region lies on both sides of one).
+std::vector<RegionInput> region_inputs(const TriangleMesh& mesh, const MeshRegions& regions, const EdgePieces& edges)
+{
+    std::vector<RegionInput> input(static_cast<Index>(regions.count));
+    std::vector<char> on_stroke(mesh.positions.size(), 0);
+    for (const auto& e : mesh.feature_edges) on_stroke[static_cast<Index>(e[0])] = on_stroke[static_cast<Index>(e[1])] = 1;
+    std::vector<int> seen(mesh.positions.size(), -1);
+    std::vector<std::vector<std::pair<int, int>>> sides(input.size()); // (piece, +1 / −1 per side seen)
+    for (Index f = 0; f < mesh.triangles.size(); ++f) {
+        const int r = regions.face_region[f];
+        RegionInput& in = input[static_cast<Index>(r)];
+        in.faces.push_back(static_cast<int>(f));
+        const auto& t = mesh.triangles[f];
+        for (int k = 0; k < 3; ++k) {
+            const int a = t[static_cast<Index>(k)], b = t[static_cast<Index>((k + 1) % 3)];
+            if (!on_stroke[static_cast<Index>(a)] && seen[static_cast<Index>(a)] != r) {
+                seen[static_cast<Index>(a)] = r;
+                in.inner.push_back(a);
+            }
+            const auto [p, side] = edges.piece_of(a, b);
+            if (p >= 0) sides[static_cast<Index>(r)].emplace_back(p, side);
+        }
+    }
+    for (Index r = 0; r < input.size(); ++r) {
+        auto& s = sides[r];
+        std::sort(s.begin(), s.end());
+        for (Index i = 0; i < s.size();) {
+            Index j = i;
+            int mask = 0;
+            while (j < s.size() && s[j].first == s[i].first) mask |= s[j++].second;
+            input[r].pieces.emplace_back(s[i].first, mask == 3);
+            i = j;
+        }
+    }
+    return input;
+}
+
+/// Puts the region's faces, inner vertices and pieces in an order of their own (by position),
+/// so that what is made of them does not depend on how the surface numbers them: the same
+/// region in the next surface, numbered otherwise, is remeshed the same. Returns the region's
+/// key: its triangles' corners and its pieces' samples in that order.
+std::vector<float> order_region(const TriangleMesh& mesh, RegionInput& in, const std::vector<Piece>& pieces)
+{
+    std::vector<std::pair<std::array<float, 9>, int>> tagged;
+    for (int f : in.faces) {
+        std::array<Key3, 3> c{};
+        for (Index k = 0; k < 3; ++k) c[k] = key_of(mesh.positions[static_cast<Index>(mesh.triangles[static_cast<Index>(f)][k])]);
+        const Index first = static_cast<Index>(std::min_element(c.begin(), c.end()) - c.begin());
+        std::array<float, 9> t{};
+        for (Index k = 0; k < 3; ++k)
+            for (Index j = 0; j < 3; ++j) t[3 * k + j] = c[(first + k) % 3][j];
+        tagged.emplace_back(t, f);
+    }
+    std::sort(tagged.begin(), tagged.end());
+    std::vector<std::array<float, 9>> tris;
+    for (Index i = 0; i < tagged.size(); ++i) {
+        tris.push_back(tagged[i].first);
+        in.faces[i] = tagged[i].second;
+    }
+    std::sort(in.inner.begin(), in.inner.end(), [&](int a, int b) {
+        return key_of(mesh.positions[static_cast<Index>(a)]) < key_of(mesh.positions[static_cast<Index>(b)]);
+    });
+    std::sort(in.pieces.begin(), in.pieces.end(), [&](const std::pair<int, bool>& a, const std::pair<int, bool>& b) {
+        const auto& x = pieces[static_cast<Index>(a.first)].samples;
+        const auto& y = pieces[static_cast<Index>(b.first)].samples;
+        const bool less = std::lexicographical_compare(x.begin(), x.end(), y.begin(), y.end(), [](const glm::vec3& u, const glm::vec3& w) {
+            return key_of(u) < key_of(w);
+        });
+        const bool more = std::lexicographical_compare(y.begin(), y.end(), x.begin(), x.end(), [](const glm::vec3& u, const glm::vec3& w) {
+            return key_of(u) < key_of(w);
+        });
+        return less || (!more && a.second < b.second);
+    });
+    std::vector<float> key;
+    key.reserve(9 * tris.size() + 16);
+    for (const auto& t : tris) key.insert(key.end(), t.begin(), t.end());
+    for (const auto& [p, both] : in.pieces) {
+        key.push_back(both ? 2.0f : 1.0f);
+        for (const glm::vec3& s : pieces[static_cast<Index>(p)].samples) key.insert(key.end(), {s.x, s.y, s.z});
+    }
+    return key;
+}
+
+/// The remeshed regions joined at their stroke vertices (the same positions on both sides).
+TriangleMesh join_regions(const std::vector<const TriangleMesh*>& remeshed)
+{
+    TriangleMesh out;
+    std::map<Key3, int> shared;
+    for (const TriangleMesh* part : remeshed) {
+        std::vector<char> on(part->positions.size(), 0);
+        for (const auto& e : part->feature_edges) on[static_cast<Index>(e[0])] = on[static_cast<Index>(e[1])] = 1;
+        std::vector<int> index(part->positions.size(), -1);
+        for (Index v = 0; v < part->positions.size(); ++v) {
+            if (on[v]) {
+                const auto [it, added] = shared.emplace(key_of(part->positions[v]), static_cast<int>(out.positions.size()));
+                index[v] = it->second;
+                if (!added) continue;
+            } else {
+                index[v] = static_cast<int>(out.positions.size());
+            }
+            out.positions.push_back(part->positions[v]);
+        }
+        for (const auto& t : part->triangles)
+            out.triangles.push_back({index[static_cast<Index>(t[0])], index[static_cast<Index>(t[1])], index[static_cast<Index>(t[2])]});
+        for (const auto& e : part->feature_edges) {
+            const int a = index[static_cast<Index>(e[0])], b = index[static_cast<Index>(e[1])];
+            out.feature_edges.push_back({std::min(a, b), std::max(a, b)});
+        }
+    }
+    std::sort(out.feature_edges.begin(), out.feature_edges.end());
+    out.feature_edges.erase(std::unique(out.feature_edges.begin(), out.feature_edges.end()), out.feature_edges.end());
+    return out;
+}
+
+/// Whether the joined regions make a closed, 2-manifold, outward surface using every vertex.
+bool joined_surface_ok(const TriangleMesh& out)
+{
+    const MeshQuality q = measure_quality(out);
+    std::vector<char> used(out.positions.size(), 0);
+    for (const auto& t : out.triangles)
+        for (int v : t) used[static_cast<Index>(v)] = 1;
+    const bool all_used = std::find(used.begin(), used.end(), 0) == used.end();
+    return q.closed && q.manifold && q.outward && all_used;
 }
 
 } // namespace
@@ -389,59 +576,11 @@ TriangleMesh remesh_lobe_surface(const LobeSurface& surface, const RemeshOptions
         return remesh_whole(surface, options);
     }
     for (Piece& p : pieces) resample(p, mesh, target);
-    // Every stroke edge → its piece, and whether the piece runs along it from its lower vertex.
-    std::vector<std::pair<std::array<int, 2>, std::pair<int, bool>>> edge_piece;
-    for (Index i = 0; i < pieces.size(); ++i) {
-        const auto& v = pieces[i].vertices;
-        for (Index k = 0; k + 1 < v.size() + (pieces[i].loop ? 1 : 0); ++k) {
-            const int a = v[k], b = v[(k + 1) % v.size()];
-            edge_piece.push_back({{std::min(a, b), std::max(a, b)}, {static_cast<int>(i), a < b}});
-        }
-    }
-    std::sort(edge_piece.begin(), edge_piece.end());
-    // (piece, 1 when the piece runs from a to b, 2 when from b to a), or (−1, 0).
-    auto piece_of = [&](int a, int b) {
-        const std::array<int, 2> e{std::min(a, b), std::max(a, b)};
-        const auto it = std::lower_bound(edge_piece.begin(), edge_piece.end(), std::make_pair(e, std::make_pair(-1, false)));
-        if (it == edge_piece.end() || it->first != e) return std::make_pair(-1, 0);
-        return std::make_pair(it->second.first, it->second.second == (a < b) ? 1 : 2);
-    };
+    const EdgePieces edges(pieces);
 
     const MeshRegions regions = mesh_regions(mesh);
     st.regions = regions.count;
-    std::vector<RegionInput> input(static_cast<Index>(regions.count));
-    std::vector<char> on_stroke(mesh.positions.size(), 0);
-    for (const auto& e : mesh.feature_edges) on_stroke[static_cast<Index>(e[0])] = on_stroke[static_cast<Index>(e[1])] = 1;
-    {
-        std::vector<int> seen(mesh.positions.size(), -1);
-        std::vector<std::vector<std::pair<int, int>>> sides(input.size()); // (piece, +1 / −1 per side seen)
-        for (Index f = 0; f < mesh.triangles.size(); ++f) {
-            const int r = regions.face_region[f];
-            RegionInput& in = input[static_cast<Index>(r)];
-            in.faces.push_back(static_cast<int>(f));
-            const auto& t = mesh.triangles[f];
-            for (int k = 0; k < 3; ++k) {
-                const int a = t[static_cast<Index>(k)], b = t[static_cast<Index>((k + 1) % 3)];
-                if (!on_stroke[static_cast<Index>(a)] && seen[static_cast<Index>(a)] != r) {
-                    seen[static_cast<Index>(a)] = r;
-                    in.inner.push_back(a);
-                }
-                const auto [p, side] = piece_of(a, b);
-                if (p >= 0) sides[static_cast<Index>(r)].emplace_back(p, side);
-            }
-        }
-        for (Index r = 0; r < input.size(); ++r) {
-            auto& s = sides[r];
-            std::sort(s.begin(), s.end());
-            for (Index i = 0; i < s.size();) {
-                Index j = i;
-                int mask = 0;
-                while (j < s.size() && s[j].first == s[i].first) mask |= s[j++].second;
-                input[r].pieces.emplace_back(s[i].first, mask == 3);
-                i = j;
-            }
-        }
-    }
+    std::vector<RegionInput> input = region_inputs(mesh, regions, edges);
 
     // Each region: from the cache, or triangulated and remeshed.
     RemeshOptions region_options;
@@ -455,47 +594,8 @@ TriangleMesh remesh_lobe_surface(const LobeSurface& surface, const RemeshOptions
     std::map<std::vector<float>, TriangleMesh> now;
     std::vector<const TriangleMesh*> remeshed(input.size(), nullptr);
     for (Index r = 0; r < input.size(); ++r) {
-        // The region's faces, inner vertices and pieces in an order of their own (by position),
-        // so that what is made of them does not depend on how the surface numbers them: the
-        // same region in the next surface, numbered otherwise, is remeshed the same.
         RegionInput& in = input[r];
-        std::vector<std::pair<std::array<float, 9>, int>> tagged;
-        for (int f : in.faces) {
-            std::array<Key3, 3> c{};
-            for (Index k = 0; k < 3; ++k) c[k] = key_of(mesh.positions[static_cast<Index>(mesh.triangles[static_cast<Index>(f)][k])]);
-            const Index first = static_cast<Index>(std::min_element(c.begin(), c.end()) - c.begin());
-            std::array<float, 9> t{};
-            for (Index k = 0; k < 3; ++k)
-                for (Index j = 0; j < 3; ++j) t[3 * k + j] = c[(first + k) % 3][j];
-            tagged.emplace_back(t, f);
-        }
-        std::sort(tagged.begin(), tagged.end());
-        std::vector<std::array<float, 9>> tris;
-        for (Index i = 0; i < tagged.size(); ++i) {
-            tris.push_back(tagged[i].first);
-            in.faces[i] = tagged[i].second;
-        }
-        std::sort(in.inner.begin(), in.inner.end(), [&](int a, int b) {
-            return key_of(mesh.positions[static_cast<Index>(a)]) < key_of(mesh.positions[static_cast<Index>(b)]);
-        });
-        std::sort(in.pieces.begin(), in.pieces.end(), [&](const std::pair<int, bool>& a, const std::pair<int, bool>& b) {
-            const auto& x = pieces[static_cast<Index>(a.first)].samples;
-            const auto& y = pieces[static_cast<Index>(b.first)].samples;
-            const bool less = std::lexicographical_compare(x.begin(), x.end(), y.begin(), y.end(), [](const glm::vec3& u, const glm::vec3& w) {
-                return key_of(u) < key_of(w);
-            });
-            const bool more = std::lexicographical_compare(y.begin(), y.end(), x.begin(), x.end(), [](const glm::vec3& u, const glm::vec3& w) {
-                return key_of(u) < key_of(w);
-            });
-            return less || (!more && a.second < b.second);
-        });
-        std::vector<float> key;
-        key.reserve(9 * tris.size() + 16);
-        for (const auto& t : tris) key.insert(key.end(), t.begin(), t.end());
-        for (const auto& [p, both] : in.pieces) {
-            key.push_back(both ? 2.0f : 1.0f);
-            for (const glm::vec3& s : pieces[static_cast<Index>(p)].samples) key.insert(key.end(), {s.x, s.y, s.z});
-        }
+        const std::vector<float> key = order_region(mesh, in, pieces);
         auto it = now.find(key);
         if (it == now.end() && cache) {
             const auto c = cache->regions.find(key);
@@ -527,38 +627,8 @@ TriangleMesh remesh_lobe_surface(const LobeSurface& surface, const RemeshOptions
         remeshed[r] = &it->second;
     }
 
-    // The regions joined at their stroke vertices (the same positions on both sides).
-    TriangleMesh out;
-    std::map<Key3, int> shared;
-    for (const TriangleMesh* part : remeshed) {
-        std::vector<char> on(part->positions.size(), 0);
-        for (const auto& e : part->feature_edges) on[static_cast<Index>(e[0])] = on[static_cast<Index>(e[1])] = 1;
-        std::vector<int> index(part->positions.size(), -1);
-        for (Index v = 0; v < part->positions.size(); ++v) {
-            if (on[v]) {
-                const auto [it, added] = shared.emplace(key_of(part->positions[v]), static_cast<int>(out.positions.size()));
-                index[v] = it->second;
-                if (!added) continue;
-            } else {
-                index[v] = static_cast<int>(out.positions.size());
-            }
-            out.positions.push_back(part->positions[v]);
-        }
-        for (const auto& t : part->triangles)
-            out.triangles.push_back({index[static_cast<Index>(t[0])], index[static_cast<Index>(t[1])], index[static_cast<Index>(t[2])]});
-        for (const auto& e : part->feature_edges) {
-            const int a = index[static_cast<Index>(e[0])], b = index[static_cast<Index>(e[1])];
-            out.feature_edges.push_back({std::min(a, b), std::max(a, b)});
-        }
-    }
-    std::sort(out.feature_edges.begin(), out.feature_edges.end());
-    out.feature_edges.erase(std::unique(out.feature_edges.begin(), out.feature_edges.end()), out.feature_edges.end());
-    const MeshQuality q = measure_quality(out);
-    std::vector<char> used(out.positions.size(), 0);
-    for (const auto& t : out.triangles)
-        for (int v : t) used[static_cast<Index>(v)] = 1;
-    const bool all_used = std::find(used.begin(), used.end(), 0) == used.end();
-    if (!q.closed || !q.manifold || !q.outward || !all_used) {
+    TriangleMesh out = join_regions(remeshed);
+    if (!joined_surface_ok(out)) {
         if (cache) cache->regions.clear();
         st = {};
         st.regions = regions.count;

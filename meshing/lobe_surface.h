@@ -1,7 +1,8 @@
 #pragma once
 /// \file lobe_surface.h
 /// The closed surface of one lobe through all of its strokes (§4.2, Fig. 5 and 9). CGAL
-/// works behind this plain interface (lobe_surface_cgal.cpp). See docs/lobes.md.
+/// works behind this plain interface (lobe_surface_cgal.cpp; the stages of a build are listed
+/// in lobe_surface_builder.h). See docs/lobes.md.
 ///
 /// A lobe is star-shaped around its centre: every point of a foliage envelope is seen from
 /// inside it. The strokes, seen from the centre, are curves on the sphere of directions.
@@ -49,7 +50,7 @@ struct LobeSurfaceOptions {
     /// 4). Remeshing puts the attractors at the target spacing and lifts every vertex it makes
     /// along its ray from the centre to the distance interpolated across the fill's triangles
     /// (RemeshOptions::radial_centre), so the remeshed lobe keeps its curvature between fill
-    /// vertices. At 2 a stroke is added in about 0.7 of the time (docs/lobes.md, "Measured").
+    /// vertices (what 2 saves: docs/lobes.md, step 6 and "Measured").
     /// A lobe that is not remeshed (remesh_iterations 0) keeps 1: its fill is its attractors.
     double fill_coarseness = 2.0;
     /// A stroke sample closer than this fraction of its stroke's median spacing to a
@@ -85,7 +86,7 @@ struct LobeVertexOrigin {
 
 /// What a build found over all of its strokes (the pole and its search, the crossings, the
 /// radius model's normal equations per stroke), kept so that the build after one more stroke
-/// looks only at that stroke where the answer cannot differ (lobe_surface_cgal.cpp). Never
+/// looks only at that stroke where the answer cannot differ (lobe_surface_builder.h). Never
 /// changes the result.
 struct LobeBuildMemo;
 

@@ -423,17 +423,22 @@ private:
     std::size_t line_;
 };
 
-TriangleMesh read_ply(const std::string& path, std::string_view data)
+/// A PLY header: the body's format and its elements in order.
+struct PlyHeader {
+    PlyFormat format = PlyFormat::ascii;
+    std::vector<PlyElement> elements;
+};
+
+/// Reads the header, `lines` left right after its end_header line.
+PlyHeader read_ply_header(const MeshBuilder& mb, LineReader& lines)
 {
-    MeshBuilder mb(path);
-    LineReader lines(data);
     std::string_view line;
     std::vector<std::string_view> tok;
-
+    PlyHeader header;
+    PlyFormat& format = header.format;
+    std::vector<PlyElement>& elements = header.elements;
     if (!lines.next(line) || (line != "ply" && line != "ply\r")) mb.fail("not a PLY file (missing 'ply' magic)");
-    PlyFormat format = PlyFormat::ascii;
     bool have_format = false, ended = false;
-    std::vector<PlyElement> elements;
     while (!ended && lines.next(line)) {
         split_tokens(line, tok);
         const std::string where = line_prefix(lines.line());
@@ -478,17 +483,21 @@ TriangleMesh read_ply(const std::string& path, std::string_view data)
     }
     if (!ended) mb.fail("header has no end_header");
     if (!have_format) mb.fail("header has no format line");
+    return header;
+}
 
-    const std::size_t body = lines.position(); // right after the end_header line
-    const std::size_t body_bytes = data.size() - body;
-
-    // Check the declared counts against the caps and against what the body can hold, before
-    // anything is allocated. Binary: a scalar takes its size, a list at least its count (a
-    // face list at least count + 3 indices). ASCII: every value takes at least 2 bytes.
+/// The vertex and the face element. Checks the declared counts against the caps and against
+/// what the body (`body_bytes`) can hold, before anything is allocated.
+std::pair<const PlyElement*, const PlyElement*> check_ply_counts(const MeshBuilder& mb, const PlyHeader& header,
+                                                                 std::size_t body_bytes)
+{
+    const PlyFormat format = header.format;
+    // Binary: a scalar takes its size, a list at least its count (a face list at least
+    // count + 3 indices). ASCII: every value takes at least 2 bytes.
     const PlyElement* vertex_el = nullptr;
     const PlyElement* face_el = nullptr;
     unsigned long long min_bytes = 0;
-    for (const PlyElement& el : elements) {
+    for (const PlyElement& el : header.elements) {
         if (el.name == "vertex") vertex_el = &el;
         if (el.name == "face") face_el = &el;
         unsigned long long per = 0;
@@ -514,31 +523,50 @@ TriangleMesh read_ply(const std::string& path, std::string_view data)
     if (face_el->count > Limits::max_triangles)
         mb.fail("declares " + std::to_string(face_el->count) + " faces (limit " +
                 std::to_string(Limits::max_triangles) + ")");
+    return {vertex_el, face_el};
+}
 
+/// Where a PLY vertex's x, y and z and a face's index list are among their element's
+/// properties.
+struct PlyColumns {
     int xyz[3] = {-1, -1, -1};
-    for (std::size_t i = 0; i < vertex_el->properties.size(); ++i) {
-        const PlyProperty& p = vertex_el->properties[i];
+    int face_list = -1;
+};
+
+PlyColumns find_ply_columns(const MeshBuilder& mb, const PlyElement& vertex, const PlyElement& face)
+{
+    PlyColumns columns;
+    int (&xyz)[3] = columns.xyz;
+    int& face_list = columns.face_list;
+    for (std::size_t i = 0; i < vertex.properties.size(); ++i) {
+        const PlyProperty& p = vertex.properties[i];
         for (int k = 0; k < 3; ++k)
             if (p.name == std::string(1, static_cast<char>('x' + k)) && p.count_type == PlyType::none)
                 xyz[k] = static_cast<int>(i);
     }
     if (xyz[0] < 0 || xyz[1] < 0 || xyz[2] < 0) mb.fail("vertex element lacks scalar x, y, z properties");
-    int face_list = -1;
-    for (std::size_t i = 0; i < face_el->properties.size(); ++i) {
-        const PlyProperty& p = face_el->properties[i];
+    for (std::size_t i = 0; i < face.properties.size(); ++i) {
+        const PlyProperty& p = face.properties[i];
         if ((p.name == "vertex_indices" || p.name == "vertex_index") && p.count_type != PlyType::none) {
             if (!ply_is_integer(p.type)) mb.fail("face indices are not integers");
             face_list = static_cast<int>(i);
         }
     }
     if (face_list < 0) mb.fail("face element lacks a vertex_indices list");
+    return columns;
+}
 
-    mb.reserve(static_cast<std::size_t>(vertex_el->count), static_cast<std::size_t>(face_el->count));
-    PlyBody in(mb, data, body, format, lines.line() + 1);
+/// Reads every element of the body: the vertices and faces into `mb`, and "edge" elements as
+/// polylines.
+void read_ply_body(MeshBuilder& mb, PlyBody& in, const PlyHeader& header, const PlyElement* vertex_el,
+                   const PlyElement* face_el, const PlyColumns& columns)
+{
+    const int (&xyz)[3] = columns.xyz;
+    const int face_list = columns.face_list;
     std::vector<int> poly;
     std::vector<int> edge_ends;
     const std::size_t max_poly = 1u << 16;
-    for (const PlyElement& el : elements) {
+    for (const PlyElement& el : header.elements) {
         const bool is_vertex = &el == vertex_el, is_face = &el == face_el, is_edge = el.name == "edge";
         for (unsigned long long e = 0; e < el.count; ++e) {
             const std::string what = "element '" + excerpt(el.name) + "' #" + std::to_string(e);
@@ -581,6 +609,19 @@ TriangleMesh read_ply(const std::string& path, std::string_view data)
         }
     }
     for (std::size_t i = 0; i + 1 < edge_ends.size(); i += 2) mb.add_polyline({edge_ends[i], edge_ends[i + 1]});
+}
+
+TriangleMesh read_ply(const std::string& path, std::string_view data)
+{
+    MeshBuilder mb(path);
+    LineReader lines(data);
+    const PlyHeader header = read_ply_header(mb, lines);
+    const std::size_t body = lines.position(); // right after the end_header line
+    const auto [vertex_el, face_el] = check_ply_counts(mb, header, data.size() - body);
+    const PlyColumns columns = find_ply_columns(mb, *vertex_el, *face_el);
+    mb.reserve(static_cast<std::size_t>(vertex_el->count), static_cast<std::size_t>(face_el->count));
+    PlyBody in(mb, data, body, header.format, lines.line() + 1);
+    read_ply_body(mb, in, header, vertex_el, face_el, columns);
     return mb.finish();
 }
 

@@ -40,10 +40,9 @@ struct LobeFromModelOptions {
     /// A mesh of more triangles than this is simplified by cluster_vertices before repair,
     /// with cubes of `simplify_cell_fraction` × the target edge length at the lobe's size
     /// (the mesh's size taken from the middle 99 % of its vertices on each axis, so that a
-    /// speck far away, which repair drops, does not coarsen them):
-    /// repair takes about 0.7 kB and 25 µs per triangle, so a 20-million-triangle scan (the
-    /// reader's limit) would need some 14 GB, while the lobe keeps nothing finer than its
-    /// spacing. 0: never.
+    /// speck far away, which repair drops, does not coarsen them): the lobe keeps nothing
+    /// finer than its spacing, and repair's memory and time grow with the triangles
+    /// (docs/lobes-from-models.md, "Large meshes"). 0: never.
     std::size_t simplify_above_triangles = 1'000'000;
     double simplify_cell_fraction = 0.2;
 };

@@ -38,8 +38,8 @@ struct RemeshOptions {
     /// the rounds as relax_feature_edges does, CGAL's split, collapse and flip one round at a
     /// time, then our tangential relaxation and a projection onto the input by walking it,
     /// then the small-angle repairs; instead of CGAL's relaxation (its vertex normals) and
-    /// projection (an AABB tree built on every call), which took about half of remeshing a
-    /// lobe region by region. Whole-mesh remeshing only (`faces` empty).
+    /// projection (an AABB tree built on every call; what they cost: docs/lobes.md,
+    /// "Measured"). Whole-mesh remeshing only (`faces` empty).
     bool own_rounds = false;
     /// Triangle indices to remesh (incremental remeshing of a changed region); empty: all.
     /// The region's border edges are constrained too (split first when longer than the

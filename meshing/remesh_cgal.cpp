@@ -13,22 +13,13 @@
 #include <unordered_map>
 #include <vector>
 
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wconversion"
-#pragma GCC diagnostic ignored "-Wshadow"
-#pragma GCC diagnostic ignored "-Wsign-conversion"
-#pragma GCC diagnostic ignored "-Wunused-parameter"
-#pragma GCC diagnostic ignored "-Wpedantic"
-#ifndef __clang__ // GCC only: Clang has no such warning and would warn about the pragma
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#endif
-#pragma GCC diagnostic ignored "-Wdeprecated-copy"
-#pragma GCC diagnostic ignored "-Woverloaded-virtual"
+#include "meshing/cgal_prelude.h"
+LOBE_CGAL_HEADERS_BEGIN
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 #include <CGAL/boost/graph/graph_traits_TriMesh_ArrayKernelT.h>
 #include <CGAL/boost/graph/properties_TriMesh_ArrayKernelT.h>
 #include <CGAL/Polygon_mesh_processing/remesh.h>
-#pragma GCC diagnostic pop
+LOBE_CGAL_HEADERS_END
 
 #include <glm/geometric.hpp>
 
@@ -40,7 +31,7 @@ namespace lobe {
 
 namespace {
 
-namespace PMP = CGAL::Polygon_mesh_processing;
+namespace PMP = cgal::PMP;
 
 constexpr double kDegree = 3.14159265358979323846 / 180.0;
 

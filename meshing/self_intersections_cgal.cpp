@@ -10,20 +10,12 @@
 #include <string>
 #include <vector>
 
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wconversion"
-#pragma GCC diagnostic ignored "-Wshadow"
-#pragma GCC diagnostic ignored "-Wsign-conversion"
-#pragma GCC diagnostic ignored "-Wunused-parameter"
-#pragma GCC diagnostic ignored "-Wpedantic"
-#ifndef __clang__ // GCC only: Clang has no such warning and would warn about the pragma
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#endif
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include "meshing/cgal_prelude.h"
+LOBE_CGAL_HEADERS_BEGIN
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Surface_mesh.h>
-#pragma GCC diagnostic pop
+LOBE_CGAL_HEADERS_END
 
 #include "core/errors.h"
 
@@ -31,10 +23,7 @@ namespace lobe {
 
 namespace {
 
-namespace PMP = CGAL::Polygon_mesh_processing;
-using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Point = Kernel::Point_3;
-using Mesh = CGAL::Surface_mesh<Point>;
+using namespace cgal; // Kernel, Point, Mesh, PMP
 
 /// `in` as a Surface_mesh. \throw InvalidInput when it is not a 2-manifold mesh.
 Mesh to_surface_mesh(const TriangleMesh& in, const char* who)

@@ -3,37 +3,26 @@
 #include <array>
 #include <vector>
 
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wconversion"
-#pragma GCC diagnostic ignored "-Wshadow"
-#pragma GCC diagnostic ignored "-Wsign-conversion"
-#pragma GCC diagnostic ignored "-Wunused-parameter"
-#pragma GCC diagnostic ignored "-Wpedantic"
-#ifndef __clang__ // GCC only: Clang has no such warning and would warn about the pragma
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#endif
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include "meshing/cgal_prelude.h"
+LOBE_CGAL_HEADERS_BEGIN
 #include <CGAL/Surface_mesh.h>
-#pragma GCC diagnostic pop
+LOBE_CGAL_HEADERS_END
 
 #include "core/mesh.h"
 
 namespace lobe::bench {
 
-using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-using SurfaceMesh = CGAL::Surface_mesh<Kernel::Point_3>;
-
-inline SurfaceMesh to_surface_mesh(const TriangleMesh& m)
+inline cgal::Mesh to_surface_mesh(const TriangleMesh& m)
 {
-    SurfaceMesh sm;
-    std::vector<SurfaceMesh::Vertex_index> v;
-    for (const auto& p : m.positions) v.push_back(sm.add_vertex(Kernel::Point_3(p.x, p.y, p.z)));
+    cgal::Mesh sm;
+    std::vector<cgal::Mesh::Vertex_index> v;
+    for (const auto& p : m.positions) v.push_back(sm.add_vertex(cgal::Point(p.x, p.y, p.z)));
     for (const auto& t : m.triangles)
         sm.add_face(v[static_cast<std::size_t>(t[0])], v[static_cast<std::size_t>(t[1])], v[static_cast<std::size_t>(t[2])]);
     return sm;
 }
 
-inline TriangleMesh from_surface_mesh(SurfaceMesh& sm)
+inline TriangleMesh from_surface_mesh(cgal::Mesh& sm)
 {
     sm.collect_garbage();
     TriangleMesh m;

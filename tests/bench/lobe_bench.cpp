@@ -20,16 +20,10 @@
 #include "tests/support/replay_fixture.h"
 #include "tests/support/shapes.h"
 
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wconversion"
-#pragma GCC diagnostic ignored "-Wshadow"
-#pragma GCC diagnostic ignored "-Wsign-conversion"
-#pragma GCC diagnostic ignored "-Wunused-parameter"
-#ifndef __clang__ // GCC only: Clang has no such warning and would warn about the pragma
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#endif
+#include "meshing/cgal_prelude.h"
+LOBE_CGAL_HEADERS_BEGIN
 #include <CGAL/Polygon_mesh_processing/remesh.h>
-#pragma GCC diagnostic pop
+LOBE_CGAL_HEADERS_END
 
 using namespace lobe;
 
@@ -215,8 +209,8 @@ void BM_CgalDefaultRemeshTenStrokeLobe10Iterations(benchmark::State& state)
     Lobe lobe;
     const auto strokes = test::ten_stroke_lobe();
     for (std::size_t i = 0; i < strokes.size(); ++i) lobe.add_stroke(static_cast<std::int64_t>(i + 1), strokes[i]);
-    const bench::SurfaceMesh input = bench::to_surface_mesh(lobe.surface().mesh);
-    bench::SurfaceMesh sm;
+    const cgal::Mesh input = bench::to_surface_mesh(lobe.surface().mesh);
+    cgal::Mesh sm;
     for (auto _ : state) {
         sm = input;
         CGAL::Polygon_mesh_processing::isotropic_remeshing(faces(sm), 0.03, sm, CGAL::parameters::number_of_iterations(10));

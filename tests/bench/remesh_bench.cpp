@@ -7,19 +7,11 @@
 #include <cmath>
 #include <vector>
 
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wconversion"
-#pragma GCC diagnostic ignored "-Wshadow"
-#pragma GCC diagnostic ignored "-Wsign-conversion"
-#pragma GCC diagnostic ignored "-Wunused-parameter"
-#pragma GCC diagnostic ignored "-Wpedantic"
-#ifndef __clang__ // GCC only: Clang has no such warning and would warn about the pragma
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#endif
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include "meshing/cgal_prelude.h"
+LOBE_CGAL_HEADERS_BEGIN
 #include <CGAL/Polygon_mesh_processing/remesh.h>
 #include <CGAL/Surface_mesh.h>
-#pragma GCC diagnostic pop
+LOBE_CGAL_HEADERS_END
 
 #include <glm/geometric.hpp>
 
@@ -29,7 +21,6 @@
 #include "tests/support/shapes.h"
 
 using namespace lobe;
-using lobe::bench::SurfaceMesh;
 using lobe::bench::from_surface_mesh;
 using lobe::bench::to_surface_mesh;
 
@@ -86,8 +77,8 @@ BENCHMARK(BM_RemeshLobe40cmAt3cm)->Unit(benchmark::kMillisecond);
 
 static void BM_CgalDefaultRemesh10Iterations(benchmark::State& state)
 {
-    const SurfaceMesh input = to_surface_mesh(bench_lobe());
-    SurfaceMesh sm;
+    const cgal::Mesh input = to_surface_mesh(bench_lobe());
+    cgal::Mesh sm;
     for (auto _ : state) {
         sm = input;
         CGAL::Polygon_mesh_processing::isotropic_remeshing(faces(sm), 0.03, sm,

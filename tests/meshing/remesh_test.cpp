@@ -533,7 +533,7 @@ TEST(Repair, ADomeASlitTheCowAndTheBunnyRepairToTheSameMeshWhateverWasRepairedBe
     // after other repairs in the same process: dome-400-edges-folding, whose base is
     // triangulated in its plane and whose folds are then cut out, and
     // slit-247-degrees-searched, whose border runs over itself in its plane and gets the
-    // searched patch (repair_cgal.cpp now does both itself: triangulate_in_plane,
+    // searched patch (hole_filling_cgal.cpp now does both itself: triangulate_in_plane,
     // search_hole_patch). The bunny's holes and the cow's cut go through the search too.
     const std::string cow_path = test::shared_data("data/models/cow.obj");
     if (cow_path.empty()) return;
