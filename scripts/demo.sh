@@ -4,7 +4,8 @@
 # the tree: tree_front.png and tree_side.png (software rendering when there is no GPU).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-./scripts/setup.sh release
+# Only the program and what it needs: the tests and benchmarks are test.sh's.
+./scripts/setup.sh demo
 OUT="${1:-out/demo}"
 ./build/release/app/lobesketch replay recordings/demo.lrec --out "$OUT"
 ./build/release/app/lobesketch render "$OUT/tree.glb" --view front --out "$OUT/tree_front.png"

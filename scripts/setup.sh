@@ -2,21 +2,28 @@
 # Installs the Debian 12 packages Lobesketch needs (only those missing, quietly), the Khronos
 # glTF validator the export tests run (npm, pinned, into build/tools/gltf-validator) and
 # builds the given CMake preset (default: release). Safe to run again and again.
+#
+# The preset `demo` (scripts/demo.sh) installs only what building and running `lobesketch`
+# needs and builds only that program, into build/release: no test frameworks, sanitizer
+# runtimes, Xvfb, Node.js or validator, and none of the tests and benchmarks.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 PRESET="${1:-release}"
 
+# What building and running `lobesketch` needs (the demo).
 PACKAGES=(
   build-essential cmake ninja-build ccache pkg-config git
   nlohmann-json3-dev libcli11-dev libglm-dev libeigen3-dev
-  libgtest-dev libgmock-dev libbenchmark-dev
   libcgal-dev libopenmesh-dev libgmp-dev libmpfr-dev
   libnanoflann-dev libtinygltf-dev libstb-dev
   libvulkan-dev mesa-vulkan-drivers glslc libopenxr-dev libopenxr-loader1
-  clang libclang-rt-14-dev
-  libglfw3-dev libimgui-dev xvfb xauth
+  libglfw3-dev libimgui-dev
 )
+# What the tests, benchmarks, the sanitizer build and the window tests need besides.
+if [ "$PRESET" != "demo" ]; then
+  PACKAGES+=(libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev xvfb xauth)
+fi
 
 missing=()
 for p in "${PACKAGES[@]}"; do
@@ -24,9 +31,11 @@ for p in "${PACKAGES[@]}"; do
     missing+=("$p")
   fi
 done
-# Node.js runs the glTF validator; a node/npm already on PATH (from any source) is kept.
-command -v node >/dev/null || missing+=(nodejs)
-command -v npm >/dev/null || missing+=(npm)
+# Node.js runs the glTF validator (tests only); a node/npm already on PATH (from any source) is kept.
+if [ "$PRESET" != "demo" ]; then
+  command -v node >/dev/null || missing+=(nodejs)
+  command -v npm >/dev/null || missing+=(npm)
+fi
 
 if ((${#missing[@]})); then
   SUDO=""
