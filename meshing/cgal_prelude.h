@@ -32,6 +32,11 @@
 
 #define LOBE_CGAL_HEADERS_END _Pragma("GCC diagnostic pop")
 
+#include <cstddef>
+#include <vector>
+
+#include "core/mesh.h"
+
 LOBE_CGAL_HEADERS_BEGIN
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Surface_mesh/Surface_mesh_fwd.h>
@@ -49,5 +54,14 @@ using Point = Kernel::Point_3;
 using Mesh = CGAL::Surface_mesh<Point>;
 
 namespace PMP = CGAL::Polygon_mesh_processing;
+
+/// A triangle of a polygon soup: indices into its points.
+using Polygon = std::vector<std::size_t>;
+
+/// `in` as a polygon soup, its preconditions checked (repair_cgal.cpp).
+/// \throw InvalidInput ("WHO: vertex with a non-finite coordinate", "WHO: triangle index out
+/// of range").
+void to_polygon_soup(const TriangleMesh& in, const char* who, std::vector<Point>& points,
+                     std::vector<Polygon>& polygons);
 
 } // namespace lobe::cgal

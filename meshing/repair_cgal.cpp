@@ -43,7 +43,7 @@ namespace {
 
 using namespace cgal; // Kernel, Point, Mesh, PMP
 using VertexIndex = Mesh::Vertex_index;
-using Polygon = std::vector<std::size_t>;
+using Polygon = cgal::Polygon;
 using repair_detail::crossing_pairs;
 using repair_detail::fill_holes;
 using repair_detail::to_triangle_mesh;
@@ -83,24 +83,6 @@ std::optional<std::vector<std::array<std::size_t, 2>>> repair_detail::crossing_p
 }
 
 namespace {
-
-/// The input as a polygon soup, with its preconditions checked.
-void to_soup(const TriangleMesh& in, const char* who, std::vector<Point>& points, std::vector<Polygon>& polygons)
-{
-    points.reserve(in.positions.size());
-    for (const glm::vec3& p : in.positions) {
-        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-            throw InvalidInput(std::string(who) + ": vertex with a non-finite coordinate");
-        points.emplace_back(p.x, p.y, p.z);
-    }
-    const auto n = static_cast<long long>(in.positions.size());
-    polygons.reserve(in.triangles.size());
-    for (const auto& t : in.triangles) {
-        for (int v : t)
-            if (v < 0 || v >= n) throw InvalidInput(std::string(who) + ": triangle index out of range");
-        polygons.push_back({static_cast<std::size_t>(t[0]), static_cast<std::size_t>(t[1]), static_cast<std::size_t>(t[2])});
-    }
-}
 
 /// Vertices at exactly the same position (the copies of a split non-manifold vertex) are
 /// moved 1% of the way towards the centroid of their own neighbours, so the surface no
@@ -481,7 +463,7 @@ TriangleMesh repair_mesh(const TriangleMesh& in, RepairReport* report)
     r.input_triangles = in.triangles.size();
     std::vector<Point> points;
     std::vector<Polygon> polygons;
-    to_soup(in, "repair_mesh", points, polygons);
+    cgal::to_polygon_soup(in, "repair_mesh", points, polygons);
 
     // 1. Soup clean-up: repeated vertices in a triangle, duplicate triangles, duplicate and
     //    unused points.
@@ -538,5 +520,24 @@ TriangleMesh repair_mesh(const TriangleMesh& in, RepairReport* report)
     if (report) *report = std::move(r);
     return out;
 }
+
+// One soup reader for repair and the self-intersection checks (cgal_prelude.h).
+void cgal::to_polygon_soup(const TriangleMesh& in, const char* who, std::vector<Point>& points, std::vector<Polygon>& polygons)
+{
+    points.reserve(in.positions.size());
+    for (const glm::vec3& p : in.positions) {
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+            throw InvalidInput(std::string(who) + ": vertex with a non-finite coordinate");
+        points.emplace_back(p.x, p.y, p.z);
+    }
+    const auto n = static_cast<long long>(in.positions.size());
+    polygons.reserve(in.triangles.size());
+    for (const auto& t : in.triangles) {
+        for (int v : t)
+            if (v < 0 || v >= n) throw InvalidInput(std::string(who) + ": triangle index out of range");
+        polygons.push_back({static_cast<std::size_t>(t[0]), static_cast<std::size_t>(t[1]), static_cast<std::size_t>(t[2])});
+    }
+}
+
 
 } // namespace lobe

@@ -29,20 +29,8 @@ using namespace cgal; // Kernel, Point, Mesh, PMP
 Mesh to_surface_mesh(const TriangleMesh& in, const char* who)
 {
     std::vector<Point> points;
-    std::vector<std::vector<std::size_t>> polygons;
-    points.reserve(in.positions.size());
-    for (const glm::vec3& p : in.positions) {
-        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-            throw InvalidInput(std::string(who) + ": vertex with a non-finite coordinate");
-        points.emplace_back(p.x, p.y, p.z);
-    }
-    const auto n = static_cast<long long>(in.positions.size());
-    polygons.reserve(in.triangles.size());
-    for (const auto& t : in.triangles) {
-        for (int v : t)
-            if (v < 0 || v >= n) throw InvalidInput(std::string(who) + ": triangle index out of range");
-        polygons.push_back({static_cast<std::size_t>(t[0]), static_cast<std::size_t>(t[1]), static_cast<std::size_t>(t[2])});
-    }
+    std::vector<Polygon> polygons;
+    to_polygon_soup(in, who, points, polygons);
     if (!PMP::is_polygon_soup_a_polygon_mesh(polygons))
         throw InvalidInput(std::string(who) + ": the mesh is not 2-manifold");
     Mesh mesh;
