@@ -8,6 +8,7 @@
 
 #include "app/desktop/desktop_script.h"
 #include "app/desktop/desktop_session.h"
+#include "app/session/panel_controls.h"
 #include "core/document.h"
 #include "growth/grower.h"
 #include "input/recording.h"
@@ -102,29 +103,38 @@ void draw_desktop_panel(DesktopSession& session, const std::string& session_name
             if (l.id == state.target_lobe) lobe = &l;
         if (!lobe) state.target_lobe = 0;
         const auto send = [&](SettingId id, double v) { session.setting(static_cast<int>(id), state.target_lobe, v); };
+        // Labels and ranges: the panel controls (app/session/panel_controls.h); lengths in cm.
+        const auto control = [](SettingId id) -> const PanelControl& { return *find_panel_control(id); };
+        const PanelControl& split_c = control(SettingId::SplitAngle);
         float split = float(lobe && lobe->split_angle_deg ? *lobe->split_angle_deg : doc.settings.growth.split_angle_deg);
-        ImGui::SliderFloat("split t", &split, 5.0f, 90.0f, "%.0f deg");
+        ImGui::SliderFloat(split_c.label, &split, float(split_c.lo), float(split_c.hi), "%.0f deg");
         if (ImGui::IsItemDeactivatedAfterEdit()) send(SettingId::SplitAngle, split);
         int species = 0;
         const std::string& current = lobe && !lobe->species.empty() ? lobe->species : doc.settings.growth.species;
         for (int i = 0; i < kSettingSpeciesCount; ++i)
             if (current == kSettingSpecies[i]) species = i;
-        if (ImGui::Combo("species", &species, kSettingSpecies, kSettingSpeciesCount)) send(SettingId::Species, species);
+        if (ImGui::Combo(control(SettingId::Species).label, &species, kSettingSpecies, kSettingSpeciesCount))
+            send(SettingId::Species, species);
         if (state.target_lobe == 0) {
             // The attractor spacing is the same for every lobe (one density for the tree).
+            const PanelControl& c = control(SettingId::AttractorSpacing);
             float spacing = float(doc.settings.lobes.edge_length_m * 100.0);
-            ImGui::SliderFloat("spacing", &spacing, 1.0f, 10.0f, "%.1f cm");
+            ImGui::SliderFloat(c.label, &spacing, float(c.lo * 100.0), float(c.hi * 100.0), "%.1f cm");
             if (ImGui::IsItemDeactivatedAfterEdit()) send(SettingId::AttractorSpacing, spacing / 100.0);
         }
         // Leaves and seed: the tree's, or the lobe's own (shown: what the lobe grows with).
+        const PanelControl& leaf_c = control(SettingId::LeafLength);
         float leaf = float((lobe && lobe->leaf_length_m ? *lobe->leaf_length_m : doc.settings.leaves.length_m) * 100.0);
-        ImGui::SliderFloat("leaf size", &leaf, 1.0f, 20.0f, "%.1f cm");
+        ImGui::SliderFloat(leaf_c.label, &leaf, float(leaf_c.lo * 100.0), float(leaf_c.hi * 100.0), "%.1f cm");
         if (ImGui::IsItemDeactivatedAfterEdit()) send(SettingId::LeafLength, leaf / 100.0);
         int leaves = lobe && lobe->leaves_per_node ? *lobe->leaves_per_node : doc.settings.leaves.per_node;
-        ImGui::SliderInt("leaves", &leaves, 0, 16);
+        const PanelControl& leaves_c = control(SettingId::LeavesPerNode);
+        ImGui::SliderInt(leaves_c.label, &leaves, int(leaves_c.lo), int(leaves_c.hi));
         if (ImGui::IsItemDeactivatedAfterEdit()) send(SettingId::LeavesPerNode, leaves);
-        int seed = int(std::min<std::uint64_t>(lobe && lobe->seed ? *lobe->seed : doc.seed, 16777215));
-        if (ImGui::InputInt("seed", &seed, 1, 10) && seed >= 1 && seed < (1 << 24)) send(SettingId::Seed, seed);
+        const PanelControl& seed_c = control(SettingId::Seed);
+        int seed = int(std::min<std::uint64_t>(lobe && lobe->seed ? *lobe->seed : doc.seed, std::uint64_t(seed_c.hi)));
+        if (ImGui::InputInt(seed_c.label, &seed, int(seed_c.step), 10) && seed >= seed_c.lo && seed <= seed_c.hi)
+            send(SettingId::Seed, seed);
     }
     if (ImGui::CollapsingHeader("Import a mesh as a lobe")) {
         // OBJ, PLY or OFF, made on a thread of its own; the lobe appears centred on the

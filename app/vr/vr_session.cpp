@@ -11,6 +11,7 @@
 #include <glm/mat3x3.hpp>
 
 #include "app/export/export_scene.h"
+#include "app/session/panel_controls.h"
 #include "app/render/render_scene.h"
 #include "app/render/scene_parts.h"
 #include "core/errors.h"
@@ -322,22 +323,30 @@ void VrSession::Impl::press(const VrButton& b, int index)
     e.value = 0; // the whole tree
     double v = 0.0;
     switch (b.setting) {
+    // Steps and ranges: the panel controls (app/session/panel_controls.h), as the desktop's
+    // sliders; the leaf size goes by a quarter per press, rounded to the millimetre.
     case kAngleDown:
-    case kAngleUp:
-        e.code = static_cast<int>(SettingId::SplitAngle);
-        v = std::clamp(doc.settings.growth.split_angle_deg + (b.setting == kAngleUp ? 5.0 : -5.0), 5.0, 90.0);
+    case kAngleUp: {
+        const PanelControl& c = *find_panel_control(SettingId::SplitAngle);
+        e.code = static_cast<int>(c.id);
+        v = std::clamp(doc.settings.growth.split_angle_deg + (b.setting == kAngleUp ? c.step : -c.step), c.lo, c.hi);
         break;
+    }
     case kLeafDown:
-    case kLeafUp:
-        e.code = static_cast<int>(SettingId::LeafLength);
-        v = std::clamp(doc.settings.leaves.length_m * (b.setting == kLeafUp ? 1.25 : 0.8), 0.005, 0.5);
+    case kLeafUp: {
+        const PanelControl& c = *find_panel_control(SettingId::LeafLength);
+        e.code = static_cast<int>(c.id);
+        v = std::clamp(doc.settings.leaves.length_m * (b.setting == kLeafUp ? 1.25 : 0.8), c.lo, c.hi);
         v = std::round(v * 1000.0) / 1000.0;
         break;
+    }
     case kLeavesDown:
-    case kLeavesUp:
-        e.code = static_cast<int>(SettingId::LeavesPerNode);
-        v = std::clamp(doc.settings.leaves.per_node + (b.setting == kLeavesUp ? 1 : -1), 0, 16);
+    case kLeavesUp: {
+        const PanelControl& c = *find_panel_control(SettingId::LeavesPerNode);
+        e.code = static_cast<int>(c.id);
+        v = std::clamp(doc.settings.leaves.per_node + (b.setting == kLeavesUp ? c.step : -c.step), c.lo, c.hi);
         break;
+    }
     case kNextSpecies: {
         e.code = static_cast<int>(SettingId::Species);
         int current = 0;
