@@ -1,7 +1,7 @@
 # Writes OUT: the SPIR-V files in FILES ("|"-separated) as 32-bit word tables, looked up by
 # the shader's file name (app/render/embedded_shaders.h), so the program needs no files beside it.
 string(REPLACE "|" ";" FILES "${FILES}")
-set(body "// Generated from app/shaders by embed_spirv.cmake: do not edit.\n#include \"app/render/embedded_shaders.h\"\n\n#include <array>\n\nnamespace lobe {\nnamespace {\n")
+set(body "// Generated from app/render/shaders by embed_spirv.cmake: do not edit.\n#include \"app/render/embedded_shaders.h\"\n\n#include <array>\n\nnamespace lobe {\nnamespace {\n")
 set(table "")
 set(i 0)
 foreach(f ${FILES})
