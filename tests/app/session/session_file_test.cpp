@@ -1,6 +1,8 @@
 // Opening a session for use (app/session/session_file.h): the growers a document names are
 // checked at load, and `--grower` picks the scene's grower.
+#include <filesystem>
 #include <fstream>
+#include <set>
 #include <iterator>
 
 #include <gtest/gtest.h>
@@ -78,6 +80,58 @@ TEST(SessionFile, GrowWithTheDefaultGrowerNamedGivesTheSameTreeAndAnUnknownOneIs
     EXPECT_NE(bad.out.find("--grower"), std::string::npos) << bad.out;
     const test::CliRun help = test::run_cli("grow --help");
     EXPECT_NE(help.out.find(kDefaultGrowerName), std::string::npos) << help.out;
+}
+
+// tests/data/sessions/ holds sessions written by the build before growers, typed edits and the
+// settings table (`replay` and `desktop --script` output): every edit kind, settings in full.
+TEST(SessionFile, SessionsWrittenBeforeGrowersAndTypedEditsLoadUpgradeAndSaveToTheSameBytes)
+{
+    const std::string dir = test::temp_dir("session-file-before");
+    std::size_t files = 0;
+    std::set<EditKind> kinds;
+    for (const std::filesystem::directory_entry& e :
+         std::filesystem::directory_iterator(test::source_path("tests/data/sessions"))) {
+        if (e.path().extension() != ".json") continue;
+        const std::string name = e.path().filename().string();
+        const Document doc = load_session(e.path().string());
+        EXPECT_EQ(scene_grower(doc).name, kDefaultGrowerName) << name; // no grower named: the paper's
+        EXPECT_FALSE(doc.edits.empty()) << name;
+        for (const EditOperation& op : doc.edits) kinds.insert(op.kind());
+        save_document(dir + "/" + name, doc);
+        EXPECT_EQ(bytes(dir + "/" + name), bytes(e.path().string())) << name;
+        ++files;
+    }
+    EXPECT_EQ(files, 2u);
+    EXPECT_EQ(kinds.size(), 5u); // deform, move, rotate and scale a lobe; edit a stroke
+}
+
+TEST(SessionFile, AnOldSessionWithAMalformedEditOrSettingIsRefusedAtLoadNamingTheField)
+{
+    const std::string dir = test::temp_dir("session-file-malformed");
+    const std::string good = bytes(test::source_path("tests/data/sessions/edit-stroke-transform.json"));
+    struct Case {
+        std::string from, to, field;
+    };
+    const std::vector<Case> cases = {
+        {"\"hand\": \"right\"", "\"hand\": \"middle\"", "edits[0].params.hand"},
+        {"\"remesh_iterations\": 4", "\"remesh_iterations\": -3", "settings.lobes.remesh_iterations"},
+    };
+    for (const Case& c : cases) {
+        std::string text = good;
+        const std::size_t at = text.find(c.from);
+        ASSERT_NE(at, std::string::npos) << c.from;
+        text.replace(at, c.from.size(), c.to);
+        const std::string path = dir + "/bad.json";
+        std::ofstream(path, std::ios::binary) << text;
+        try {
+            load_session(path);
+            ADD_FAILURE() << "opened a session with " << c.to;
+        } catch (const FileError& e) {
+            const std::string m = e.what();
+            EXPECT_NE(m.find(c.field), std::string::npos) << m;
+            EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+        }
+    }
 }
 
 InputAction grower_setting(double code, std::int64_t lobe = 0)
