@@ -31,6 +31,8 @@ using detail::SymbolRule;
 
 void Word::push(SymbolId symbol, std::span<const double> values)
 {
+    if (values.size() > kMaxModuleParams)
+        throw InvalidInput("a module with " + std::to_string(values.size()) + " parameters (at most 255)");
     Module m;
     m.symbol = symbol;
     m.param_count = static_cast<std::uint16_t>(values.size());
