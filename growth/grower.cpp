@@ -3,6 +3,7 @@
 #include <array>
 
 #include "core/errors.h"
+#include "growth/selforg/selforg_grower.h"
 #include "growth/subtree_library.h"
 
 namespace lobe {
@@ -38,7 +39,7 @@ public:
 };
 
 const SubtreeGrower kSubtrees;
-const std::array<const Grower*, 1> kGrowers{&kSubtrees};
+const std::array<const Grower*, 2> kGrowers{&kSubtrees, &self_organizing_grower()};
 
 } // namespace
 
