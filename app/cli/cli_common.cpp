@@ -19,6 +19,7 @@
 #include "core/settings_json.h"
 #include "core/settings_table.h"
 #include "growth/grower.h"
+#include "growth/selforg/selforg_grower.h"
 #include "growth/species.h"
 #include "input/pipeline.h"
 #include "app/session/stage_options.h"
@@ -124,7 +125,8 @@ void add_tree_input_options(CLI::App* cmd, TreeInputOptions& o)
     const SettingInfo& spacing = *find_setting("lobes.edge_length_m");
     cmd->add_option("--settings", o.settings, "Settings JSON (a settings object or a session document)");
     cmd->add_option("--species", o.species,
-                    "Species preset: broadleaf, conifer, willow, birch, or a preset .json file");
+                    "Species preset: broadleaf, conifer, willow, birch, or a preset .json file (with the "
+                    "self-organizing grower also its growth preset)");
     std::vector<std::string> names;
     for (const Grower* g : growers()) names.emplace_back(g->name());
     cmd->add_option("--grower", o.grower, "Growth model: " + grower_names() + " (default: the session's, else " +
@@ -148,6 +150,13 @@ void add_tree_input_options(CLI::App* cmd, TreeInputOptions& o)
             },
             "", "setting assignment"));
     cmd->add_option("--seed", o.seed, "Seed of every random choice of growth (default: the session's)");
+    cmd->add_option("--environment", o.environment,
+                    "Self-organizing grower: what buds perceive, markers (space colonization) or shadow")
+        ->check(CLI::IsMember({"markers", "shadow"}));
+    cmd->add_option("--bud-fate", o.bud_fate, "Self-organizing grower: borchert-honda or priority")
+        ->check(CLI::IsMember({"borchert-honda", "priority"}));
+    cmd->add_option("--iterations", o.iterations, "Self-organizing grower: growth iterations (1 to 500)")
+        ->check(CLI::Range(std::int64_t{1}, std::int64_t{500}));
     cmd->add_option("--split-angle", o.split_angle, setting_help(split))->check(setting_value_check(split));
     cmd->add_option("--attractor-spacing", o.spacing, setting_help(spacing))->check(setting_value_check(spacing));
 }
@@ -224,12 +233,26 @@ bool is_mesh_file(const std::string& path)
 void apply_document_options(Document& doc, const TreeInputOptions& o)
 {
     if (o.seed) doc.seed = *o.seed;
+    const std::string selforg(self_organizing_grower().name());
+    GrowerChoice choice;
     if (!o.grower.empty()) {
-        GrowerChoice choice;
         choice.name = o.grower;
         if (const Grower* g = find_grower(o.grower)) choice.version = g->version();
-        set_scene_grower(doc, std::move(choice));
+    } else {
+        choice = scene_grower(doc);
     }
+    const char* only_selforg = o.environment ? "--environment" : o.bud_fate ? "--bud-fate" : o.iterations ? "--iterations" : nullptr;
+    if (only_selforg && choice.name != selforg)
+        throw InvalidInput(std::string(only_selforg) + " is only valid with --grower " + selforg + " (the grower is " +
+                           choice.name + ")");
+    if (choice.name == selforg) {
+        if (o.environment) choice.params["environment"] = *o.environment;
+        if (o.bud_fate) choice.params["bud_fate"] = *o.bud_fate;
+        if (o.iterations) choice.params["iterations"] = *o.iterations;
+        const std::vector<std::string> presets = selforg_species_list();
+        if (std::find(presets.begin(), presets.end(), o.species) != presets.end()) choice.params["species"] = o.species;
+    }
+    if (!o.grower.empty() || choice != scene_grower(doc)) set_scene_grower(doc, std::move(choice));
 }
 
 GrownInput grow_input_tree(const std::string& input, const TreeInputOptions& o)

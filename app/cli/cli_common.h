@@ -44,10 +44,15 @@ struct TreeInputOptions {
     std::optional<std::uint64_t> seed;
     std::optional<double> split_angle, spacing;
     double mesh_size = 1.5; ///< a mesh input's largest side (metres)
+    /// The self-organizing grower's parameters (growth/selforg/selforg_grower.h); only with
+    /// that grower. `--species` also sets its `species` when it names one of its presets.
+    std::optional<std::string> environment, bud_fate;
+    std::optional<std::int64_t> iterations;
 };
 
-/// Registers --settings, --species, --grower, --set, --seed, --split-angle and
-/// --attractor-spacing. The help and range checks of --set, --split-angle and
+/// Registers --settings, --species, --grower, --set, --seed, --split-angle,
+/// --attractor-spacing, and the self-organizing grower's --environment, --bud-fate and
+/// --iterations. The help and range checks of --set, --split-angle and
 /// --attractor-spacing come from the settings table: a bad value is a bad command line (exit
 /// 2) naming the setting.
 void add_tree_input_options(CLI::App* cmd, TreeInputOptions& o);
@@ -64,7 +69,10 @@ SettingsOverlay setting_assignments(const std::vector<std::string>& assignments)
 void apply_tree_input_options(Settings& s, const TreeInputOptions& o);
 
 /// Applies the options that are the document's rather than its settings': --seed and
-/// --grower (the scene's tree grows with that grower and its default parameters).
+/// --grower (the scene's tree grows with that grower and its default parameters, or those
+/// --environment, --bud-fate, --iterations and --species give the self-organizing grower;
+/// without --grower they change the session's self-organizing grower).
+/// \throw InvalidInput (one line) for a self-organizing option with another grower.
 void apply_document_options(Document& doc, const TreeInputOptions& o);
 
 /// The local time as "YYYYMMDD-HHMMSS", for default file names.
