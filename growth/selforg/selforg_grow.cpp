@@ -28,6 +28,9 @@ struct Workspace {
     std::vector<std::int64_t> best_bud; ///< per marker: that bud (2·metamer + lateral), −1 none
     std::vector<std::uint32_t> touched;
     std::vector<int> marker_count_terminal, marker_count_lateral;
+    /// Per bud (2·metamer + lateral): it perceived no marker once, so it never will again
+    /// (markers are only removed and a bud's cone never moves): its query is skipped.
+    std::vector<std::uint8_t> blind;
     std::vector<float> light;
 };
 
@@ -45,17 +48,22 @@ void perceive_markers(const MetamerTree& tree, const SelfOrgRun& run, const Mark
         ws.best_bud.assign(markers.size(), -1);
     }
     ws.touched.clear();
+    ws.blind.resize(2 * n, 0);
     auto consider = [&](std::int64_t bud, const glm::vec3& at, const glm::vec3& axis) {
+        if (ws.blind[static_cast<std::size_t>(bud)]) return;
+        std::size_t seen = 0;
         markers.for_each_within(at, r, [&](std::size_t i) {
             const glm::vec3 d = markers.point(i) - at;
             const float d2 = glm::dot(d, d);
             if (d2 <= 0.0f || glm::dot(d, axis) < cos_half * std::sqrt(d2)) return;
+            ++seen;
             if (ws.best_bud[i] < 0) ws.touched.push_back(static_cast<std::uint32_t>(i));
             if (ws.best_bud[i] < 0 || d2 < ws.best_d2[i]) {
                 ws.best_d2[i] = d2;
                 ws.best_bud[i] = bud;
             }
         });
+        if (seen == 0) ws.blind[static_cast<std::size_t>(bud)] = 1;
     };
     for (std::size_t m = 0; m < n; ++m) {
         const Metamer& mm = tree.metamers[m];
@@ -90,23 +98,30 @@ void perceive_markers(const MetamerTree& tree, const SelfOrgRun& run, const Mark
     }
 }
 
-/// Shadow alone: Q = max(C − s + a, 0) at the bud, V to the least shadowed neighbour voxel
-/// inside the perception cone.
-void perceive_shadow(const MetamerTree& tree, const SelfOrgRun& run, const ShadowGrid& shadow, Workspace& ws)
+/// Shadow alone: Q = max(C − s + a, 0) at the bud.
+void perceive_shadow_light(const MetamerTree& tree, const ShadowGrid& shadow, Workspace& ws)
 {
-    const float cos_half = static_cast<float>(std::cos(0.5 * run.species.perception_angle_deg * kDegToRad));
     for (std::size_t m = 0; m < tree.metamers.size(); ++m) {
         const Metamer& mm = tree.metamers[m];
         if (!mm.alive || !(mm.terminal_bud || mm.lateral_bud)) continue;
         const double q = shadow.light(mm.tip);
-        if (mm.terminal_bud) {
-            ws.q.terminal[m] = q;
+        if (mm.terminal_bud) ws.q.terminal[m] = q;
+        if (mm.lateral_bud) ws.q.lateral[m] = q;
+    }
+}
+
+/// Shadow alone: V towards the least shadowed neighbour voxel inside the perception cone, for
+/// the buds that will grow (v ≥ 1), from the shadow as it was when their light was read.
+void perceive_shadow_direction(const MetamerTree& tree, const SelfOrgRun& run, const ShadowGrid& shadow, Workspace& ws)
+{
+    const float cos_half = static_cast<float>(std::cos(0.5 * run.species.perception_angle_deg * kDegToRad));
+    for (std::size_t m = 0; m < tree.metamers.size(); ++m) {
+        const Metamer& mm = tree.metamers[m];
+        if (!mm.alive) continue;
+        if (mm.terminal_bud && ws.v.terminal[m] >= 1.0)
             ws.opt_terminal[m] = shadow.least_shadowed_direction(mm.tip, mm.dir, cos_half);
-        }
-        if (mm.lateral_bud) {
-            ws.q.lateral[m] = q;
+        if (mm.lateral_bud && ws.v.lateral[m] >= 1.0)
             ws.opt_lateral[m] = shadow.least_shadowed_direction(mm.tip, mm.lateral_dir, cos_half);
-        }
     }
 }
 
@@ -208,13 +223,14 @@ SelfOrgStats grow_metamers(MetamerTree& tree, const SelfOrgRun& run, MarkerCloud
         ws.opt_terminal.assign(n, glm::vec3(0.0f));
         ws.opt_lateral.assign(n, glm::vec3(0.0f));
         if (use_markers) perceive_markers(tree, run, *markers, shadow, ws);
-        else perceive_shadow(tree, run, shadow, ws);
+        else perceive_shadow_light(tree, shadow, ws);
         if (run.bud_fate == BudFate::BorchertHonda) {
             accumulate_light(tree, ws.q, ws.sub);
             distribute_borchert_honda(tree, ws.q, ws.sub, sp.alpha, sp.lambda, ws.into, ws.v);
         } else {
             distribute_priority(tree, ws.q, sp.alpha, sp.priority_w_max, sp.priority_w_min, sp.priority_kappa, ws.v);
         }
+        if (!use_markers) perceive_shadow_direction(tree, run, shadow, ws);
         std::size_t grown = 0;
         for (std::size_t m = 0; m < n && !stats.metamer_cap; ++m) {
             if (!tree.metamers[m].alive) continue;

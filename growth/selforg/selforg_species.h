@@ -31,7 +31,7 @@ struct SelfOrgSpecies {
     double occupancy_radius = 2.0;      ///< ρ: markers this close to a new node are removed
     double perception_radius = 4.0;     ///< r: a bud sees markers up to this distance
     double perception_angle_deg = 90.0; ///< θ: full opening angle of a bud's perception cone
-    double marker_spacing = 1.0;        ///< markers lie on a jittered grid of this spacing
+    double marker_spacing = 1.5;        ///< markers lie on a jittered grid of this spacing
     double shadow_a = 0.1;              ///< a: shadow a bud adds to its own voxel
     double shadow_b = 1.75;             ///< b: Δs = a·b^(−q) q voxels below
     int shadow_q_max = 6;               ///< q_max: depth of the shadow pyramid
