@@ -65,24 +65,25 @@ MarkerCloud::MarkerCloud(std::vector<glm::vec3> points, double cell_m) : points_
     nz_ = n.z;
     const std::size_t cells = static_cast<std::size_t>(nx_) * static_cast<std::size_t>(ny_) * static_cast<std::size_t>(nz_);
     cell_.resize(points_.size());
-    cell_start_.assign(cells + 1, 0);
+    std::vector<std::uint32_t> start(cells + 1, 0);
     for (std::size_t i = 0; i < points_.size(); ++i) {
         int x, y, z;
         cell_of(points_[i], x, y, z);
         cell_[i] = static_cast<std::uint32_t>((static_cast<std::size_t>(z) * static_cast<std::size_t>(ny_) +
                                                static_cast<std::size_t>(y)) * static_cast<std::size_t>(nx_) +
                                               static_cast<std::size_t>(x));
-        ++cell_start_[cell_[i] + 1];
+        ++start[cell_[i] + 1];
     }
-    for (std::size_t c = 0; c < cells; ++c) cell_start_[c + 1] += cell_start_[c];
-    cell_live_.resize(cells);
-    for (std::size_t c = 0; c < cells; ++c) cell_live_[c] = cell_start_[c + 1] - cell_start_[c];
+    for (std::size_t c = 0; c < cells; ++c) start[c + 1] += start[c];
+    cells_.resize(cells);
+    for (std::size_t c = 0; c < cells; ++c) cells_[c] = {start[c], start[c + 1] - start[c]};
     order_.resize(points_.size());
     where_.resize(points_.size());
-    std::vector<std::uint32_t> fill(cell_start_.begin(), cell_start_.end() - 1);
+    slot_point_.resize(points_.size());
     for (std::size_t i = 0; i < points_.size(); ++i) {
-        where_[i] = fill[cell_[i]]++;
+        where_[i] = start[cell_[i]]++;
         order_[where_[i]] = static_cast<std::uint32_t>(i);
+        slot_point_[where_[i]] = points_[i];
     }
 }
 
@@ -97,10 +98,11 @@ void MarkerCloud::cell_of(const glm::vec3& p, int& x, int& y, int& z) const
 void MarkerCloud::remove(std::size_t i)
 {
     // Swap the marker with the last live one of its cell, and shorten the live part.
-    const std::uint32_t c = cell_[i];
-    const std::uint32_t last = cell_start_[c] + --cell_live_[c];
+    Cell& cell = cells_[cell_[i]];
+    const std::uint32_t last = cell.start + --cell.live;
     const std::uint32_t other = order_[last];
     std::swap(order_[where_[i]], order_[last]);
+    std::swap(slot_point_[where_[i]], slot_point_[last]);
     where_[other] = where_[i];
     where_[i] = last;
     alive_[i] = 0;

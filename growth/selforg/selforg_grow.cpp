@@ -49,27 +49,34 @@ void perceive_markers(const MetamerTree& tree, const SelfOrgRun& run, const Mark
     }
     ws.touched.clear();
     ws.blind.resize(2 * n, 0);
-    auto consider = [&](std::int64_t bud, const glm::vec3& at, const glm::vec3& axis) {
-        if (ws.blind[static_cast<std::size_t>(bud)]) return;
-        std::size_t seen = 0;
-        markers.for_each_within(at, r, [&](std::size_t i) {
-            const glm::vec3 d = markers.point(i) - at;
-            const float d2 = glm::dot(d, d);
-            if (d2 <= 0.0f || glm::dot(d, axis) < cos_half * std::sqrt(d2)) return;
-            ++seen;
-            if (ws.best_bud[i] < 0) ws.touched.push_back(static_cast<std::uint32_t>(i));
-            if (ws.best_bud[i] < 0 || d2 < ws.best_d2[i]) {
-                ws.best_d2[i] = d2;
-                ws.best_bud[i] = bud;
-            }
-        });
-        if (seen == 0) ws.blind[static_cast<std::size_t>(bud)] = 1;
-    };
     for (std::size_t m = 0; m < n; ++m) {
         const Metamer& mm = tree.metamers[m];
         if (!mm.alive) continue;
-        if (mm.terminal_bud) consider(static_cast<std::int64_t>(2 * m), mm.tip, mm.dir);
-        if (mm.lateral_bud) consider(static_cast<std::int64_t>(2 * m + 1), mm.tip, mm.lateral_dir);
+        // The node's buds that still see markers: terminal (id 2m) before lateral (2m + 1).
+        glm::vec3 axes[2];
+        std::int64_t ids[2];
+        std::size_t seen[2] = {0, 0};
+        std::size_t count = 0;
+        if (mm.terminal_bud && !ws.blind[2 * m]) {
+            axes[count] = mm.dir;
+            ids[count++] = static_cast<std::int64_t>(2 * m);
+        }
+        if (mm.lateral_bud && !ws.blind[2 * m + 1]) {
+            axes[count] = mm.lateral_dir;
+            ids[count++] = static_cast<std::int64_t>(2 * m + 1);
+        }
+        if (count == 0) continue;
+        markers.for_each_in_cones(mm.tip, r, std::span<const glm::vec3>(axes, count), cos_half,
+                                  [&](std::size_t i, float d2, std::size_t cone) {
+                                      ++seen[cone];
+                                      if (ws.best_bud[i] < 0) ws.touched.push_back(static_cast<std::uint32_t>(i));
+                                      if (ws.best_bud[i] < 0 || d2 < ws.best_d2[i]) {
+                                          ws.best_d2[i] = d2;
+                                          ws.best_bud[i] = ids[cone];
+                                      }
+                                  });
+        for (std::size_t k = 0; k < count; ++k)
+            if (seen[k] == 0) ws.blind[static_cast<std::size_t>(ids[k])] = 1;
     }
     ws.marker_count_terminal.assign(n, 0);
     ws.marker_count_lateral.assign(n, 0);
@@ -169,9 +176,15 @@ std::size_t grow_shoot(MetamerTree& tree, std::size_t m, bool lateral, double v,
             dir = shoot_direction(dir, j, glm::vec3(0.0f), sp.jitter, 0.0);
         }
         const glm::vec3 tip = base + dir * length;
-        if (run.confine && !inside_any(*run.confine, lobe, tip, lobe)) {
-            stopped = true;
-            break;
+        if (run.confine) {
+            // A base known inside lobe `lobe` (a grown metamer's tip): the tip is inside too
+            // when the internode crosses no surface of it; else the full parity test.
+            const bool base_inside = (k > 0 || !tree.metamers[m].fixed) && lobe >= 0;
+            const bool stays = base_inside && (*run.confine)[static_cast<std::size_t>(lobe)].first_hit(base, dir, length) < 0.0f;
+            if (!stays && !inside_any(*run.confine, lobe, tip, lobe)) {
+                stopped = true;
+                break;
+            }
         }
         Metamer nm;
         nm.base = base;

@@ -156,7 +156,7 @@ GrowthResult grow_in_lobes(const GrowerInput& in, SelfOrgRun run, const SelfOrgC
             points.insert(points.end(), p.begin(), p.end());
             marker_end.push_back(points.size());
         }
-    MarkerCloud cloud(std::move(points), 0.5 * run.species.perception_radius * run.internode_m);
+    MarkerCloud cloud(std::move(points), run.species.perception_radius * run.internode_m);
     MarkerCloud* markers = run.environment == SelfOrgEnvironment::Markers ? &cloud : nullptr;
     MetamerTree tree = skeleton_metamers(sk, rays, run, markers, shadow);
     run.confine = &rays;
@@ -192,7 +192,7 @@ GrowthResult grow_free(const GrowerInput& in, SelfOrgRun run, const SelfOrgChoic
     std::vector<glm::vec3> points;
     if (run.environment == SelfOrgEnvironment::Markers)
         points = markers_in_sphere(centre, sp.crown_radius * run.internode_m, sp.marker_spacing * run.internode_m, run.seed);
-    MarkerCloud cloud(std::move(points), 0.5 * sp.perception_radius * run.internode_m);
+    MarkerCloud cloud(std::move(points), sp.perception_radius * run.internode_m);
     MarkerCloud* markers = run.environment == SelfOrgEnvironment::Markers ? &cloud : nullptr;
     const std::vector<MeshRaycaster> no_lobes;
     MetamerTree tree = skeleton_metamers(sk, no_lobes, run, markers, shadow);

@@ -66,7 +66,7 @@ void BM_SelfOrgRegrowInLobe(benchmark::State& state)
     in.lobes.push_back(l);
     in.choice.name = "self-organizing";
     in.choice.params["environment"] = std::string(state.range(0) ? "shadow" : "markers");
-    in.choice.params["internode_m"] = state.range(0) ? 0.012 : 0.011;
+    in.choice.params["internode_m"] = state.range(0) ? 0.009 : 0.0105;
     std::size_t nodes = 0;
     for (auto _ : state) {
         const GrowthResult r = self_organizing_grower().grow(in);
