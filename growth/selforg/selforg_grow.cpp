@@ -32,6 +32,7 @@ struct Workspace {
     /// (markers are only removed and a bud's cone never moves): its query is skipped.
     std::vector<std::uint8_t> blind;
     std::vector<float> light;
+    std::vector<char> was_alive;
 };
 
 /// Markers: each live marker in a bud's cone (r, θ) goes to its nearest such bud; a bud with
@@ -220,52 +221,88 @@ glm::vec3 lateral_bud_direction(const glm::vec3& dir, float phi, double angle_ra
     return glm::normalize(static_cast<float>(std::cos(angle_rad)) * dir + static_cast<float>(std::sin(angle_rad)) * radial);
 }
 
-SelfOrgStats grow_metamers(MetamerTree& tree, const SelfOrgRun& run, MarkerCloud* markers, ShadowGrid& shadow)
+namespace {
+
+void check_run(const SelfOrgRun& run, const MarkerCloud* markers)
 {
     if (!(run.internode_m > 0.0) || !std::isfinite(run.internode_m))
         throw InvalidInput("self-organizing: the internode length must be > 0");
     if (run.iterations < 0) throw InvalidInput("self-organizing: iterations must be ≥ 0");
+    if (run.environment == SelfOrgEnvironment::Markers && !markers)
+        throw InvalidInput("self-organizing: the markers environment needs markers");
+}
+
+/// One iteration on one tree: perception, bud fate, new shoots, shedding. Returns the
+/// metamers made.
+std::size_t grow_iteration(MetamerTree& tree, const SelfOrgRun& run, MarkerCloud* markers, ShadowGrid& shadow,
+                           Workspace& ws, SelfOrgStats& stats)
+{
     const bool use_markers = run.environment == SelfOrgEnvironment::Markers;
-    if (use_markers && !markers) throw InvalidInput("self-organizing: the markers environment needs markers");
     const SelfOrgSpecies& sp = run.species;
+    const std::size_t n = tree.metamers.size();
+    ws.q.assign(n);
+    ws.opt_terminal.assign(n, glm::vec3(0.0f));
+    ws.opt_lateral.assign(n, glm::vec3(0.0f));
+    if (use_markers) perceive_markers(tree, run, *markers, shadow, ws);
+    else perceive_shadow_light(tree, shadow, ws);
+    if (run.bud_fate == BudFate::BorchertHonda) {
+        accumulate_light(tree, ws.q, ws.sub);
+        distribute_borchert_honda(tree, ws.q, ws.sub, sp.alpha, sp.lambda, ws.into, ws.v);
+    } else {
+        distribute_priority(tree, ws.q, sp.alpha, sp.priority_w_max, sp.priority_w_min, sp.priority_kappa, ws.v);
+    }
+    if (!use_markers) perceive_shadow_direction(tree, run, shadow, ws);
+    std::size_t grown = 0;
+    for (std::size_t m = 0; m < n && !stats.metamer_cap; ++m) {
+        if (!tree.metamers[m].alive) continue;
+        if (tree.metamers[m].terminal_bud && ws.v.terminal[m] >= 1.0)
+            grown += grow_shoot(tree, m, false, ws.v.terminal[m], ws.opt_terminal[m], run, markers, shadow, stats);
+        if (tree.metamers[m].lateral_bud && ws.v.lateral[m] >= 1.0)
+            grown += grow_shoot(tree, m, true, ws.v.lateral[m], ws.opt_lateral[m], run, markers, shadow, stats);
+    }
+    stats.grown += grown;
+    ++stats.iterations;
+    ws.light.resize(tree.metamers.size());
+    for (std::size_t m = 0; m < tree.metamers.size(); ++m)
+        ws.light[m] = tree.metamers[m].alive ? shadow.light(tree.metamers[m].tip) : 0.0f;
+    ws.was_alive.resize(tree.metamers.size());
+    for (std::size_t m = 0; m < tree.metamers.size(); ++m) ws.was_alive[m] = tree.metamers[m].alive;
+    shed_starved(tree, ws.light, sp.shed_threshold, sp.shed_min_internodes);
+    for (std::size_t m = 0; m < tree.metamers.size(); ++m)
+        if (ws.was_alive[m] && !tree.metamers[m].alive) {
+            shadow.cast(tree.metamers[m].tip, -1);
+            ++stats.shed;
+        }
+    return grown;
+}
+
+} // namespace
+
+SelfOrgStats grow_metamers(MetamerTree& tree, const SelfOrgRun& run, MarkerCloud* markers, ShadowGrid& shadow)
+{
+    check_run(run, markers);
     SelfOrgStats stats;
     Workspace ws;
+    for (int it = 0; it < run.iterations; ++it)
+        if (grow_iteration(tree, run, markers, shadow, ws, stats) == 0 || stats.metamer_cap) break;
+    return stats;
+}
+
+std::vector<SelfOrgStats> grow_metamer_trees(std::span<MetamerTree> trees, const SelfOrgRun& run, MarkerCloud* markers,
+                                             ShadowGrid& shadow)
+{
+    check_run(run, markers);
+    std::vector<SelfOrgStats> stats(trees.size());
+    std::vector<Workspace> ws(trees.size());
+    std::vector<char> done(trees.size(), 0);
     for (int it = 0; it < run.iterations; ++it) {
-        const std::size_t n = tree.metamers.size();
-        ws.q.assign(n);
-        ws.opt_terminal.assign(n, glm::vec3(0.0f));
-        ws.opt_lateral.assign(n, glm::vec3(0.0f));
-        if (use_markers) perceive_markers(tree, run, *markers, shadow, ws);
-        else perceive_shadow_light(tree, shadow, ws);
-        if (run.bud_fate == BudFate::BorchertHonda) {
-            accumulate_light(tree, ws.q, ws.sub);
-            distribute_borchert_honda(tree, ws.q, ws.sub, sp.alpha, sp.lambda, ws.into, ws.v);
-        } else {
-            distribute_priority(tree, ws.q, sp.alpha, sp.priority_w_max, sp.priority_w_min, sp.priority_kappa, ws.v);
+        bool any = false;
+        for (std::size_t t = 0; t < trees.size(); ++t) {
+            if (done[t]) continue;
+            if (grow_iteration(trees[t], run, markers, shadow, ws[t], stats[t]) == 0 || stats[t].metamer_cap) done[t] = 1;
+            any = true;
         }
-        if (!use_markers) perceive_shadow_direction(tree, run, shadow, ws);
-        std::size_t grown = 0;
-        for (std::size_t m = 0; m < n && !stats.metamer_cap; ++m) {
-            if (!tree.metamers[m].alive) continue;
-            if (tree.metamers[m].terminal_bud && ws.v.terminal[m] >= 1.0)
-                grown += grow_shoot(tree, m, false, ws.v.terminal[m], ws.opt_terminal[m], run, markers, shadow, stats);
-            if (tree.metamers[m].lateral_bud && ws.v.lateral[m] >= 1.0)
-                grown += grow_shoot(tree, m, true, ws.v.lateral[m], ws.opt_lateral[m], run, markers, shadow, stats);
-        }
-        stats.grown += grown;
-        ++stats.iterations;
-        ws.light.resize(tree.metamers.size());
-        for (std::size_t m = 0; m < tree.metamers.size(); ++m)
-            ws.light[m] = tree.metamers[m].alive ? shadow.light(tree.metamers[m].tip) : 0.0f;
-        std::vector<bool> was_alive(tree.metamers.size());
-        for (std::size_t m = 0; m < tree.metamers.size(); ++m) was_alive[m] = tree.metamers[m].alive;
-        shed_starved(tree, ws.light, sp.shed_threshold, sp.shed_min_internodes);
-        for (std::size_t m = 0; m < tree.metamers.size(); ++m)
-            if (was_alive[m] && !tree.metamers[m].alive) {
-                shadow.cast(tree.metamers[m].tip, -1);
-                ++stats.shed;
-            }
-        if (grown == 0 || stats.metamer_cap) break;
+        if (!any) break;
     }
     return stats;
 }

@@ -123,4 +123,10 @@ struct SelfOrgStats {
 /// shadow. The tree's existing metamers must already have cast theirs.
 SelfOrgStats grow_metamers(MetamerTree& tree, const SelfOrgRun& run, MarkerCloud* markers, ShadowGrid& shadow);
 
+/// Several trees in one environment (a stand): each iteration grows every tree in turn, so
+/// they compete for the same markers and shade each other through the same grid. Each tree
+/// stops on its own (no bud grew, or max_metamers). Returns the stats of each.
+std::vector<SelfOrgStats> grow_metamer_trees(std::span<MetamerTree> trees, const SelfOrgRun& run, MarkerCloud* markers,
+                                             ShadowGrid& shadow);
+
 } // namespace lobe

@@ -261,6 +261,60 @@ TEST(SelfOrganizingShoots, TropismBendsShootsTowardsIt)
     EXPECT_GT(mean_x(bent), 0.4);
 }
 
+MetamerTree seedling(float x)
+{
+    MetamerTree tree;
+    tree.root = glm::vec3(x, 0.0f, 0.0f);
+    Metamer m;
+    m.base = tree.root;
+    m.tip = tree.root + glm::vec3(0.0f, 1.0f, 0.0f);
+    m.terminal_bud = true;
+    m.fixed = true;
+    tree.add(m, false);
+    return tree;
+}
+
+/// Mean x of a tree's live tips, relative to its root.
+double lean_x(const MetamerTree& t)
+{
+    double s = 0.0;
+    std::size_t n = 0;
+    for (const Metamer& m : t.metamers)
+        if (m.alive) {
+            s += m.tip.x - t.root.x;
+            ++n;
+        }
+    return s / static_cast<double>(n);
+}
+
+TEST(SelfOrganizingShadow, TwoTreesSideBySideShadeEachOtherAndLeanApart)
+{
+    SelfOrgRun run;
+    run.species = selforg_species("broadleaf");
+    run.environment = SelfOrgEnvironment::Shadow;
+    run.iterations = 16;
+    run.internode_m = 1.0;
+    const ShadowParams sp{run.species.shadow_a, run.species.shadow_b, run.species.shadow_q_max, run.species.light_c};
+    const glm::vec3 lo(-40.0f, -1.0f, -40.0f), hi(40.0f, 60.0f, 40.0f);
+    // Alone: each tree on its own grid.
+    std::vector<double> alone;
+    for (float x : {-4.0f, 4.0f}) {
+        ShadowGrid g(lo, hi, 1.0, sp);
+        MetamerTree t = seedling(x);
+        g.cast(t.metamers[0].tip);
+        grow_metamers(t, run, nullptr, g);
+        alone.push_back(lean_x(t));
+    }
+    // Together: one grid, 8 internodes apart.
+    ShadowGrid g(lo, hi, 1.0, sp);
+    std::vector<MetamerTree> pair{seedling(-4.0f), seedling(4.0f)};
+    for (const MetamerTree& t : pair) g.cast(t.metamers[0].tip);
+    grow_metamer_trees(pair, run, nullptr, g);
+    ASSERT_GT(pair[0].metamers.size(), 300u);
+    EXPECT_LT(lean_x(pair[0]), alone[0] - 0.5) << alone[0];
+    EXPECT_GT(lean_x(pair[1]), alone[1] + 0.5) << alone[1];
+}
+
 GrowerInput lobe_input(std::uint64_t seed)
 {
     GrowerInput in;
