@@ -4,13 +4,17 @@
 #include <memory>
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 #include "app/session/session_file.h"
 #include "app/cli/cli.h"
 #include "app/cli/cli_common.h"
 #include "app/export/tree_output.h"
+#include "app/export/export_scene.h"
 #include "app/session/tree_pipeline.h"
+#include "core/atomic_file.h"
 #include "core/errors.h"
+#include "growth/wood.h"
 
 namespace lobe::cli {
 
@@ -18,7 +22,7 @@ namespace {
 
 struct TreeArgs {
     TreeInputOptions in;
-    std::string input, out, lod = "all";
+    std::string input, out, lod = "all", report;
     double height = 0.0;
     bool lobes = false, strokes = false;
 };
@@ -31,6 +35,31 @@ void add_tree_options(CLI::App* cmd, TreeArgs& a)
         ->check(CLI::Range(0.0, 1000.0));
     cmd->add_flag("--lobes", a.lobes, "Also write the lobes as extra nodes");
     cmd->add_flag("--strokes", a.strokes, "Also write the strokes as extra nodes");
+    cmd->add_option("--report", a.report,
+                    "Write the tree's wood volume, dry biomass, carbon and CO2 as JSON (docs/wood-and-co2.md)");
+}
+
+/// The wood report as JSON: the tree as grown, and scaled to --height when given.
+std::string wood_report(const TreeArgs& a, const Document& doc, const BuiltTree& tree, const TreeGeometry& geometry)
+{
+    const double density = basic_wood_density(doc.settings.growth.species);
+    auto fields = [](const WoodEstimate& e) {
+        return nlohmann::json{{"wood_volume_m3", e.wood_volume_m3},
+                              {"dry_biomass_kg", e.dry_biomass_kg},
+                              {"carbon_kg", e.carbon_kg},
+                              {"co2_kg", e.co2_kg},
+                              {"density_kg_m3", e.density_kg_m3}};
+    };
+    nlohmann::json j = fields(estimate_wood(tree.growth.tree, density));
+    j["species"] = doc.settings.growth.species;
+    if (a.height > 0.0) {
+        const double height = tree_height(geometry, tree.growth.tree.nodes[0].position);
+        if (!(height > 1e-9)) throw InvalidInput("--report: the tree has no height above its base to scale");
+        nlohmann::json at = fields(estimate_wood(tree.growth.tree, density, a.height / height));
+        at["height_m"] = a.height;
+        j["at_height"] = std::move(at);
+    }
+    return j.dump(2) + "\n";
 }
 
 void report_and_write(const TreeArgs& a, const Document& doc, const BuiltTree& tree, const std::string& input,
@@ -51,6 +80,10 @@ void report_and_write(const TreeArgs& a, const Document& doc, const BuiltTree& t
     options.include_lobes = a.lobes;
     options.include_strokes = a.strokes;
     write_tree_file(a.out, doc, tree, geometry, options);
+    if (!a.report.empty()) {
+        write_file_atomic(a.report, wood_report(a, doc, tree, geometry));
+        progress("wrote " + a.report);
+    }
     std::size_t attractors = 0, reached = 0;
     for (const LobeGrowthStats& l : tree.growth.lobes) {
         attractors += l.attractors;

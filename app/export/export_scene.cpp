@@ -64,9 +64,8 @@ std::vector<int> chosen_lods(const TreeGeometry& tree, const std::vector<int>& r
     return lods;
 }
 
-/// Height of the tallest vertex of LOD0 (the tree itself; coarser LODs' larger leaves may
-/// reach a little higher) above the base, so that exporting any subset of LODs scales
-/// exactly like exporting all of them.
+} // namespace
+
 double tree_height(const TreeGeometry& tree, const glm::vec3& base)
 {
     double top = -std::numeric_limits<double>::infinity();
@@ -75,6 +74,8 @@ double tree_height(const TreeGeometry& tree, const glm::vec3& base)
         for (const glm::vec3& p : g->positions) top = std::max(top, double(p.y) - double(base.y));
     return top;
 }
+
+namespace {
 
 glm::vec3 to_export(const glm::vec3& p, const glm::vec3& base, float scale) { return (p - base) * scale; }
 

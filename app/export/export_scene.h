@@ -76,6 +76,11 @@ struct PreparedExport {
     bool has_branches() const;
 };
 
+/// Height of the tallest vertex of LOD0 (the tree itself; coarser LODs' larger leaves may
+/// reach a little higher) above `base`, so that exporting any subset of LODs scales exactly
+/// like exporting all of them: a target height h scales by h / tree_height. −∞ with no LOD.
+double tree_height(const TreeGeometry& tree, const glm::vec3& base);
+
 /// Checks `scene` and `options` and transforms the geometry: x' = (x − base) · scale.
 /// \throw InvalidInput (one line) for a missing tree, a bad name, an unknown or repeated LOD
 /// index, a non-finite or negative target height, a tree with no height to scale, array

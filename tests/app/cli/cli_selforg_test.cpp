@@ -1,8 +1,10 @@
-// `lobesketch grow --grower self-organizing` and its options (app/cli/cli_common.h).
+// `lobesketch grow --grower self-organizing` and its options (app/cli/cli_common.h), and the
+// wood report (`--report`, growth/wood.h) every grower writes.
 #include <fstream>
 #include <iterator>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "tests/support/cli_run.h"
 #include "tests/support/test_paths.h"
@@ -45,6 +47,44 @@ TEST(SelfOrganizingCli, ItsOptionsWithAnotherGrowerOrBadValuesAreRefusedInOneLin
     for (const char* opt : {"--environment sun", "--bud-fate random", "--iterations 0", "--iterations 501"}) {
         const test::CliRun r = test::run_cli("grow " + rec + " --grower self-organizing " + opt + " --out " + out + "/a.glb");
         EXPECT_EQ(r.code, 2) << opt << ": " << r.out;
+    }
+}
+
+} // namespace
+} // namespace lobe
+
+namespace lobe {
+namespace {
+
+TEST(WoodReportCli, EveryGrowerWritesTheWoodReportAndHeightScalesItByTheCube)
+{
+    const std::string out = test::temp_dir("wood-report-cli");
+    const std::string rec = test::source_path("recordings/table1-1lobe-5strokes.lrec");
+    for (const char* grower : {"subtrees", "self-organizing"}) {
+        const std::string base = out + "/" + grower;
+        const test::CliRun plain =
+            test::run_cli("grow " + rec + " --grower " + grower + " --out " + base + ".glb --report " + base + ".json");
+        ASSERT_EQ(plain.code, 0) << plain.out;
+        const nlohmann::json r = nlohmann::json::parse(bytes(base + ".json"));
+        for (const char* key : {"wood_volume_m3", "dry_biomass_kg", "carbon_kg", "co2_kg", "density_kg_m3"})
+            ASSERT_TRUE(r.contains(key)) << grower << " " << key;
+        EXPECT_FALSE(r.contains("at_height"));
+        const double v = r["wood_volume_m3"].get<double>();
+        EXPECT_GT(v, 0.0) << grower;
+        EXPECT_NEAR(r["dry_biomass_kg"].get<double>(), v * r["density_kg_m3"].get<double>(), 1e-9);
+        EXPECT_NEAR(r["carbon_kg"].get<double>(), 0.5 * r["dry_biomass_kg"].get<double>(), 1e-9);
+        EXPECT_NEAR(r["co2_kg"].get<double>(), r["carbon_kg"].get<double>() * 44.0 / 12.0, 1e-9);
+
+        const test::CliRun tall = test::run_cli("grow " + rec + " --grower " + grower + " --height 12 --out " + base +
+                                                "-12.glb --report " + base + "-12.json");
+        ASSERT_EQ(tall.code, 0) << tall.out;
+        const nlohmann::json t = nlohmann::json::parse(bytes(base + "-12.json"));
+        ASSERT_TRUE(t.contains("at_height")) << grower;
+        EXPECT_EQ(t["wood_volume_m3"].get<double>(), v); // the tree as grown is the same
+        const double ratio = t["at_height"]["wood_volume_m3"].get<double>() / v;
+        EXPECT_GT(ratio, 1.0) << grower; // sketches are about 1.5 m tall
+        EXPECT_NEAR(t["at_height"]["co2_kg"].get<double>(), ratio * r["co2_kg"].get<double>(),
+                    1e-9 * ratio * r["co2_kg"].get<double>());
     }
 }
 
