@@ -50,8 +50,9 @@ double mesh_volume(const TriangleMesh& mesh)
     return std::abs(six_v) / 6.0;
 }
 
-/// The sketched skeleton as fixed metamers; those inside a lobe carry an axillary bud, its
-/// tips a terminal bud. Every metamer casts shadow and clears the markers around it.
+/// The sketched skeleton as fixed metamers; those inside a lobe carry an axillary bud at right
+/// angles to the skeleton (the preset's branch angle tilts them up and left the lower half of
+/// the lobes bare), its tips a terminal bud. Every metamer casts shadow and clears the markers around it.
 MetamerTree skeleton_metamers(const Skeleton& sk, const std::vector<MeshRaycaster>& rays, const SelfOrgRun& run,
                               MarkerCloud* markers, ShadowGrid& shadow)
 {
@@ -60,7 +61,7 @@ MetamerTree skeleton_metamers(const Skeleton& sk, const std::vector<MeshRaycaste
     tree.root = nodes.empty() ? glm::vec3(0.0f) : nodes[0].position;
     std::vector<char> has_child(nodes.size(), 0);
     for (std::size_t i = 1; i < nodes.size(); ++i) has_child[static_cast<std::size_t>(nodes[i].parent)] = 1;
-    const double angle = run.species.branch_angle_deg * std::numbers::pi / 180.0;
+    const double angle = 0.5 * std::numbers::pi;
     for (std::size_t i = 1; i < nodes.size(); ++i) {
         Metamer m;
         m.base = nodes[static_cast<std::size_t>(nodes[i].parent)].position;

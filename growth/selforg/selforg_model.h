@@ -80,8 +80,8 @@ void distribute_borchert_honda(const MetamerTree& tree, const BudValues& q, cons
 void distribute_priority(const MetamerTree& tree, const BudValues& q, double alpha, double w_max, double w_min,
                          double kappa, BudValues& v);
 
-/// Shoot direction (Palubicki §4.3): normalise(default + ξ·optimal + η·tropism); `fallback`
-/// when that sum vanishes. All unit or zero.
+/// Shoot direction (Palubicki §4.3): normalise(default + ξ·optimal + η·tropism);
+/// `default_dir` when that sum vanishes. Directions unit (optimal may be zero: none).
 glm::vec3 shoot_direction(const glm::vec3& default_dir, const glm::vec3& optimal, const glm::vec3& tropism, double xi,
                           double eta);
 
