@@ -1,11 +1,16 @@
 // `lobesketch grow --grower self-organizing` and its options (app/cli/cli_common.h), and the
 // wood report (`--report`, growth/wood.h) every grower writes.
 #include <fstream>
+#include <string>
+#include <variant>
 #include <iterator>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "app/cli/cli_common.h"
+#include "core/document.h"
+#include "core/errors.h"
 #include "tests/support/cli_run.h"
 #include "tests/support/test_paths.h"
 
@@ -32,6 +37,34 @@ TEST(SelfOrganizingCli, GrowsWithEveryOptionAndTheSameSeedWritesTheSameBytes)
     const test::CliRun markers = test::run_cli("grow " + rec + " --grower self-organizing --out " + out + "/c.glb");
     ASSERT_EQ(markers.code, 0) << markers.out;
     EXPECT_NE(bytes(out + "/a.glb"), bytes(out + "/c.glb"));
+}
+
+TEST(SelfOrganizingCli, TheOptionsBecomeTheGrowersParametersAndASpeciesPresetNameIsOneOfThem)
+{
+    cli::TreeInputOptions o;
+    o.grower = "self-organizing";
+    o.environment = "shadow";
+    o.bud_fate = "priority";
+    o.iterations = 9;
+    o.species = "birch";
+    Document doc;
+    cli::apply_document_options(doc, o);
+    const GrowerChoice& c = scene_grower(doc);
+    EXPECT_EQ(c.name, "self-organizing");
+    EXPECT_EQ(std::get<std::string>(c.params.at("environment")), "shadow");
+    EXPECT_EQ(std::get<std::string>(c.params.at("bud_fate")), "priority");
+    EXPECT_EQ(std::get<std::int64_t>(c.params.at("iterations")), 9);
+    EXPECT_EQ(std::get<std::string>(c.params.at("species")), "birch");
+    // Without --grower, the options change a session already growing self-organizing; a
+    // preset file sets only the appearance.
+    cli::TreeInputOptions later;
+    later.iterations = 30;
+    later.species = "my-preset.json";
+    cli::apply_document_options(doc, later);
+    EXPECT_EQ(std::get<std::int64_t>(scene_grower(doc).params.at("iterations")), 30);
+    EXPECT_EQ(std::get<std::string>(scene_grower(doc).params.at("species")), "birch");
+    Document other;
+    EXPECT_THROW(cli::apply_document_options(other, later), InvalidInput);
 }
 
 TEST(SelfOrganizingCli, ItsOptionsWithAnotherGrowerOrBadValuesAreRefusedInOneLine)
