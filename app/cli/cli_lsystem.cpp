@@ -1,5 +1,5 @@
 // `lobesketch lsystem FILE.l --out tree.glb`: a tree from an L-system in cpfg's language
-// (growth/lsystem/, docs/lsystems.md), alone or in the lobes of a session; and the L-system
+// (growth/lsystem/, docs/lsystem-turtle.md), alone or in the lobes of a session; and the L-system
 // file input of `render FILE.l` and `grow --lsystem FILE.l`.
 #include <chrono>
 #include <filesystem>
@@ -88,7 +88,7 @@ void add_lsystem_command(CLI::App& app, int& exit_code)
     cmd->add_option("--lobes", a->lobes,
                     "Grow in the lobes of this session document (.json): from its trunk base, with its settings");
     cmd->add_option("--string-out", a->string_out, "Also write the derived word, one line");
-    cmd->add_option("--skeleton-out", a->skeleton_out, "Also write the tree graph as JSON (docs/lsystems.md)");
+    cmd->add_option("--skeleton-out", a->skeleton_out, "Also write the tree graph as JSON (docs/lsystem-turtle.md)");
     cmd->add_option("--height", a->in.height, "A tree grown without lobes is scaled to this height in metres (default 3)")
         ->check(CLI::Range(0.01, 100.0));
     cmd->add_option("--settings", a->in.settings, "Settings JSON (a settings object or a session document)");

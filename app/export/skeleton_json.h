@@ -1,6 +1,6 @@
 #pragma once
 /// \file skeleton_json.h
-/// The tree graph as a file (`--skeleton-out tree.json`, docs/lsystems.md):
+/// The tree graph as a file (`--skeleton-out tree.json`, docs/lsystem-turtle.md):
 ///
 ///   {"nodes": [{"id": 0, "parent": -1, "position": [x, y, z], "radius": r, "lobe": 0}, …]}
 ///

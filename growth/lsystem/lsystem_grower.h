@@ -22,7 +22,7 @@
 ///     top of the highest lobe, without lobes to `height_m`.
 /// Radii are the model's widths (`!`, `#`) when it sets any, else the pipe model's. Leaves
 /// are the model's surfaces (`~`, `@o`): a model without surfaces has no leaves. A node in a
-/// lobe records that lobe (TreeNode::lobe). docs/lsystems.md.
+/// lobe records that lobe (TreeNode::lobe). docs/lsystem-turtle.md.
 
 #include <cstdint>
 #include <string>
