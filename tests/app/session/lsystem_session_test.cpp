@@ -8,6 +8,8 @@
 #include <string>
 
 #include "app/export/tree_output.h"
+#include "app/session/panel_controls.h"
+#include "app/session/session_builder.h"
 #include "app/session/session_file.h"
 #include "app/session/tree_pipeline.h"
 #include "core/document.h"
@@ -99,4 +101,30 @@ TEST(LSystemGrowerSession, ASessionNamingABadParameterIsRefusedWhenLoaded)
     } catch (const FileError& e) {
         EXPECT_NE(std::string(e.what()).find("params.colour: unknown parameter"), std::string::npos) << e.what();
     }
+}
+
+TEST(LSystemGrowerSession, ThePanelsPickItByItsCodeAndItsDefaultGrowsInTheLobes)
+{
+    // The panels' grower setting (desktop combo, VR GROWER button) takes panel codes from
+    // growers(): code 1 makes the scene's tree an L-system tree with default parameters.
+    const PanelControl* control = find_panel_control(SettingId::Grower);
+    ASSERT_NE(control, nullptr);
+    EXPECT_LE(lsystem::kGrowerPanelCode, control->accepts().hi);
+    Document start = lsystem_document();
+    start.trees.clear();
+    SessionBuilder b(start);
+    InputAction a;
+    a.type = InputAction::Type::SettingChanged;
+    a.time = 1.0;
+    a.setting.id = SettingId::Grower;
+    a.setting.value = lsystem::kGrowerPanelCode;
+    ASSERT_TRUE(b.apply(a));
+    const GrowerChoice& chosen = scene_grower(b.document());
+    EXPECT_EQ(chosen.name, "lsystem");
+    EXPECT_TRUE(chosen.params.empty());
+    const BuiltTree tree = build_document_tree(b.document());
+    ASSERT_GT(tree.growth.tree.size(), 50u);
+    ASSERT_EQ(tree.growth.lobes.size(), 1u);
+    EXPECT_GT(tree.growth.lobes[0].nodes, 20u); // the crown is in the lobe
+    EXPECT_FALSE(tree.growth.leaves->empty());
 }
