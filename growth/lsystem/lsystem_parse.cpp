@@ -443,13 +443,18 @@ void LParser::parse_production(std::size_t begin, std::size_t end)
     {
         int paren = 0;
         int brace = 0;
-        for (std::size_t i = begin; i + 1 < end; ++i) {
+        std::size_t open_paren = 0;
+        for (std::size_t i = begin; i < end; ++i) {
             const char c = clean_[i];
-            if (c == '(') ++paren;
-            else if (c == ')') paren = std::max(0, paren - 1);
+            if (c == '(') {
+                if (paren++ == 0) open_paren = i;
+            } else if (c == ')') {
+                if (paren == 0) src().fail(i, "unbalanced ')'");
+                --paren;
+            }
             else if (c == '{') ++brace;
             else if (c == '}') brace = std::max(0, brace - 1);
-            else if (paren == 0 && brace == 0 && c == '-' && clean_[i + 1] == '>') {
+            else if (paren == 0 && brace == 0 && c == '-' && i + 1 < end && clean_[i + 1] == '>') {
                 arrow = i;
                 arrow_end = i + 2;
             } else if (paren == 0 && brace == 0 && c == '-' && clean_[i + 1] == 'o' && i + 2 < end && clean_[i + 2] == '>') {
@@ -457,6 +462,7 @@ void LParser::parse_production(std::size_t begin, std::size_t end)
                 arrow_end = i + 3;
             }
         }
+        if (paren > 0) src().fail(open_paren, "unclosed '('");
         if (arrow != std::string_view::npos && clean_[arrow + 1] == '>' && arrow > begin && clean_[arrow - 1] == '-') --arrow;
     }
     const std::size_t first = skip_blanks(begin, end);
@@ -572,7 +578,10 @@ void LParser::parse_production(std::size_t begin, std::size_t end)
 
     // Pre-build a constant successor.
     for (const Expr& e : prod.param_exprs)
-        if (!e.constant) prod.constant_successor = false;
+        if (!e.constant) {
+            prod.constant_successor = false;
+            prod.successor_cost += e.count;
+        }
     prod.successor_param_count = static_cast<std::uint32_t>(prod.param_exprs.size());
     if (prod.constant_successor) {
         for (const SuccessorModule& s : prod.successor) {
