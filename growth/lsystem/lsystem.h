@@ -165,8 +165,10 @@ struct DeriveOptions {
 /// max_modules / max_param_values, a division by zero or another failed evaluation.
 Word derive(const LSystem& system, const DeriveOptions& options = {});
 
-/// One derivation step of `in` into `out` (cut and decomposition included); `step` keys the
-/// random numbers. For derive() and callers that show growth step by step.
+/// One derivation step of `in` into `out` (cut and decomposition included, then
+/// answer_queries when the system has queries); `step` (1 for the first) keys the random
+/// numbers and names the step in messages. For callers that show growth step by step.
+/// \throw InvalidInput as derive(), and for a module of `in` that is not of this system.
 void derive_step(const LSystem& system, const Word& in, Word& out, int step, const DeriveOptions& options);
 
 /// The word the turtle draws: the homomorphism productions applied (up to their
