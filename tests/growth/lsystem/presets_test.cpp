@@ -1,0 +1,147 @@
+// The L-system presets Lobesketch ships (growth/data/lsystems/, docs/lsystems.md): each one
+// is compiled into the program, reads without warnings, derives a balanced word that draws,
+// and exports a .glb that passes the Khronos glTF validator; the lobe filler keeps its
+// branches inside a lobe.
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "core/errors.h"
+#include "growth/lsystem/lsystem.h"
+#include "growth/lsystem/presets.h"
+#include "tests/support/cli_run.h"
+#include "tests/support/gltf_check.h"
+#include "tests/support/test_paths.h"
+
+using namespace lobe;
+using namespace lobe::lsystem;
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::vector<std::string> kPresets = {
+    "abop-monopodial", "abop-sympodial", "bush",          "lobe-filler", "ordinary-tree",
+    "seaweed",         "stochastic-bush", "sympodial-tree", "willow",
+};
+
+/// How many modules named `name` the word holds.
+std::size_t count(const LSystem& system, const Word& word, std::string_view name)
+{
+    const int id = system.find_symbol(name);
+    if (id < 0) return 0;
+    return static_cast<std::size_t>(std::count_if(word.modules.begin(), word.modules.end(),
+                                                  [&](const Module& m) { return m.symbol == id; }));
+}
+
+std::string read_file(const std::string& path)
+{
+    std::ifstream in(path, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+} // namespace
+
+TEST(LSystemPresets, TheProgramCarriesEveryPresetFileOfTheSourceTreeByItsStem)
+{
+    std::vector<std::string> names;
+    for (const Preset& p : presets()) names.push_back(p.name);
+    EXPECT_EQ(names, kPresets);
+    // Each compiled-in preset is byte for byte the file in growth/data/lsystems/, its view
+    // file included exactly when one is there.
+    for (const Preset& p : presets()) {
+        const std::string dir = test::source_path("growth/data/lsystems/");
+        EXPECT_EQ(p.lsystem, read_file(dir + p.name + ".l")) << p.name;
+        if (fs::exists(dir + p.name + ".v"))
+            EXPECT_EQ(p.view, read_file(dir + p.name + ".v")) << p.name;
+        else
+            EXPECT_TRUE(p.view.empty()) << p.name;
+    }
+}
+
+TEST(LSystemPresets, EveryPresetReadsWithoutWarningsAndDerivesABalancedWordThatDraws)
+{
+    for (const std::string& name : kPresets) {
+        SCOPED_TRACE(name);
+        const LSystemFile f = load_preset(name);
+        EXPECT_TRUE(f.warnings.empty()) << f.warnings.front();
+        EXPECT_GT(f.system.derivation_length(), 0);
+        const Word w = derive(f.system);
+        // Balanced: every ] closes an earlier [.
+        const int open = f.system.find_symbol("["), close = f.system.find_symbol("]");
+        long depth = 0;
+        for (const Module& m : w.modules) {
+            if (m.symbol == open) ++depth;
+            if (m.symbol == close) {
+                ASSERT_GT(depth, 0);
+                --depth;
+            }
+        }
+        EXPECT_EQ(depth, 0);
+        EXPECT_GE(count(f.system, w, "F") + count(f.system, w, "G"), 20u); // a tree, not a twig
+        EXPECT_LT(w.size(), 2'000'000u);                                   // and small enough to draw at once
+    }
+}
+
+TEST(LSystemPresets, ThePresetsWithAViewFileSetTheirAnglesAndTropism)
+{
+    const LSystemFile seaweed = load_preset("seaweed");
+    ASSERT_TRUE(seaweed.has_view);
+    EXPECT_DOUBLE_EQ(seaweed.view.angle_increment_deg, 22.0);
+    const LSystemFile bush = load_preset("bush");
+    EXPECT_DOUBLE_EQ(bush.view.angle_increment_deg, 22.5);
+    const LSystemFile willow = load_preset("willow");
+    EXPECT_TRUE(willow.view.tropism);
+    EXPECT_DOUBLE_EQ(willow.view.elasticity, 0.35);
+    EXPECT_EQ(willow.view.tropism_direction.y, -1.0);
+    EXPECT_FALSE(load_preset("abop-monopodial").has_view);
+}
+
+TEST(LSystemPresets, TheSeaweedDrawsItsThirdBranchWithGWhichNoProductionRewrites)
+{
+    const LSystemFile f = load_preset("seaweed");
+    DeriveOptions one;
+    one.steps = 1;
+    EXPECT_EQ(to_string(f.system, derive(f.system, one)), "FF+[^F&F&F]-[&F^F^F]\\[&G&G^G]");
+    // Each F becomes 8 F and 3 G; G's stay: after three steps 8³ = 512 F and
+    // 3·(1 + 8 + 64) = 219 G.
+    const Word w = derive(f.system);
+    EXPECT_EQ(count(f.system, w, "F"), 512u);
+    EXPECT_EQ(count(f.system, w, "G"), 219u);
+    EXPECT_EQ(count(f.system, w, "f"), 0u);
+}
+
+TEST(LSystemPresets, TheWillowDependsOnTheSeedAndOnlyOnIt)
+{
+    const LSystemFile f = load_preset("willow");
+    DeriveOptions a, b, c;
+    a.seed = b.seed = 11;
+    c.seed = 12;
+    const std::string wa = to_string(f.system, derive(f.system, a));
+    EXPECT_EQ(wa, to_string(f.system, derive(f.system, b)));
+    EXPECT_NE(wa, to_string(f.system, derive(f.system, c)));
+}
+
+TEST(LSystemPresets, ANameIsReadAsAFileWhenOneExistsElseAsAPreset)
+{
+    const std::string dir = test::temp_dir("lsystem-presets-lookup");
+    // A file of a preset's name in the working folder wins over the preset.
+    const std::string own = dir + "/willow";
+    std::ofstream(own) << "Lsystem: 1\nderivation length: 1\nAxiom: F\nF --> FF\nendlsystem\n";
+    EXPECT_EQ(load_lsystem_or_preset(own).system.derivation_length(), 1);
+    EXPECT_EQ(load_lsystem_or_preset("willow").system.derivation_length(), 12);
+    try {
+        load_lsystem_or_preset(dir + "/no-such-tree");
+        FAIL() << "no error for a name that is neither a file nor a preset";
+    } catch (const FileError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("no-such-tree"), std::string::npos) << what;
+        EXPECT_NE(what.find("ordinary-tree"), std::string::npos) << what; // lists the presets
+        EXPECT_EQ(what.find('\n'), std::string::npos);
+    }
+    EXPECT_THROW(load_preset("Willow"), InvalidInput);
+}
