@@ -22,7 +22,7 @@ LINDENMAYER_DIR="build/tools/lindenmayer"
 out="$(mktemp -d)"
 trap 'rm -rf "$out"' EXIT
 
-"$BENCH" --benchmark_filter='^BM_LSystem(Bracketed|Parametric|Stochastic)$' \
+"$BENCH" --benchmark_filter='^BM_LSystem(Bracketed|Parametric|Stochastic)(/real_time)?$' \
   --benchmark_repetitions="$RUNS" --benchmark_format=json --benchmark_out="$out/cpp.json" >/dev/null
 node tests/bench/lsystem_lindenmayer.cjs "$LINDENMAYER_DIR" "$RUNS" >"$out/js.jsonl"
 
@@ -40,7 +40,7 @@ console.log(['grammar', 'steps', 'modules written', 'Lobesketch ms', 'M mod/s', 
 let mismatch = false;
 for (const j of js) {
   // Per-repetition runs of the benchmark (not its aggregates): their real times, in ms.
-  const reps = cpp.benchmarks.filter(b => b.run_name === names[j.grammar] && b.run_type === 'iteration');
+  const reps = cpp.benchmarks.filter(b => b.run_name.split('/')[0] === names[j.grammar] && b.run_type === 'iteration');
   if (!reps.length) { console.error(`no C++ runs of ${names[j.grammar]}`); process.exit(1); }
   const ms = median(reps.map(b => b.real_time * ({ns: 1e-6, us: 1e-3, ms: 1, s: 1e3}[b.time_unit])));
   const written = reps[0].modules_written;

@@ -88,12 +88,12 @@ void run_rewriting(benchmark::State& state, const char* text, const char* name)
 }
 
 void BM_LSystemBracketed(benchmark::State& state) { run_rewriting(state, kBracketed, "bracketed.l"); }
-BENCHMARK(BM_LSystemBracketed)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LSystemBracketed)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_LSystemParametric(benchmark::State& state) { run_rewriting(state, kParametric, "parametric.l"); }
-BENCHMARK(BM_LSystemParametric)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LSystemParametric)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_LSystemStochastic(benchmark::State& state) { run_rewriting(state, kStochastic, "stochastic.l"); }
-BENCHMARK(BM_LSystemStochastic)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LSystemStochastic)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 } // namespace
