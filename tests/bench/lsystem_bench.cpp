@@ -61,7 +61,7 @@ std::size_t modules_written(const LSystem& system, const DeriveOptions& options)
 {
     Word a = system.axiom(), b;
     std::size_t total = 0;
-    for (int step = 0; step < system.derivation_length(); ++step) {
+    for (int step = 1; step <= system.derivation_length(); ++step) {
         derive_step(system, a, b, step, options);
         total += b.size();
         std::swap(a, b);
