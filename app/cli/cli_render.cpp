@@ -107,7 +107,7 @@ void add_render_command(CLI::App& app, int& exit_code)
             const GrownInput grown = grow_input_tree(a->input, a->in);
             for (const std::string& w : grown.tree.warnings) warn(a->input + ": " + w);
             const BuiltTree& tree = grown.tree;
-            if (tree.lobes.empty() || tree.growth.tree.size() <= tree.growth.skeleton_nodes) {
+            if (tree.growth.tree.size() <= tree.growth.skeleton_nodes) {
                 error(a->input + ": no tree could be grown (no lobe could be built)");
                 exit_code = kExitFailure;
                 return;
