@@ -11,7 +11,13 @@
 #include <cstddef>
 #include <string>
 
+#include <glm/geometric.hpp>
+
+#include "app/export/tree_output.h"
+#include "core/settings.h"
+#include "growth/branch_geometry.h"
 #include "growth/lsystem/lsystem.h"
+#include "growth/lsystem/turtle.h"
 
 using namespace lobe;
 using namespace lobe::lsystem;
@@ -95,5 +101,110 @@ BENCHMARK(BM_LSystemParametric)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_LSystemStochastic(benchmark::State& state) { run_rewriting(state, kStochastic, "stochastic.l"); }
 BENCHMARK(BM_LSystemStochastic)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// A ternary tree after The Algorithmic Beauty of Plants, Fig. 2.8, in 3D with widths and
+// internodes shortening by 0.8 per order: 10 steps draw 1 + 2·(3¹⁰ − 1) = 118,097 segments,
+// no two of them merged (a width change or a branch separates every pair).
+constexpr const char* kTernary = R"(
+Lsystem: 1
+derivation length: 10
+Axiom: !(1)F(4)/(45)A(1,0.7)
+A(l,w) --> !(w)F(l)[&(30)F(l)A(l*0.8,w*0.7)]/(94.74)[&(30)F(l)A(l*0.8,w*0.7)]/(132.63)[&(30)F(l)A(l*0.8,w*0.7)]
+endlsystem
+)";
+
+struct TurtleInput {
+    LSystem system;
+    Word word;
+    TurtleOptions options;
+};
+
+/// The ternary tree's word, scaled so that its segments are 2 cm long on average: about one
+/// ring (every 1.5 cm at LOD0) per segment, as twigs of a tree this size have.
+const TurtleInput& ternary_tree()
+{
+    static const TurtleInput input = [] {
+        TurtleInput in;
+        in.system = parse_lsystem(kTernary, "ternary.l");
+        in.word = derive(in.system);
+        const TurtleResult unit = interpret(in.system, in.word, in.options);
+        double length = 0.0;
+        for (std::size_t i = 1; i < unit.tree.size(); ++i) {
+            const TreeNode& n = unit.tree.nodes[i];
+            length += glm::length(glm::dvec3(n.position) - glm::dvec3(unit.tree.nodes[static_cast<std::size_t>(n.parent)].position));
+        }
+        in.options.metres_per_unit = 0.02 / (length / static_cast<double>(unit.segments));
+        return in;
+    }();
+    return input;
+}
+
+// The turtle alone: the word drawn as a tree graph.
+void BM_LSystemTurtle(benchmark::State& state)
+{
+    const TurtleInput& in = ternary_tree();
+    const TurtleSymbols symbols(in.system);
+    std::size_t segments = 0, nodes = 0;
+    for (auto _ : state) {
+        TurtleResult r = interpret(symbols, in.word, in.options);
+        segments = r.segments;
+        nodes = r.tree.size();
+        benchmark::DoNotOptimize(r.tree.nodes.data());
+    }
+    state.SetItemsProcessed(static_cast<std::int64_t>(segments) * state.iterations());
+    state.counters["segments"] = static_cast<double>(segments);
+    state.counters["nodes"] = static_cast<double>(nodes);
+    state.counters["modules"] = static_cast<double>(in.word.size());
+}
+BENCHMARK(BM_LSystemTurtle)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The turtle and the branch geometry (issue: ≤ 100 ms for 100k segments): the tree graph and
+// its LOD0 branch mesh at the default branch settings, built into kept storage as the apps
+// regrow (build_tree_geometry_into, one level of detail, no leaves: the ternary tree places
+// none and the tips' leaves are a separate cost, measured with them in BM_LSystemTreeGeometry).
+void BM_LSystemTurtleBranchGeometry(benchmark::State& state)
+{
+    const TurtleInput& in = ternary_tree();
+    const TurtleSymbols symbols(in.system);
+    BranchSettings branches;
+    branches.lod_count = 1;
+    LeafSettings leaves;
+    leaves.per_node = 0;
+    TreeGeometry g;
+    std::size_t segments = 0;
+    for (auto _ : state) {
+        TurtleResult r = interpret(symbols, in.word, in.options);
+        segments = r.segments;
+        build_tree_geometry_into(g, r.tree, branches, leaves, 1);
+        benchmark::DoNotOptimize(g);
+    }
+    state.SetItemsProcessed(static_cast<std::int64_t>(segments) * state.iterations());
+    state.counters["segments"] = static_cast<double>(segments);
+    state.counters["tris_LOD0"] = static_cast<double>(lod_triangles(g.lods[0]));
+}
+BENCHMARK(BM_LSystemTurtleBranchGeometry)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// Everything a tree gets in the apps: the turtle, then branches and leaves at every level
+// of detail of the default settings (3 LODs, 4 leaves per tip).
+void BM_LSystemTreeGeometry(benchmark::State& state)
+{
+    const TurtleInput& in = ternary_tree();
+    const TurtleSymbols symbols(in.system);
+    const BranchSettings branches;
+    const LeafSettings leaves;
+    TreeGeometry g;
+    std::size_t segments = 0;
+    for (auto _ : state) {
+        TurtleResult r = interpret(symbols, in.word, in.options);
+        segments = r.segments;
+        build_tree_geometry_into(g, r.tree, branches, leaves, 1);
+        benchmark::DoNotOptimize(g);
+    }
+    state.SetItemsProcessed(static_cast<std::int64_t>(segments) * state.iterations());
+    state.counters["segments"] = static_cast<double>(segments);
+    for (std::size_t i = 0; i < g.lods.size(); ++i)
+        state.counters["tris_LOD" + std::to_string(i)] = static_cast<double>(lod_triangles(g.lods[i]));
+}
+BENCHMARK(BM_LSystemTreeGeometry)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 } // namespace
