@@ -148,6 +148,10 @@ struct DeriveOptions {
     std::uint64_t seed = 1; ///< keys stochastic productions, ran() and nran()
     std::size_t max_modules = kMaxModules;
     std::size_t max_param_values = kMaxParamValues;
+    /// Most work one call may do: modules visited and written plus expression instructions
+    /// run (about 30 s of one core at the default); past it InvalidInput naming the step, so
+    /// that a file whose productions evaluate huge expressions over a huge word cannot hang.
+    std::uint64_t max_operations = std::uint64_t{1} << 35;
     /// Where `inside(x, y, z)` and `?E` look; null: everywhere is inside.
     const Environment* environment = nullptr;
     /// Fills the parameters of the query modules of `word` (`?P(x, y, z)` the turtle's
@@ -174,6 +178,10 @@ void derive_step(const LSystem& system, const Word& in, Word& out, int step, con
 /// The word the turtle draws: the homomorphism productions applied (up to their
 /// `maximum depth:`); the word itself when the system has none.
 Word interpretation_word(const LSystem& system, const Word& word, std::uint64_t seed = 1);
+/// As above, with `options.seed` and the limits of `options` (max_modules, max_param_values,
+/// max_operations); steps, environment and answer_queries are not used.
+/// \throw InvalidInput past the limits or for a failed evaluation ("NAME: step 0: …").
+Word interpretation_word(const LSystem& system, const Word& word, const DeriveOptions& options);
 
 /// The word as text, as cpfg writes it: `F(1.5)[+(30)A]B`, numbers in shortest form.
 std::string to_string(const LSystem& system, const Word& word);

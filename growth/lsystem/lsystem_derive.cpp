@@ -141,6 +141,7 @@ public:
     {
         max_modules_ = std::min(options.max_modules, kMaxModules);
         max_params_ = std::min(options.max_param_values, kMaxParamValues);
+        max_ops_ = options.max_operations;
     }
 
     /// Rewrites `in` into `out` with `set`. `live_in` (optional) marks the modules that may be
@@ -157,11 +158,20 @@ private:
     void bind(const Production& p, std::size_t i, const std::uint32_t* pos, double* vars) const;
     std::int32_t select(const ProductionSet& set, const SymbolRule& r, std::size_t i);
     [[noreturn]] void fail_eval(EvalError err, const Production& p, std::size_t i, const char* what) const;
+    void check_operations() const
+    {
+        if (ops_ > max_ops_)
+            throw InvalidInput(sys_.source_name + ": step " + std::to_string(step_) + ": the derivation went past " +
+                               std::to_string(max_ops_) +
+                               " operations (its productions evaluate too much over too large a word)");
+    }
 
     const LSystem::Impl& sys_;
     const DeriveOptions& opt_;
     std::size_t max_modules_ = 0;
     std::size_t max_params_ = 0;
+    std::uint64_t max_ops_ = 0;
+    std::uint64_t ops_ = 0; ///< work done so far (modules and instructions)
     // Per call.
     const Word* in_ = nullptr;
     const ProductionSet* set_ = nullptr;
@@ -278,6 +288,7 @@ std::int32_t Rewriter::select(const ProductionSet& set, const SymbolRule& r, std
             if (group == 0 && !match_context(p, i, pos)) continue;
             bind(p, i, pos, vars);
             if (p.has_condition) {
+                ops_ += p.condition.count;
                 double v = 0.0;
                 const EvalError err = detail::evaluate(sys_.code, p.condition, ctx_, v);
                 if (err != EvalError::None) fail_eval(err, p, i, "condition");
@@ -289,6 +300,7 @@ std::int32_t Rewriter::select(const ProductionSet& set, const SymbolRule& r, std
             }
             double weight = 1.0;
             if (p.has_probability) {
+                ops_ += p.probability.count;
                 const EvalError err = detail::evaluate(sys_.code, p.probability, ctx_, weight);
                 if (err != EvalError::None) fail_eval(err, p, i, "probability");
                 if (!(weight >= 0.0) || !std::isfinite(weight))
@@ -369,6 +381,8 @@ std::size_t Rewriter::rewrite(const ProductionSet& set, Section section, int ste
     }
 
     // Pass 1: choose, and count.
+    ops_ += n;
+    check_operations();
     std::size_t total_modules = 0;
     std::size_t total_params = 0;
     std::size_t rewritten = 0;
@@ -388,6 +402,8 @@ std::size_t Rewriter::rewrite(const ProductionSet& set, Section section, int ste
                 }
             } else if (r.kind == SymbolRule::General) {
                 c = select(set, r, i);
+                if (c >= 0) ops_ += prods[c].successor_cost;
+                if (ops_ > max_ops_) check_operations();
             }
         }
         choice_[i] = c;
@@ -400,6 +416,8 @@ std::size_t Rewriter::rewrite(const ProductionSet& set, Section section, int ste
             ++rewritten;
         }
     }
+    ops_ += total_modules;
+    check_operations();
     if (total_modules > max_modules_)
         throw InvalidInput(sys_.source_name + ": step " + std::to_string(step) + ": the word would grow to " +
                            std::to_string(total_modules) + " modules, over the limit of " + std::to_string(max_modules_));
@@ -408,9 +426,15 @@ std::size_t Rewriter::rewrite(const ProductionSet& set, Section section, int ste
                            std::to_string(total_params) + " parameter values, over the limit of " + std::to_string(max_params_));
 
     // Pass 2: write.
+    // Cleared first, so that growing the storage copies nothing.
+    out.modules.clear();
+    out.params.clear();
     out.modules.resize(total_modules);
     out.params.resize(total_params);
-    if (live_out != nullptr) live_out->resize(total_modules);
+    if (live_out != nullptr) {
+        live_out->clear();
+        live_out->resize(total_modules);
+    }
     Module* om = out.modules.data();
     double* op = out.params.data();
     const double* ip = in.params.data();
@@ -609,14 +633,19 @@ void derive_step(const LSystem& system, const Word& in, Word& out, int step, con
 
 Word interpretation_word(const LSystem& system, const Word& word, std::uint64_t seed)
 {
+    DeriveOptions options;
+    options.seed = seed;
+    return interpretation_word(system, word, options);
+}
+
+Word interpretation_word(const LSystem& system, const Word& word, const DeriveOptions& options)
+{
     const LSystem::Impl& sys = system.impl();
     if (sys.homomorphism.empty() || sys.homomorphism.depth <= 0) return word;
     check_word(sys, word, "homomorphism");
-    DeriveOptions options;
-    options.seed = seed;
     Rewriter rw(sys, options);
     Word w = word;
-    apply_levels(rw, sys.homomorphism, kHomomorphism, 0, w, seed);
+    apply_levels(rw, sys.homomorphism, kHomomorphism, 0, w, options.seed);
     return w;
 }
 

@@ -56,6 +56,7 @@ struct Production {
     std::vector<Module> block;
     std::vector<double> block_params;
     std::uint32_t successor_param_count = 0;
+    std::uint64_t successor_cost = 0; ///< instructions of its non-constant parameter expressions
     std::size_t offset = 0; ///< where the production starts in the source (messages)
     std::string where;      ///< "NAME:LINE:COL" of the production
     bool is_context_sensitive() const { return !left.empty() || !right.empty(); }

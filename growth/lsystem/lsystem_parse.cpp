@@ -578,7 +578,10 @@ void LParser::parse_production(std::size_t begin, std::size_t end)
 
     // Pre-build a constant successor.
     for (const Expr& e : prod.param_exprs)
-        if (!e.constant) prod.constant_successor = false;
+        if (!e.constant) {
+            prod.constant_successor = false;
+            prod.successor_cost += e.count;
+        }
     prod.successor_param_count = static_cast<std::uint32_t>(prod.param_exprs.size());
     if (prod.constant_successor) {
         for (const SuccessorModule& s : prod.successor) {

@@ -658,5 +658,27 @@ TEST(LSystemBadInput, AWordOfAnotherSystemIsRefusedByDeriveStep)
     EXPECT_NE(refusal([&] { derive_step(sys, w, out, 1, {}); }).find("not one of this system's"), std::string::npos);
 }
 
+TEST(LSystemBadInput, WorkPastTheOperationBudgetStopsWithTheStep)
+{
+    std::string expr = "x";
+    for (int i = 0; i < 200; ++i) expr += " + x * 0.5";
+    const LSystem sys = parse("Lsystem: b\nAxiom: A(1)\nA(x) --> A(" + expr + ")A(x)\nendlsystem\n");
+    DeriveOptions o;
+    o.steps = 30;
+    o.max_operations = 100000;
+    const std::string msg = refusal([&] { derive(sys, o); });
+    EXPECT_EQ(msg.rfind("test.l: step ", 0), 0u) << msg;
+    EXPECT_NE(msg.find("went past 100000 operations"), std::string::npos) << msg;
+}
+
+TEST(LSystemBadInput, TheHomomorphismKeepsTheLimitsItIsGiven)
+{
+    const LSystem sys = parse("Lsystem: h\nAxiom: A\nhomomorphism\nmaximum depth: 30\nA --> AA\nendlsystem\n");
+    DeriveOptions o;
+    o.max_modules = 1000;
+    const std::string msg = refusal([&] { interpretation_word(sys, sys.axiom(), o); });
+    EXPECT_EQ(msg, "test.l: step 0: the word would grow to 1024 modules, over the limit of 1000");
+}
+
 } // namespace
 } // namespace lobe::lsystem
