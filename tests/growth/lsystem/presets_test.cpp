@@ -8,12 +8,14 @@
 #include <string>
 #include <vector>
 
+#include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include "core/errors.h"
 #include "growth/lsystem/lsystem.h"
 #include "growth/lsystem/presets.h"
+#include "growth/lsystem/turtle.h"
 #include "tests/support/cli_run.h"
 #include "tests/support/gltf_check.h"
 #include "tests/support/test_paths.h"
@@ -36,6 +38,31 @@ std::size_t count(const LSystem& system, const Word& word, std::string_view name
     if (id < 0) return 0;
     return static_cast<std::size_t>(std::count_if(word.modules.begin(), word.modules.end(),
                                                   [&](const Module& m) { return m.symbol == id; }));
+}
+
+/// A ball: the space a topiary model is given in the tests.
+struct Ball final : Environment {
+    glm::dvec3 centre{0.0, 1.2, 0.0};
+    double radius = 0.6;
+    bool inside(const glm::dvec3& p) const override { return glm::length(p - centre) <= radius; }
+};
+
+/// The drawn branch length of `tree` (metres), and how much of it lies inside `space`
+/// (each segment sampled at 20 points).
+std::pair<double, double> length_inside(const TreeGraph& tree, const Environment& space)
+{
+    double all = 0.0, in = 0.0;
+    for (std::size_t i = 1; i < tree.size(); ++i) {
+        const TreeNode& n = tree.nodes[i];
+        if (n.kind == TreeNodeKind::Detached) continue; // a move: nothing drawn
+        const glm::dvec3 a(tree.nodes[static_cast<std::size_t>(n.parent)].position), b(n.position);
+        const double piece = glm::length(b - a) / 20.0;
+        for (int k = 0; k < 20; ++k) {
+            all += piece;
+            if (space.inside(a + (b - a) * ((k + 0.5) / 20.0))) in += piece;
+        }
+    }
+    return {all, in};
 }
 
 std::string read_file(const std::string& path)
@@ -144,4 +171,29 @@ TEST(LSystemPresets, ANameIsReadAsAFileWhenOneExistsElseAsAPreset)
         EXPECT_EQ(what.find('\n'), std::string::npos);
     }
     EXPECT_THROW(load_preset("Willow"), InvalidInput);
+}
+
+TEST(LSystemPresets, TheLobeFillerPrunesWhatGrowsOutOfItsSpaceAndKeepsItsBranchesInside)
+{
+    const LSystemFile f = load_preset("lobe-filler");
+    ASSERT_TRUE(f.system.has_queries());
+    // The turtle starts at the origin, 0.6 m below a ball of radius 0.6 m: the trunk rises
+    // into it, then the crown grows until the ball prunes it.
+    const Ball ball;
+    DeriveOptions o;
+    o.environment = &ball;
+    o.answer_queries = query_answerer(f.system, f.view, &ball);
+    const Word in_ball = derive(f.system, o);
+    TurtleOptions t;
+    t.view = f.view;
+    const TurtleResult r = interpret(f.system, in_ball, t);
+    const auto [all, in] = length_inside(r.tree, ball);
+    EXPECT_GT(all, 20.0);          // a crown, not a stick: tens of metres of twigs
+    EXPECT_GE(in / all, 0.98);     // only the trunk below the ball is outside
+    EXPECT_GT(r.leaves.size(), 100u);
+    // Without a space nothing is pruned: the same model grows far larger.
+    DeriveOptions free;
+    free.answer_queries = query_answerer(f.system, f.view);
+    const TurtleResult unpruned = interpret(f.system, derive(f.system, free), t);
+    EXPECT_GT(unpruned.segments, 4 * r.segments);
 }
