@@ -249,20 +249,30 @@ void SourceText::fail(std::size_t offset, const std::string& message) const
 ExprCompiler::ExprCompiler(const SourceText& source, std::vector<Instr>& code,
                            std::unordered_map<std::string, Define>& defines,
                            std::function<void(std::size_t, const std::string&)> warn)
-    : src_(source), code_(code), defines_(defines), warn_(std::move(warn))
+    : src_(source), code_(code), defines_(defines), warn_(std::move(warn)), max_tokens_(max_expr_tokens(source.text().size()))
 {
 }
 
 ExprCompiler::Token ExprCompiler::peek(const Cursor& c) const
 {
+    if (c.pos == cache_pos_ && c.end == cache_end_) return cache_token_;
     Cursor copy = c;
-    return lex(copy);
+    cache_token_ = lex(copy);
+    cache_pos_ = c.pos;
+    cache_end_ = c.end;
+    cache_next_ = copy.pos;
+    return cache_token_;
 }
 
 ExprCompiler::Token ExprCompiler::next(Cursor& c)
 {
-    if (++tokens_ > kMaxExprTokens)
-        src_.fail(c.pos, "the expressions are too large to compile (#define expansions over 32 million tokens)");
+    if (++tokens_ > max_tokens_)
+        src_.fail(c.pos, "the expressions are too large to compile (#define expansions past " +
+                             std::to_string(max_tokens_) + " tokens)");
+    if (c.pos == cache_pos_ && c.end == cache_end_) {
+        c.pos = cache_next_;
+        return cache_token_;
+    }
     return lex(c);
 }
 
@@ -503,7 +513,7 @@ Op binary_op(std::string_view op)
 
 std::size_t ExprCompiler::parse_ternary(Cursor& c, int depth)
 {
-    if (depth > kMaxExprNesting) src_.fail(c.pos, "expression nested too deeply (over 200 levels)");
+    if (depth > kMaxExprNesting) src_.fail(c.pos, "expression nested too deeply (over " + std::to_string(kMaxExprNesting) + " levels)");
     const std::size_t start = parse_binary(c, 0, depth + 1);
     if (peek(c).kind != Tok::Question) return start;
     next(c);
@@ -586,7 +596,7 @@ std::size_t ExprCompiler::parse_binary(Cursor& c, int level, int depth)
 
 std::size_t ExprCompiler::parse_unary(Cursor& c, int depth)
 {
-    if (depth > kMaxExprNesting) src_.fail(c.pos, "expression nested too deeply (over 200 levels)");
+    if (depth > kMaxExprNesting) src_.fail(c.pos, "expression nested too deeply (over " + std::to_string(kMaxExprNesting) + " levels)");
     const Token t = peek(c);
     if (t.kind == Tok::Op && (t.text == "-" || t.text == "!" || t.text == "+")) {
         next(c);
@@ -717,7 +727,7 @@ std::size_t ExprCompiler::parse_name(const Token& name, int depth)
     if (d != defines_.end()) {
         Define& def = d->second;
         if (def.expanding) src_.fail(def.name_offset, "recursive #define '" + n + "'");
-        if (depth > kMaxExprNesting) src_.fail(name.begin, "expression nested too deeply (over 200 levels)");
+        if (depth > kMaxExprNesting) src_.fail(name.begin, "expression nested too deeply (over " + std::to_string(kMaxExprNesting) + " levels)");
         def.expanding = true;
         try {
             Cursor sub{def.begin, def.end};

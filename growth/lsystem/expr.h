@@ -62,7 +62,7 @@ struct Expr {
 };
 
 /// Deepest expression nesting (parentheses, calls, unary chains, #define expansions).
-inline constexpr int kMaxExprNesting = 200;
+inline constexpr int kMaxExprNesting = 100;
 /// Deepest evaluation stack an expression may need.
 inline constexpr std::uint32_t kMaxExprStack = 256;
 /// Most instructions in one system (all expressions together).
@@ -188,10 +188,17 @@ private:
     std::uint32_t max_depth_ = 0;
     std::vector<std::string> warned_functions_;
     bool lenient_ = false;
-    std::size_t tokens_ = 0; ///< tokens read, bounded so #define expansions cannot blow up
+    std::size_t tokens_ = 0;     ///< tokens read, bounded so #define expansions cannot blow up
+    std::size_t max_tokens_ = 0;
+    // The last token peeked (the precedence levels peek the same token in turn).
+    mutable std::size_t cache_pos_ = static_cast<std::size_t>(-1);
+    mutable std::size_t cache_end_ = 0;
+    mutable Token cache_token_;
+    mutable std::size_t cache_next_ = 0;
 };
 
-/// Most tokens one source's expressions may read (every #define expansion counts).
-inline constexpr std::size_t kMaxExprTokens = std::size_t{1} << 25;
+/// Most tokens the expressions of a source of `bytes` bytes may read, every #define expansion
+/// counting: a million plus two per byte, so that expansions cannot blow up.
+inline std::size_t max_expr_tokens(std::size_t bytes) { return (std::size_t{1} << 20) + 2 * bytes; }
 
 } // namespace lobe::lsystem::detail

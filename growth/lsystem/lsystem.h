@@ -22,8 +22,11 @@
 
 namespace lobe::lsystem {
 
-/// A module's name, interned per LSystem: one character (`F`, `+`, `[`, `A`), or `@` or `?`
-/// followed by letters (`@o`, `@v`, `?P`, `?E`).
+/// A module's name, interned per LSystem: one printable ASCII character (`F`, `+`, `[`, `A`),
+/// or `@` or `?` followed by one letter (`@o`, `@v`, `?P`, `?E`; also cpfg's `@Gs`, `@Dd`,
+/// `@Tx`: `@G`, `@D`, `@T` take one more lower-case letter). Not modules: `*` (no context, no
+/// condition, the empty successor), `<` `>` `:` `(` `)`; a line starting with `#` is a
+/// preprocessor line.
 using SymbolId = std::uint16_t;
 
 /// Most modules a word may hold, and most parameter values (all modules together); a
@@ -58,6 +61,7 @@ struct Word {
     }
     std::span<double> params_of(const Module& m) { return {params.data() + m.first_param, m.param_count}; }
     /// Appends a module with `values` as its parameters.
+    /// \throw InvalidInput for more than kMaxModuleParams values.
     void push(SymbolId symbol, std::span<const double> values = {});
     void clear()
     {
@@ -118,10 +122,16 @@ private:
 };
 
 /// Reads a `.l` file's text. Unsupported cpfg features give one warning line each (in
-/// `warnings`, "NAME:LINE:COL: …") and a stand-in (docs/lsystems.md).
+/// `warnings`, "NAME:LINE:COL: …", at most 200 and then one line counting the rest) and a
+/// stand-in (docs/lsystems.md): statement blocks `{…}` are skipped, `func()` gives 1 and
+/// cpfg's other functions 0, `-o>` reads as `-->`, `seed:` and a second L-system are ignored.
+/// `#define NAME value` defines a constant, expanded where used as a parenthesised expression;
+/// `/* */` comments anywhere, `//` comments where `//` starts a line or stands between blanks
+/// (elsewhere `//` is two rolls). Expressions: expr.h (trigonometry in degrees).
 /// \throw InvalidInput "NAME:LINE:COL: …", one line, for anything malformed: unbalanced
 /// brackets, an unknown or malformed production, an undefined constant, a recursive
-/// `#define`, a file over kMaxFileBytes.
+/// `#define`, a constant division by zero, expressions nested over 100 levels, a derivation
+/// length over kMaxDerivationLength, a file over kMaxFileBytes.
 LSystem parse_lsystem(std::string_view text, const std::string& source_name,
                       std::vector<std::string>* warnings = nullptr);
 
@@ -161,10 +171,17 @@ struct DeriveOptions {
     std::function<void(Word& word)> answer_queries;
 };
 
-/// Rewrites the axiom `steps` times in parallel; after each step applies the cut symbol and
-/// the decomposition productions (up to their `maximum depth:`). Context-sensitive
-/// productions are tried before context-free ones; among those that match, a stochastic
-/// choice by weight (normalised per predecessor, as cpfg does).
+/// Rewrites the axiom `steps` times in parallel; after each step applies the decomposition
+/// productions (up to their `maximum depth:`, cpfg's default 1) and then the cut symbol (`%`
+/// and the rest of its branch are removed). Context-sensitive productions are tried before
+/// context-free ones, each kind in file order: the first that matches (predecessor and
+/// parameter count, context, condition) applies, or, when any of that kind carries a
+/// probability, one of those that match chosen by weight (normalised, as cpfg does; no
+/// probability counts 1). Context is bracket-aware as in ABOP: a branch's first module sees
+/// the module before the branch, earlier branches are skipped, a right context skips whole
+/// branches and stops at the end of its own unless it names brackets (`A > [B]C`); the
+/// `ignore:`/`consider:` modules are skipped. Random numbers (choices, ran, nran) are keyed by
+/// the seed, the step and the module's position: the same seed gives the same word.
 /// \throw InvalidInput, one line naming the step and the module, for a word past
 /// max_modules / max_param_values, a division by zero or another failed evaluation.
 Word derive(const LSystem& system, const DeriveOptions& options = {});

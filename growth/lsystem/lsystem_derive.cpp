@@ -31,6 +31,8 @@ using detail::SymbolRule;
 
 void Word::push(SymbolId symbol, std::span<const double> values)
 {
+    if (values.size() > kMaxModuleParams)
+        throw InvalidInput("a module with " + std::to_string(values.size()) + " parameters (at most 255)");
     Module m;
     m.symbol = symbol;
     m.param_count = static_cast<std::uint16_t>(values.size());
@@ -154,7 +156,8 @@ public:
     std::size_t max_params() const { return max_params_; }
 
 private:
-    bool match_context(const Production& p, std::size_t i, std::uint32_t* pos) const;
+    bool match_context(const Production& p, std::size_t i, std::uint32_t* pos);
+    void build_context_tables();
     void bind(const Production& p, std::size_t i, const std::uint32_t* pos, double* vars) const;
     std::int32_t select(const ProductionSet& set, const SymbolRule& r, std::size_t i);
     [[noreturn]] void fail_eval(EvalError err, const Production& p, std::size_t i, const char* what) const;
@@ -179,8 +182,11 @@ private:
     int step_ = 0;
     EvalContext ctx_;
     std::vector<std::int32_t> choice_;
-    std::vector<std::uint32_t> ctx_store_;
-    std::vector<std::int64_t> match_; ///< matching bracket of each bracket
+    // Context tables (rewrite() builds them when the set has context-sensitive productions).
+    std::vector<std::int32_t> left_;
+    std::vector<std::int32_t> right_;
+    std::vector<std::int32_t> next_;
+    std::vector<std::int32_t> open_;
     std::vector<double> vars_;
     std::vector<std::uint32_t> pos_;
     std::vector<std::uint32_t> matched_;
@@ -194,58 +200,99 @@ void Rewriter::fail_eval(EvalError err, const Production& p, std::size_t i, cons
                        std::to_string(i + 1) + " " + module_text(sys_, *in_, i));
 }
 
-bool Rewriter::match_context(const Production& p, std::size_t i, std::uint32_t* pos) const
+bool Rewriter::match_context(const Production& p, std::size_t i, std::uint32_t* pos)
 {
-    const Word& w = *in_;
-    const Module* mods = w.modules.data();
-    const std::int64_t n = static_cast<std::int64_t>(w.modules.size());
+    // O(context length): the tables built in rewrite() jump over ignored modules and branches.
+    const Module* mods = in_->modules.data();
+    const std::int32_t n = static_cast<std::int32_t>(in_->modules.size());
     const SymbolId lb = sys_.left_bracket;
-    const SymbolId rb = sys_.right_bracket;
-    const std::uint8_t* ignored = sys_.ignored.data();
-    const std::size_t nsym = sys_.ignored.size();
-    std::int64_t at = static_cast<std::int64_t>(i) - 1;
+    ops_ += p.left.size() + p.right.size();
+    std::int32_t at = static_cast<std::int32_t>(i) - 1;
     for (std::size_t k = p.left.size(); k-- > 0;) {
-        const PatternModule& want = p.left[k];
-        for (;;) {
-            if (at < 0) return false;
-            const SymbolId s = mods[at].symbol;
-            if (s == rb) {
-                at = match_[static_cast<std::size_t>(at)] - 1; // skip the branch
-                continue;
-            }
-            if (s == lb || (s < nsym && ignored[s])) {
-                --at; // a branch's first module sees the module before the branch
-                continue;
-            }
-            break;
-        }
+        if (at < 0) return false;
+        at = left_[static_cast<std::size_t>(at)];
+        if (at < 0) return false;
         const Module& m = mods[at];
-        if (m.symbol != want.symbol || m.param_count != want.param_count) return false;
+        if (m.symbol != p.left[k].symbol || m.param_count != p.left[k].param_count) return false;
         pos[k] = static_cast<std::uint32_t>(at);
         --at;
     }
-    at = static_cast<std::int64_t>(i) + 1;
+    at = static_cast<std::int32_t>(i) + 1;
     for (std::size_t k = 0; k < p.right.size(); ++k) {
         const PatternModule& want = p.right[k];
-        for (;;) {
-            if (at >= n) return false;
-            const SymbolId s = mods[at].symbol;
-            if (s < nsym && ignored[s] && s != lb && s != rb) {
-                ++at;
-                continue;
-            }
-            if (s == lb && want.symbol != lb) {
-                at = match_[static_cast<std::size_t>(at)] + 1; // right context skips whole branches
-                continue;
-            }
-            break;
-        }
+        if (at >= n) return false;
+        // A right context skips whole branches unless it names one ('A > [B]C').
+        at = (want.symbol == lb ? next_ : right_)[static_cast<std::size_t>(at)];
+        if (at >= n) return false;
         const Module& m = mods[at];
         if (m.symbol != want.symbol || m.param_count != want.param_count) return false;
         pos[p.left.size() + k] = static_cast<std::uint32_t>(at);
         ++at;
     }
     return true;
+}
+
+void Rewriter::build_context_tables()
+{
+    const Module* mods = in_->modules.data();
+    const std::size_t n = in_->modules.size();
+    const auto sn = static_cast<std::int32_t>(n);
+    const SymbolId lb = sys_.left_bracket;
+    const SymbolId rb = sys_.right_bracket;
+    const std::uint8_t* ignored = sys_.ignored.data();
+    const std::size_t nsym = sys_.ignored.size();
+    auto is_ignored = [&](SymbolId s) { return s < nsym && ignored[s] != 0; };
+    // Matching brackets (in next_ for now); an unmatched '[' reaches the end, an unmatched ']'
+    // the start.
+    next_.assign(n, 0);
+    open_.clear();
+    for (std::size_t k = 0; k < n; ++k) {
+        const SymbolId s = mods[k].symbol;
+        if (s == lb && lb != kNoSymbol) {
+            open_.push_back(static_cast<std::int32_t>(k));
+            next_[k] = sn;
+        } else if (s == rb && rb != kNoSymbol) {
+            if (open_.empty()) {
+                next_[k] = -1;
+            } else {
+                next_[k] = open_.back();
+                next_[static_cast<std::size_t>(open_.back())] = static_cast<std::int32_t>(k);
+                open_.pop_back();
+            }
+        }
+    }
+    // left_[p]: the module a left context meets walking left from p (inclusive): a branch's
+    // first module sees the module before the branch; earlier branches are skipped whole.
+    left_.resize(n);
+    for (std::size_t k = 0; k < n; ++k) {
+        const SymbolId s = mods[k].symbol;
+        std::int32_t v = static_cast<std::int32_t>(k);
+        if (s == rb && rb != kNoSymbol) {
+            const std::int32_t open = next_[k];
+            v = open <= 0 ? -1 : left_[static_cast<std::size_t>(open - 1)];
+        } else if ((s == lb && lb != kNoSymbol) || is_ignored(s)) {
+            v = k == 0 ? -1 : left_[k - 1];
+        }
+        left_[k] = v;
+    }
+    // right_[p]: the module a right context meets walking right from p, skipping branches.
+    right_.resize(n);
+    for (std::size_t k = n; k-- > 0;) {
+        const SymbolId s = mods[k].symbol;
+        std::int32_t v = static_cast<std::int32_t>(k);
+        if (s == lb && lb != kNoSymbol) {
+            const std::int32_t close = next_[k];
+            v = close >= sn - 1 ? sn : right_[static_cast<std::size_t>(close) + 1];
+        } else if (is_ignored(s) && s != rb) {
+            v = k + 1 >= n ? sn : right_[k + 1];
+        }
+        right_[k] = v;
+    }
+    // next_[p]: the next module not ignored, branches not skipped.
+    for (std::size_t k = n; k-- > 0;) {
+        const SymbolId s = mods[k].symbol;
+        next_[k] = (is_ignored(s) && s != lb && s != rb) ? (k + 1 >= n ? sn : next_[k + 1]) : static_cast<std::int32_t>(k);
+    }
 }
 
 void Rewriter::bind(const Production& p, std::size_t i, const std::uint32_t* pos, double* vars) const
@@ -294,10 +341,7 @@ std::int32_t Rewriter::select(const ProductionSet& set, const SymbolRule& r, std
                 if (err != EvalError::None) fail_eval(err, p, i, "condition");
                 if (v == 0.0) continue;
             }
-            if (!stochastic) {
-                if (group == 0) ctx_store_.insert(ctx_store_.end(), pos, pos + p.left.size() + p.right.size());
-                return static_cast<std::int32_t>(pi);
-            }
+            if (!stochastic) return static_cast<std::int32_t>(pi);
             double weight = 1.0;
             if (p.has_probability) {
                 ops_ += p.probability.count;
@@ -325,11 +369,6 @@ std::int32_t Rewriter::select(const ProductionSet& set, const SymbolRule& r, std
                 break;
             }
         }
-        const Production& p = set.productions[matched_[pick]];
-        if (group == 0) {
-            match_context(p, i, pos);
-            ctx_store_.insert(ctx_store_.end(), pos, pos + p.left.size() + p.right.size());
-        }
         return static_cast<std::int32_t>(matched_[pick]);
     }
     return -1;
@@ -352,33 +391,12 @@ std::size_t Rewriter::rewrite(const ProductionSet& set, Section section, int ste
     const Module* mods = in.modules.data();
     const std::size_t nrules = set.rules.size();
     choice_.resize(n);
-    ctx_store_.clear();
     vars_.resize(std::max<std::size_t>(set.max_vars, 1));
     std::size_t longest_context = 0;
     for (const Production& p : set.productions) longest_context = std::max(longest_context, p.left.size() + p.right.size());
     pos_.resize(std::max<std::size_t>(longest_context, 1));
 
-    if (set.has_context) {
-        // Matching brackets, for context that skips branches. Unmatched ones reach the ends.
-        match_.assign(n, 0);
-        std::vector<std::size_t> open;
-        const SymbolId lb = sys_.left_bracket;
-        const SymbolId rb = sys_.right_bracket;
-        for (std::size_t k = 0; k < n; ++k) {
-            if (mods[k].symbol == lb && lb != kNoSymbol) {
-                open.push_back(k);
-                match_[k] = static_cast<std::int64_t>(n);
-            } else if (mods[k].symbol == rb && rb != kNoSymbol) {
-                if (open.empty()) {
-                    match_[k] = -1;
-                } else {
-                    match_[k] = static_cast<std::int64_t>(open.back());
-                    match_[open.back()] = static_cast<std::int64_t>(k);
-                    open.pop_back();
-                }
-            }
-        }
-    }
+    if (set.has_context) build_context_tables();
 
     // Pass 1: choose, and count.
     ops_ += n;
@@ -441,7 +459,6 @@ std::size_t Rewriter::rewrite(const ProductionSet& set, Section section, int ste
     std::uint8_t* lo = live_out != nullptr ? live_out->data() : nullptr;
     std::size_t mo = 0;
     std::uint32_t po = 0;
-    std::size_t ctx_cursor = 0;
     for (std::size_t i = 0; i < n; ++i) {
         const std::int32_t c = choice_[i];
         if (c < 0) {
@@ -475,12 +492,7 @@ std::size_t Rewriter::rewrite(const ProductionSet& set, Section section, int ste
             continue;
         }
         std::uint32_t* pos = pos_.data();
-        const std::size_t nctx = p.left.size() + p.right.size();
-        if (nctx != 0) {
-            std::copy(ctx_store_.begin() + static_cast<std::ptrdiff_t>(ctx_cursor),
-                      ctx_store_.begin() + static_cast<std::ptrdiff_t>(ctx_cursor + nctx), pos);
-            ctx_cursor += nctx;
-        }
+        if (p.is_context_sensitive()) match_context(p, i, pos); // matched in pass 1: the same positions
         double* vars = vars_.data();
         bind(p, i, pos, vars);
         ctx_.vars = vars;

@@ -345,6 +345,52 @@ TEST(LSystemContext, ARightContextMayNameABranchAsCpfgAllows)
     EXPECT_EQ(derived(sys, 1), "X[B]CA[D]C");
 }
 
+TEST(LSystemContext, ContextOverManySiblingBranchesAndIgnoredRunsIsLinear)
+{
+    // Each B's left context walks back over every earlier sibling branch, and each A's right
+    // context over every A after it: quadratic (minutes) if walked module by module.
+    const LSystem sys = parse("Lsystem: c\nignore: A\nAxiom: A[B]C\nA < B --> X\nA > C --> Y\nendlsystem\n");
+    const auto a = static_cast<SymbolId>(sys.find_symbol("A"));
+    const auto b = static_cast<SymbolId>(sys.find_symbol("B"));
+    const auto c = static_cast<SymbolId>(sys.find_symbol("C"));
+    const auto open = static_cast<SymbolId>(sys.find_symbol("["));
+    const auto close = static_cast<SymbolId>(sys.find_symbol("]"));
+    Word w;
+    const int n = 300000;
+    for (int k = 0; k < n; ++k) w.push(a);
+    for (int k = 0; k < n; ++k) {
+        w.push(open);
+        w.push(b);
+        w.push(close);
+    }
+    w.push(c);
+    Word out;
+    derive_step(sys, w, out, 1, {});
+    const auto x = static_cast<SymbolId>(sys.find_symbol("X"));
+    const auto y = static_cast<SymbolId>(sys.find_symbol("Y"));
+    std::size_t xs = 0, ys = 0;
+    for (const Module& m : out.modules) {
+        xs += m.symbol == x;
+        ys += m.symbol == y;
+    }
+    // A is ignored, so the B's see nothing before the branches; every A sees C past them.
+    EXPECT_EQ(xs, 0u);
+    EXPECT_EQ(ys, static_cast<std::size_t>(n));
+    const LSystem plain = parse("Lsystem: c\nAxiom: A[B]C\nA < B --> X\nendlsystem\n");
+    Word w2;
+    w2.push(static_cast<SymbolId>(plain.find_symbol("A")));
+    for (int k = 0; k < n; ++k) {
+        w2.push(static_cast<SymbolId>(plain.find_symbol("[")));
+        w2.push(static_cast<SymbolId>(plain.find_symbol("B")));
+        w2.push(static_cast<SymbolId>(plain.find_symbol("]")));
+    }
+    derive_step(plain, w2, out, 1, {});
+    const auto x2 = static_cast<SymbolId>(plain.find_symbol("X"));
+    xs = 0;
+    for (const Module& m : out.modules) xs += m.symbol == x2;
+    EXPECT_EQ(xs, static_cast<std::size_t>(n));
+}
+
 TEST(LSystemContext, ContextParametersAreBoundToTheMatchedModules)
 {
     const LSystem sys = parse(R"(Lsystem: c
