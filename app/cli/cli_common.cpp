@@ -19,6 +19,7 @@
 #include "core/settings_json.h"
 #include "core/settings_table.h"
 #include "growth/grower.h"
+#include "growth/lsystem/lsystem_grower.h"
 #include "growth/species.h"
 #include "input/pipeline.h"
 #include "app/session/stage_options.h"
@@ -130,6 +131,8 @@ void add_tree_input_options(CLI::App* cmd, TreeInputOptions& o)
     cmd->add_option("--grower", o.grower, "Growth model: " + grower_names() + " (default: the session's, else " +
                                               std::string(kDefaultGrowerName) + ")")
         ->check(CLI::IsMember(names));
+    cmd->add_option("--lsystem", o.lsystem,
+                    "L-system file (cpfg's .l, with NAME.v beside it) for the lsystem grower; implies --grower lsystem");
     cmd->add_option("--set", o.set,
                     "Sets one setting (repeatable): growth.split_angle_deg=25, leaves.color=0.2,0.4,0.1. Applied "
                     "after --settings and --species, in the order given, before --split-angle and "
@@ -224,6 +227,15 @@ bool is_mesh_file(const std::string& path)
 void apply_document_options(Document& doc, const TreeInputOptions& o)
 {
     if (o.seed) doc.seed = *o.seed;
+    if (!o.lsystem.empty()) {
+        if (!o.grower.empty() && o.grower != lsystem::kGrowerName)
+            throw InvalidInput("--lsystem: an L-system file grows with --grower " + std::string(lsystem::kGrowerName) +
+                               ", not " + o.grower);
+        GrowerChoice choice = lsystem_file_choice(o.lsystem);
+        if (o.height) choice.params["height_m"] = *o.height;
+        set_scene_grower(doc, std::move(choice));
+        return;
+    }
     if (!o.grower.empty()) {
         GrowerChoice choice;
         choice.name = o.grower;

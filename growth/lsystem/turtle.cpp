@@ -5,6 +5,7 @@
 #include <limits>
 #include <memory>
 
+#include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
 #include "core/errors.h"
@@ -102,8 +103,13 @@ private:
         }
         double a = 0.0;
         if (!arg(word, m, 0.0, a)) return false;
-        c = std::cos(a * kDegToRad);
-        s = std::sin(a * kDegToRad);
+        if (a != last_angle_) { // words repeat their angles: one cosine and sine per new one
+            last_angle_ = a;
+            last_cos_ = std::cos(a * kDegToRad);
+            last_sin_ = std::sin(a * kDegToRad);
+        }
+        c = last_cos_;
+        s = last_sin_;
         return true;
     }
 
@@ -127,6 +133,7 @@ private:
     TurtleState state_;
     std::vector<TurtleState> stack_;
     double default_cos_ = 1.0, default_sin_ = 0.0;
+    double last_angle_ = 0.0, last_cos_ = 1.0, last_sin_ = 0.0;
     glm::dvec3 tropism_{0.0, -1.0, 0.0};
     bool use_tropism_ = false;
 
@@ -187,8 +194,11 @@ void Walker::bend()
     const glm::dvec3 axis = glm::cross(state_.h, tropism_);
     const double sin_t = glm::length(axis);
     if (sin_t < 1e-12) return;
-    const double between = std::atan2(sin_t, glm::dot(state_.h, tropism_));
-    const double alpha = std::clamp(state_.elasticity * sin_t, -between, between);
+    double alpha = state_.elasticity * sin_t;
+    if (std::abs(state_.elasticity) > 1.0) { // only then can α pass the angle θ to T (sin θ ≤ θ)
+        const double between = std::atan2(sin_t, glm::dot(state_.h, tropism_));
+        alpha = std::clamp(alpha, -between, between);
+    }
     const glm::dvec3 k = axis / sin_t;
     const double c = std::cos(alpha), s = std::sin(alpha);
     state_.h = glm::normalize(rotate(state_.h, k, c, s));

@@ -2,7 +2,7 @@
 /// \file turtle.h
 /// The 3D turtle that draws a derived L-system word (lsystem.h) as a tree graph
 /// (core/tree.h), as cpfg does (*The Algorithmic Beauty of Plants*, "ABOP", §1.5 and §2.4;
-/// the cpfg manual). docs/lsystems.md lists what it reads.
+/// the cpfg manual). docs/lsystem-turtle.md describes it.
 ///
 /// The turtle has a position and three unit vectors, heading H, left L and up U (H × L = U).
 /// It starts at the model's origin with H = +Y (up), L = −X and U = +Z, so the model's +Y is

@@ -1,0 +1,309 @@
+#include "growth/lsystem/lsystem_grower.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <variant>
+
+#include <glm/common.hpp>
+
+#include "core/errors.h"
+#include "growth/embedded_data.h"
+#include "growth/lsystem/turtle.h"
+#include "growth/skeleton.h"
+
+namespace lobe {
+namespace lsystem {
+
+namespace {
+
+/// The built-in preset "default": a tree that fills the lobes (lengths in metres).
+constexpr char kDefaultText[] = R"(/* default: the lsystem grower's built-in tree. Lengths are metres.
+   A trunk T rises from the trunk base in steps of TS until it enters a lobe (at most MAXT
+   steps); there it becomes the crown apex A. An apex grows an internode when the
+   internode's end is inside the lobes, or when a lobe lies ahead of it within AHEADA (the
+   main axis) or AHEAD (its laterals), so branches cross the gaps between lobes they point at; else it dies with a leaf, so the
+   crown takes the lobes' shape. ?H and ?P tell an apex where it heads and where it is. A
+   leaves a lateral B at every node, turned by the golden angle; B leaves laterals C, which
+   carry the leaves (~l). Without lobes everywhere is inside, and the derivation length and
+   the counters bound the tree. */
+#define S 0.03
+#define TS 0.06
+#define MAXT 60
+#define AHEAD 0.4
+#define AHEADA 0.8
+#define W0 0.03
+#define WR 0.92
+#define BA 50
+#define CA 45
+#define MAXB 14
+#define MAXC 5
+
+Lsystem: 1
+derivation length: 60
+Axiom: !(W0)T(0)?H(0,0,0)?P(0,0,0)
+T(n) > ?H(u,v,t)?P(x,y,z) : inside(x,y,z) == 0 && n < MAXT --> F(TS)T(n+1)
+T(n) > ?H(u,v,t)?P(x,y,z) : inside(x,y,z) != 0 || n >= MAXT --> A(W0)
+A(w) > ?H(u,v,t)?P(x,y,z) : inside(x+S*u, y+S*v, z+S*t) || inside(x+AHEADA*u/2, y+AHEADA*v/2, z+AHEADA*t/2) || inside(x+AHEADA*u, y+AHEADA*v, z+AHEADA*t) --> !(w)F(S)[&(BA)B(w*0.6,0)?H(0,0,0)?P(0,0,0)]/(137.5)A(w*WR)
+A(w) > ?H(u,v,t)?P(x,y,z) : !(inside(x+S*u, y+S*v, z+S*t) || inside(x+AHEADA*u/2, y+AHEADA*v/2, z+AHEADA*t/2) || inside(x+AHEADA*u, y+AHEADA*v, z+AHEADA*t)) --> [&(60)~l(1)]
+B(w,n) > ?H(u,v,t)?P(x,y,z) : n < MAXB && (inside(x+0.8*S*u, y+0.8*S*v, z+0.8*S*t) || inside(x+AHEAD*u/2, y+AHEAD*v/2, z+AHEAD*t/2) || inside(x+AHEAD*u, y+AHEAD*v, z+AHEAD*t)) --> !(w)F(0.8*S)[+(CA)C(w*0.6,0)?H(0,0,0)?P(0,0,0)]/(180)B(w*WR,n+1)
+B(w,n) > ?H(u,v,t)?P(x,y,z) : n >= MAXB || !(inside(x+0.8*S*u, y+0.8*S*v, z+0.8*S*t) || inside(x+AHEAD*u/2, y+AHEAD*v/2, z+AHEAD*t/2) || inside(x+AHEAD*u, y+AHEAD*v, z+AHEAD*t)) --> [&(60)~l(1)]
+C(w,n) > ?H(u,v,t)?P(x,y,z) : n < MAXC && inside(x+0.6*S*u, y+0.6*S*v, z+0.6*S*t) != 0 --> !(w)F(0.6*S)[&(60)~l(1)]/(137.5)C(w*WR,n+1)
+C(w,n) > ?H(u,v,t)?P(x,y,z) : n >= MAXC || inside(x+0.6*S*u, y+0.6*S*v, z+0.6*S*t) == 0 --> [&(60)~l(1)]
+endlsystem
+)";
+
+constexpr char kPresetFolder[] = "lsystems/";
+
+/// A text parameter, or null when absent (or not a text: check_params refuses that).
+const std::string* text_param(const GrowerChoice& c, const std::string& key)
+{
+    const auto it = c.params.find(key);
+    if (it == c.params.end()) return nullptr;
+    return std::get_if<std::string>(&it->second);
+}
+
+/// A number parameter (whole or not), or nullopt.
+std::optional<double> number_param(const GrowerChoice& c, const std::string& key)
+{
+    const auto it = c.params.find(key);
+    if (it == c.params.end()) return std::nullopt;
+    if (const auto* i = std::get_if<std::int64_t>(&it->second)) return static_cast<double>(*i);
+    if (const auto* d = std::get_if<double>(&it->second)) return *d;
+    return std::nullopt;
+}
+
+std::string view_name_of(const std::string& name)
+{
+    const std::size_t dot = name.rfind('.');
+    const std::size_t slash = name.find_last_of("/\\");
+    if (dot != std::string::npos && (slash == std::string::npos || dot > slash)) return name.substr(0, dot) + ".v";
+    return name + ".v";
+}
+
+/// The source the grower's parameters name (checked).
+LSystemSource choice_source(const GrowerChoice& c)
+{
+    LSystemSource src;
+    if (const std::string* text = text_param(c, "source")) {
+        const std::string* name = text_param(c, "source_name");
+        src.name = name && !name->empty() ? *name : "lsystem.l";
+        src.text = *text;
+        src.view_name = view_name_of(src.name);
+    } else {
+        const std::string* preset = text_param(c, "preset");
+        src = preset_source(preset ? *preset : kDefaultPreset);
+    }
+    if (const std::string* view = text_param(c, "view")) {
+        src.view_text = *view;
+        src.has_view = true;
+    }
+    return src;
+}
+
+/// Where the turtle starts: the trunk base of the skeleton the strokes and lobes make.
+glm::dvec3 trunk_base(const GrowerInput& in)
+{
+    if (in.trunk_strokes.empty() && in.lobes.empty()) return glm::dvec3(0.0);
+    std::vector<TriangleMesh> meshes;
+    meshes.reserve(in.lobes.size());
+    for (const GrowthLobe& l : in.lobes) meshes.push_back(l.mesh);
+    SkeletonOptions o;
+    o.spacing_m = in.settings.growth.skeleton_spacing_m;
+    const Skeleton s = build_skeleton(in.trunk_strokes, meshes, o);
+    return s.graph.empty() ? glm::dvec3(0.0) : glm::dvec3(s.graph.nodes[0].position);
+}
+
+/// Highest lobe point, metres; -inf without lobes.
+double lobes_top(const std::vector<GrowthLobe>& lobes)
+{
+    double top = -std::numeric_limits<double>::infinity();
+    for (const GrowthLobe& l : lobes)
+        for (const glm::vec3& p : l.mesh.positions) top = std::max(top, static_cast<double>(p.y));
+    return top;
+}
+
+/// Records in each node the lobe holding it, and counts the nodes per lobe.
+void assign_lobes(GrowthResult& g, const std::vector<GrowthLobe>& lobes, const LobeEnvironment& env)
+{
+    g.lobes.assign(lobes.size(), LobeGrowthStats{});
+    for (TreeNode& n : g.tree.nodes) {
+        if (n.kind == TreeNodeKind::Root) continue;
+        n.lobe = env.lobe_at(n.position);
+        if (n.lobe >= 0) ++g.lobes[static_cast<std::size_t>(n.lobe)].nodes;
+    }
+}
+
+class LSystemGrower final : public Grower {
+public:
+    std::string_view name() const override { return kGrowerName; }
+    std::string_view title() const override { return "L-system"; }
+    int version() const override { return 1; }
+    int panel_code() const override { return kGrowerPanelCode; }
+    void check_params(const GrowerChoice& choice, const std::string& where) const override;
+    GrowthResult grow(const GrowerInput& in) const override { return run_lsystem(in).growth; }
+};
+
+void LSystemGrower::check_params(const GrowerChoice& choice, const std::string& where) const
+{
+    if (choice.version > version())
+        throw InvalidInput(where + ".version: " + std::to_string(choice.version) + " is newer than this build reads (" +
+                           std::to_string(version()) + ")");
+    for (const auto& [key, value] : choice.params) {
+        const std::string at = where + ".params." + key;
+        if (key == "preset" || key == "source" || key == "view" || key == "source_name") {
+            const std::string* text = std::get_if<std::string>(&value);
+            if (!text) throw InvalidInput(at + ": expected a text");
+            if (text->size() > kMaxFileBytes)
+                throw InvalidInput(at + ": longer than " + std::to_string(kMaxFileBytes) + " bytes");
+            if (key == "preset") {
+                const std::vector<std::string> names = preset_names();
+                if (std::find(names.begin(), names.end(), *text) == names.end()) {
+                    std::string known;
+                    for (const std::string& n : names) known += (known.empty() ? "" : ", ") + n;
+                    throw InvalidInput(at + ": no L-system preset \"" + *text + "\" (known: " + known + ")");
+                }
+            }
+        } else if (key == "steps") {
+            const auto* n = std::get_if<std::int64_t>(&value);
+            if (!n || *n < 0 || *n > kMaxDerivationLength)
+                throw InvalidInput(at + ": expected a whole number from 0 to " + std::to_string(kMaxDerivationLength));
+        } else if (key == "height_m") {
+            const std::optional<double> h = number_param(choice, key);
+            if (!h || !(*h > 0.0 && *h <= 100.0)) throw InvalidInput(at + ": expected a number of metres in (0, 100]");
+        } else {
+            throw InvalidInput(at + ": unknown parameter (the " + std::string(kGrowerName) +
+                               " grower takes preset, source, view, source_name, steps and height_m)");
+        }
+    }
+    if (choice.params.count("preset") && choice.params.count("source"))
+        throw InvalidInput(where + ".params: give preset or source, not both");
+}
+
+const LSystemGrower kLSystemGrower;
+
+} // namespace
+
+LobeEnvironment::LobeEnvironment(const std::vector<GrowthLobe>& lobes, const glm::dvec3& origin) : origin_(origin)
+{
+    rays_.reserve(lobes.size());
+    for (const GrowthLobe& l : lobes) {
+        rays_.emplace_back(l.mesh);
+        glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+        for (const glm::vec3& p : l.mesh.positions) {
+            lo = glm::min(lo, p);
+            hi = glm::max(hi, p);
+        }
+        lo_.push_back(lo);
+        hi_.push_back(hi);
+    }
+}
+
+int LobeEnvironment::lobe_at(const glm::vec3& p) const
+{
+    for (std::size_t i = 0; i < rays_.size(); ++i) {
+        const glm::vec3& lo = lo_[i];
+        const glm::vec3& hi = hi_[i];
+        if (p.x < lo.x || p.y < lo.y || p.z < lo.z || p.x > hi.x || p.y > hi.y || p.z > hi.z) continue;
+        if (rays_[i].inside(p)) return static_cast<int>(i);
+    }
+    return -1;
+}
+
+bool LobeEnvironment::inside(const glm::dvec3& p) const
+{
+    const glm::dvec3 stage = origin_ + p;
+    if (!std::isfinite(stage.x) || !std::isfinite(stage.y) || !std::isfinite(stage.z)) return false;
+    return lobe_at(glm::vec3(stage)) >= 0;
+}
+
+std::vector<std::string> preset_names()
+{
+    std::vector<std::string> names{kDefaultPreset};
+    const std::string folder = kPresetFolder;
+    for (const EmbeddedFile& f : embedded_growth_data()) {
+        if (f.name.rfind(folder, 0) != 0 || f.name.size() < folder.size() + 3) continue;
+        if (f.name.compare(f.name.size() - 2, 2, ".l") != 0) continue;
+        const std::string n = f.name.substr(folder.size(), f.name.size() - folder.size() - 2);
+        if (n.find('/') == std::string::npos && n != kDefaultPreset) names.push_back(n);
+    }
+    std::sort(names.begin() + 1, names.end());
+    return names;
+}
+
+LSystemSource preset_source(const std::string& name)
+{
+    LSystemSource src;
+    src.name = kPresetFolder + name + ".l";
+    src.view_name = kPresetFolder + name + ".v";
+    bool found = false;
+    for (const EmbeddedFile& f : embedded_growth_data()) {
+        if (f.name == src.name) {
+            src.text = std::string(f.text);
+            found = true;
+        } else if (f.name == src.view_name) {
+            src.view_text = std::string(f.text);
+            src.has_view = true;
+        }
+    }
+    if (!found && name == kDefaultPreset) {
+        src.text = kDefaultText;
+        found = true;
+    }
+    if (!found) throw InvalidInput("no L-system preset \"" + name + "\"");
+    return src;
+}
+
+LSystemRun run_lsystem(const GrowerInput& in)
+{
+    kLSystemGrower.check_params(in.choice, "grower");
+    const LSystemSource src = choice_source(in.choice);
+    LSystemRun run;
+    std::vector<std::string>& messages = run.growth.messages;
+    run.system = parse_lsystem(src.text, src.name, &messages);
+    const ViewSettings view = src.has_view ? parse_view(src.view_text, src.view_name, &messages) : ViewSettings{};
+
+    const glm::dvec3 base = trunk_base(in);
+    const LobeEnvironment environment(in.lobes, base);
+    const bool in_lobes = !in.lobes.empty();
+    DeriveOptions derive_options;
+    if (const auto it = in.choice.params.find("steps"); it != in.choice.params.end())
+        derive_options.steps = static_cast<int>(std::get<std::int64_t>(it->second));
+    derive_options.seed = in.seed;
+    derive_options.environment = in_lobes ? &environment : nullptr;
+    if (run.system.has_queries()) derive_options.answer_queries = query_answerer(run.system, view, derive_options.environment);
+    run.word = derive(run.system, derive_options);
+
+    TurtleOptions turtle;
+    turtle.view = view;
+    turtle.origin = base;
+    turtle.surface_length_m = in.settings.leaves.length_m;
+    turtle.surface_width_m = in.settings.leaves.width_m;
+    turtle.max_nodes = in.max_tree_nodes;
+    if (!(in_lobes && run.system.has_queries())) {
+        // Drawn in its own units, then scaled: to the lobes' top, or to the free height.
+        const double top = lobes_top(in.lobes) - base.y;
+        turtle.fit_height_m = in_lobes && top > 0.01 ? top : number_param(in.choice, "height_m").value_or(kDefaultFreeHeightM);
+    }
+    TurtleResult drawn = interpret(run.system, interpretation_word(run.system, run.word, in.seed), turtle);
+    run.metres_per_unit = drawn.metres_per_unit;
+
+    GrowthResult& g = run.growth;
+    g.tree = std::move(drawn.tree);
+    g.skeleton_nodes = g.tree.empty() ? 0 : 1; // the root
+    g.radii_set = drawn.widths_set;
+    g.leaves = std::move(drawn.leaves);
+    for (std::string& m : drawn.messages) messages.push_back(std::move(m));
+    if (g.tree.empty())
+        messages.push_back(src.name + ": the derived word (" + std::to_string(run.word.size()) +
+                           " modules) draws no branch (no F or G)");
+    if (in_lobes) assign_lobes(g, in.lobes, environment);
+    return run;
+}
+
+} // namespace lsystem
+
+const Grower& lsystem_grower() { return lsystem::kLSystemGrower; }
+
+} // namespace lobe
