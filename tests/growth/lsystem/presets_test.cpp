@@ -12,12 +12,17 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "app/session/session_file.h"
+#include "app/session/tree_pipeline.h"
+#include "core/document.h"
 #include "core/errors.h"
 #include "growth/lsystem/lsystem.h"
+#include "growth/lsystem/lsystem_grower.h"
 #include "growth/lsystem/presets.h"
 #include "growth/lsystem/turtle.h"
 #include "tests/support/cli_run.h"
 #include "tests/support/gltf_check.h"
+#include "input/truth_surface.h"
 #include "tests/support/test_paths.h"
 
 using namespace lobe;
@@ -42,14 +47,15 @@ std::size_t count(const LSystem& system, const Word& word, std::string_view name
 
 /// A ball: the space a topiary model is given in the tests.
 struct Ball final : Environment {
-    glm::dvec3 centre{0.0, 1.2, 0.0};
-    double radius = 0.6;
+    glm::dvec3 centre{0.0, 0.8, 0.0};
+    double radius = 0.3;
     bool inside(const glm::dvec3& p) const override { return glm::length(p - centre) <= radius; }
 };
 
-/// The drawn branch length of `tree` (metres), and how much of it lies inside `space`
-/// (each segment sampled at 20 points).
-std::pair<double, double> length_inside(const TreeGraph& tree, const Environment& space)
+/// The drawn branch length of `tree` (metres), and how much of it lies where `inside`
+/// says (each segment sampled at 20 points).
+template <class Inside>
+std::pair<double, double> length_inside(const TreeGraph& tree, const Inside& inside)
 {
     double all = 0.0, in = 0.0;
     for (std::size_t i = 1; i < tree.size(); ++i) {
@@ -59,7 +65,7 @@ std::pair<double, double> length_inside(const TreeGraph& tree, const Environment
         const double piece = glm::length(b - a) / 20.0;
         for (int k = 0; k < 20; ++k) {
             all += piece;
-            if (space.inside(a + (b - a) * ((k + 0.5) / 20.0))) in += piece;
+            if (inside(a + (b - a) * ((k + 0.5) / 20.0))) in += piece;
         }
     }
     return {all, in};
@@ -177,7 +183,7 @@ TEST(LSystemPresets, TheLobeFillerPrunesWhatGrowsOutOfItsSpaceAndKeepsItsBranche
 {
     const LSystemFile f = load_preset("lobe-filler");
     ASSERT_TRUE(f.system.has_queries());
-    // The turtle starts at the origin, 0.6 m below a ball of radius 0.6 m: the trunk rises
+    // The turtle starts at the origin, 0.5 m below a ball of radius 0.3 m: the trunk rises
     // into it, then the crown grows until the ball prunes it.
     const Ball ball;
     DeriveOptions o;
@@ -187,13 +193,74 @@ TEST(LSystemPresets, TheLobeFillerPrunesWhatGrowsOutOfItsSpaceAndKeepsItsBranche
     TurtleOptions t;
     t.view = f.view;
     const TurtleResult r = interpret(f.system, in_ball, t);
-    const auto [all, in] = length_inside(r.tree, ball);
-    EXPECT_GT(all, 20.0);          // a crown, not a stick: tens of metres of twigs
-    EXPECT_GE(in / all, 0.98);     // only the trunk below the ball is outside
+    const auto [all, in] = length_inside(r.tree, [&](const glm::dvec3& p) { return ball.inside(p); });
+    EXPECT_GT(all, 10.0);      // a crown, not a stick: metres of twigs
+    EXPECT_GE(in / all, 0.95); // only the trunk below the ball (0.5 m) is outside
+    // Of the crown (above the ball's lowest point) nothing is outside: a shoot leaving a
+    // ball cannot point back into it, so every one that left was pruned.
+    double crown_out = 0.0;
+    for (std::size_t i = 1; i < r.tree.size(); ++i) {
+        const glm::dvec3 p(r.tree.nodes[i].position);
+        if (p.y > ball.centre.y - ball.radius && !ball.inside(p)) crown_out += 1.0;
+    }
+    EXPECT_EQ(crown_out, 0.0);
     EXPECT_GT(r.leaves.size(), 100u);
-    // Without a space nothing is pruned: the same model grows far larger.
+    // Without a space nothing is pruned: the same model grows well over twice as much (only
+    // the axes' lengths bound it).
     DeriveOptions free;
     free.answer_queries = query_answerer(f.system, f.view);
     const TurtleResult unpruned = interpret(f.system, derive(f.system, free), t);
-    EXPECT_GT(unpruned.segments, 4 * r.segments);
+    EXPECT_GT(unpruned.segments, 2 * r.segments);
+}
+
+TEST(LSystemPresets, TheLobeFillerGrownInALobeKeeps98PercentOfItsBranchLengthInsideIt)
+{
+    // A session with one lobe, an ellipsoid 0.8 × 0.7 × 0.8 m, and the lsystem grower with
+    // the lobe-filler preset; no trunk strokes, so the tree starts at the default trunk's
+    // base below the lobe.
+    Document doc;
+    doc.seed = 5;
+    TruthSurface s;
+    s.center = {0.0, 1.3, 0.0};
+    s.radii = {0.4, 0.35, 0.4};
+    LobeRecord lobe = LobeRecord::of_strokes(1);
+    lobe.model = std::make_shared<const LobeModel>(LobeModel{"ellipsoid.obj", truth_surface_mesh(s, 3)});
+    doc.lobes.push_back(std::move(lobe));
+    GrowerChoice choice;
+    choice.name = "lsystem";
+    choice.params["preset"] = std::string("lobe-filler");
+    set_scene_grower(doc, choice);
+    const BuiltTree tree = build_document_tree(doc);
+    ASSERT_EQ(tree.lobes.size(), 1u);
+    const lsystem::LobeEnvironment lobes(growth_lobes(doc, tree.lobes), glm::dvec3(0.0));
+    const auto in_lobe = [&](const glm::dvec3& p) { return lobes.lobe_at(glm::vec3(p)) >= 0; };
+    const TreeGraph& g = tree.growth.tree;
+    const auto [all, in] = length_inside(g, in_lobe);
+    // The trunk rises from the trunk base to the lobe outside it; of everything after the
+    // trunk's first node in the lobe (the crown), at least 98 % lies in the lobe.
+    std::size_t first_in = 0;
+    while (first_in < g.size() && !in_lobe(glm::dvec3(g.nodes[first_in].position))) ++first_in;
+    ASSERT_LT(first_in, g.size()) << "the trunk never reached the lobe";
+    const glm::dvec3 entry(g.nodes[first_in].position);
+    const double trunk = glm::length(entry - glm::dvec3(g.nodes[0].position));
+    EXPECT_GT(all, 10.0) << "a crown, not a stick";
+    EXPECT_GE(in / (all - trunk), 0.98) << "crown length " << all - trunk << " m, inside " << in << " m";
+    EXPECT_GT(tree.growth.leaves ? tree.growth.leaves->size() : 0u, 100u);
+}
+
+TEST(LSystemPresets, EveryPresetExportsAGlbThatPassesTheGltfValidator)
+{
+    const std::string out = test::temp_dir("lsystem-presets-glb");
+    for (const std::string& name : kPresets) {
+        SCOPED_TRACE(name);
+        const std::string glb = out + "/" + name + ".glb";
+        const test::CliRun r = test::run_cli("lsystem " + test::source_path("growth/data/lsystems/" + name + ".l") +
+                                             " --out " + glb);
+        ASSERT_EQ(r.code, 0) << r.out;
+        EXPECT_EQ(r.out.find("warning"), std::string::npos) << r.out; // the presets read without warnings
+        nlohmann::json report;
+        ASSERT_TRUE(test::validate_gltf(glb, report));
+        EXPECT_EQ(report["issues"]["numErrors"], 0) << test::describe_gltf_issues(report);
+        EXPECT_EQ(report["issues"]["numWarnings"], 0) << test::describe_gltf_issues(report);
+    }
 }
