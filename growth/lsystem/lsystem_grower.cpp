@@ -286,7 +286,7 @@ LSystemRun run_lsystem(const GrowerInput& in)
         const double top = lobes_top(in.lobes) - base.y;
         turtle.fit_height_m = in_lobes && top > 0.01 ? top : number_param(in.choice, "height_m").value_or(kDefaultFreeHeightM);
     }
-    TurtleResult drawn = interpret(run.system, interpretation_word(run.system, run.word, in.seed), turtle);
+    TurtleResult drawn = interpret(run.system, interpretation_word(run.system, run.word, derive_options), turtle);
     run.metres_per_unit = drawn.metres_per_unit;
 
     GrowthResult& g = run.growth;
