@@ -8,6 +8,7 @@
 // `lindenmayer` (tests/bench/lsystem_lindenmayer.cjs) and prints the medians side by side.
 #include <benchmark/benchmark.h>
 
+#include <chrono>
 #include <cstddef>
 #include <string>
 
@@ -16,6 +17,7 @@
 #include "app/export/tree_output.h"
 #include "core/settings.h"
 #include "growth/branch_geometry.h"
+#include "growth/radii.h"
 #include "growth/lsystem/lsystem.h"
 #include "growth/lsystem/turtle.h"
 
@@ -206,5 +208,49 @@ void BM_LSystemTreeGeometry(benchmark::State& state)
         state.counters["tris_LOD" + std::to_string(i)] = static_cast<double>(lod_triangles(g.lods[i]));
 }
 BENCHMARK(BM_LSystemTreeGeometry)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The bracketed tree of docs/lsystem-turtle.md's timings: `F → F[+F]F[-F]/(90)F` from `F`,
+// 7 steps (5⁷ = 78,125 segments) and 8 steps (390,625), tropism on, no widths; drawn as the
+// grower draws a free tree (scaled to 3 m, pipe-model radii), then branches and leaves at
+// the default settings' 3 LODs.
+constexpr const char* kBracketedTree = R"(
+Lsystem: 1
+derivation length: 7
+Axiom: F
+F --> F[+F]F[-F]/(90)F
+endlsystem
+)";
+
+void BM_LSystemBracketedTreeGeometry(benchmark::State& state)
+{
+    const LSystem system = parse_lsystem(kBracketedTree, "bracketed-tree.l");
+    DeriveOptions d;
+    d.steps = static_cast<int>(state.range(0));
+    const Word word = derive(system, d);
+    const TurtleSymbols symbols(system);
+    TurtleOptions t;
+    t.view = parse_view("angle increment: 25.7\ntropism direction: 0,-1,0\ninitial elasticity: 0.1\n", "bracketed-tree.v");
+    t.fit_height_m = 3.0;
+    const BranchSettings branches;
+    const LeafSettings leaves;
+    TreeGeometry g;
+    std::size_t segments = 0;
+    double turtle_ms = 0.0;
+    for (auto _ : state) {
+        const auto t0 = std::chrono::steady_clock::now();
+        TurtleResult r = interpret(symbols, word, t);
+        turtle_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        segments = r.segments;
+        assign_pipe_radii(r.tree, branches.pipe_exponent, branches.tip_radius_m);
+        build_tree_geometry_into(g, r.tree, branches, leaves, 1);
+        benchmark::DoNotOptimize(g);
+    }
+    state.SetItemsProcessed(static_cast<std::int64_t>(segments) * state.iterations());
+    state.counters["segments"] = static_cast<double>(segments);
+    state.counters["turtle_ms"] = turtle_ms / static_cast<double>(state.iterations());
+    for (std::size_t i = 0; i < g.lods.size(); ++i)
+        state.counters["tris_LOD" + std::to_string(i)] = static_cast<double>(lod_triangles(g.lods[i]));
+}
+BENCHMARK(BM_LSystemBracketedTreeGeometry)->Arg(7)->Arg(8)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 } // namespace
