@@ -1,0 +1,4 @@
+/* View of bush.l: the seed's angle; a light tropism down, as the seed's Fig. 5. */
+angle increment: 22.5
+tropism direction: 0,-1,0
+initial elasticity: 0.1
