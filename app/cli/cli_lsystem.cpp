@@ -17,6 +17,7 @@
 #include "core/atomic_file.h"
 #include "core/errors.h"
 #include "growth/lsystem/lsystem_grower.h"
+#include "growth/lsystem/presets.h"
 
 namespace lobe::cli {
 
@@ -25,6 +26,17 @@ GrowerChoice lsystem_file_choice(const std::string& path)
     GrowerChoice choice;
     choice.name = lsystem::kGrowerName;
     choice.version = lsystem_grower().version();
+    std::error_code exists_ec;
+    if (!std::filesystem::exists(path, exists_ec)) {
+        // A shipped preset's name where no file of that name is (docs/lsystems.md).
+        if (lsystem::find_preset(path)) {
+            choice.params["preset"] = path;
+            return choice;
+        }
+        std::string names;
+        for (const std::string& n : lsystem::preset_names()) names += (names.empty() ? "" : ", ") + n;
+        throw FileError(path, "no such file, nor a shipped L-system preset (" + names + ")");
+    }
     choice.params["source"] = read_file_limited(path, lsystem::kMaxFileBytes);
     choice.params["source_name"] = path;
     std::filesystem::path view(path);
@@ -80,7 +92,7 @@ void add_lsystem_command(CLI::App& app, int& exit_code)
         std::optional<int> steps;
     };
     auto a = std::make_shared<Args>();
-    cmd->add_option("FILE", a->file, "L-system file (.l); NAME.v beside it is its view file")->required();
+    cmd->add_option("FILE", a->file, "L-system file (.l; NAME.v beside it is its view file), or a shipped preset's name (docs/lsystems.md)")->required();
     cmd->add_option("-o,--out", a->out, "Output file: tree.glb (glTF binary) or tree.obj (with .mtl and PNG)")->required();
     cmd->add_option("--steps", a->steps, "Derivation steps (default: the file's derivation length)")
         ->check(CLI::Range(0, lsystem::kMaxDerivationLength));

@@ -1,4 +1,5 @@
 #include "growth/lsystem/lsystem_grower.h"
+#include "growth/lsystem/presets.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +10,6 @@
 #include <glm/common.hpp>
 
 #include "core/errors.h"
-#include "growth/embedded_data.h"
 #include "growth/lsystem/turtle.h"
 #include "growth/skeleton.h"
 
@@ -19,40 +19,6 @@ namespace lsystem {
 namespace {
 
 /// The built-in preset "default": a tree that fills the lobes (lengths in metres).
-constexpr char kDefaultText[] = R"(/* default: the lsystem grower's built-in tree. Lengths are metres.
-   A trunk T rises from the trunk base in steps of TS until it enters a lobe (at most MAXT
-   steps); there it becomes the crown apex A. An apex grows an internode when the
-   internode's end is inside the lobes, or when a lobe lies ahead of it within AHEADA (the
-   main axis) or AHEAD (its laterals), so branches cross the gaps between lobes they point at; else it dies with a leaf, so the
-   crown takes the lobes' shape. ?H and ?P tell an apex where it heads and where it is. A
-   leaves a lateral B at every node, turned by the golden angle; B leaves laterals C, which
-   carry the leaves (~l). Without lobes everywhere is inside, and the derivation length and
-   the counters bound the tree. */
-#define S 0.03
-#define TS 0.06
-#define MAXT 60
-#define AHEAD 0.4
-#define AHEADA 0.8
-#define W0 0.03
-#define WR 0.92
-#define BA 50
-#define CA 45
-#define MAXB 14
-#define MAXC 5
-
-Lsystem: 1
-derivation length: 60
-Axiom: !(W0)T(0)?H(0,0,0)?P(0,0,0)
-T(n) > ?H(u,v,t)?P(x,y,z) : inside(x,y,z) == 0 && n < MAXT --> F(TS)T(n+1)
-T(n) > ?H(u,v,t)?P(x,y,z) : inside(x,y,z) != 0 || n >= MAXT --> A(W0)
-A(w) > ?H(u,v,t)?P(x,y,z) : inside(x+S*u, y+S*v, z+S*t) || inside(x+AHEADA*u/2, y+AHEADA*v/2, z+AHEADA*t/2) || inside(x+AHEADA*u, y+AHEADA*v, z+AHEADA*t) --> !(w)F(S)[&(BA)B(w*0.6,0)?H(0,0,0)?P(0,0,0)]/(137.5)A(w*WR)
-A(w) > ?H(u,v,t)?P(x,y,z) : !(inside(x+S*u, y+S*v, z+S*t) || inside(x+AHEADA*u/2, y+AHEADA*v/2, z+AHEADA*t/2) || inside(x+AHEADA*u, y+AHEADA*v, z+AHEADA*t)) --> [&(60)~l(1)]
-B(w,n) > ?H(u,v,t)?P(x,y,z) : n < MAXB && (inside(x+0.8*S*u, y+0.8*S*v, z+0.8*S*t) || inside(x+AHEAD*u/2, y+AHEAD*v/2, z+AHEAD*t/2) || inside(x+AHEAD*u, y+AHEAD*v, z+AHEAD*t)) --> !(w)F(0.8*S)[+(CA)C(w*0.6,0)?H(0,0,0)?P(0,0,0)]/(180)B(w*WR,n+1)
-B(w,n) > ?H(u,v,t)?P(x,y,z) : n >= MAXB || !(inside(x+0.8*S*u, y+0.8*S*v, z+0.8*S*t) || inside(x+AHEAD*u/2, y+AHEAD*v/2, z+AHEAD*t/2) || inside(x+AHEAD*u, y+AHEAD*v, z+AHEAD*t)) --> [&(60)~l(1)]
-C(w,n) > ?H(u,v,t)?P(x,y,z) : n < MAXC && inside(x+0.6*S*u, y+0.6*S*v, z+0.6*S*t) != 0 --> !(w)F(0.6*S)[&(60)~l(1)]/(137.5)C(w*WR,n+1)
-C(w,n) > ?H(u,v,t)?P(x,y,z) : n >= MAXC || inside(x+0.6*S*u, y+0.6*S*v, z+0.6*S*t) == 0 --> [&(60)~l(1)]
-endlsystem
-)";
 
 constexpr char kPresetFolder[] = "lsystems/";
 
@@ -221,37 +187,25 @@ bool LobeEnvironment::inside(const glm::dvec3& p) const
 std::vector<std::string> preset_names()
 {
     std::vector<std::string> names{kDefaultPreset};
-    const std::string folder = kPresetFolder;
-    for (const EmbeddedFile& f : embedded_growth_data()) {
-        if (f.name.rfind(folder, 0) != 0 || f.name.size() < folder.size() + 3) continue;
-        if (f.name.compare(f.name.size() - 2, 2, ".l") != 0) continue;
-        const std::string n = f.name.substr(folder.size(), f.name.size() - folder.size() - 2);
-        if (n.find('/') == std::string::npos && n != kDefaultPreset) names.push_back(n);
-    }
-    std::sort(names.begin() + 1, names.end());
+    for (const Preset& p : presets())
+        if (p.name != kDefaultPreset) names.push_back(p.name);
     return names;
 }
 
 LSystemSource preset_source(const std::string& name)
 {
+    const Preset* p = find_preset(name);
+    if (!p) {
+        std::string list;
+        for (const std::string& n : preset_names()) list += (list.empty() ? "" : ", ") + n;
+        throw InvalidInput("no L-system preset \"" + name + "\" (presets: " + list + ")");
+    }
     LSystemSource src;
-    src.name = kPresetFolder + name + ".l";
-    src.view_name = kPresetFolder + name + ".v";
-    bool found = false;
-    for (const EmbeddedFile& f : embedded_growth_data()) {
-        if (f.name == src.name) {
-            src.text = std::string(f.text);
-            found = true;
-        } else if (f.name == src.view_name) {
-            src.view_text = std::string(f.text);
-            src.has_view = true;
-        }
-    }
-    if (!found && name == kDefaultPreset) {
-        src.text = kDefaultText;
-        found = true;
-    }
-    if (!found) throw InvalidInput("no L-system preset \"" + name + "\"");
+    src.name = std::string(kPresetFolder) + name + ".l";
+    src.view_name = std::string(kPresetFolder) + name + ".v";
+    src.text = std::string(p->lsystem);
+    src.view_text = std::string(p->view);
+    src.has_view = !p->view.empty();
     return src;
 }
 

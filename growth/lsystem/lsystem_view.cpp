@@ -124,6 +124,21 @@ void read_view_line(std::string_view clean, std::size_t p, std::size_t end, cons
         v.angle_increment_deg = 360.0 / f;
     } else if (label == "initial line width") {
         v.initial_line_width = numbers(1, true)[0];
+        std::size_t k = value.size();
+        while (k > 0 && is_letter(value[k - 1])) --k;
+        std::string unit;
+        for (const char c : value.substr(k)) unit += lower(c);
+        if (unit == "polygons" || unit == "polygon") v.width_unit = ViewSettings::WidthUnit::Model;
+        else if (unit.empty() || unit == "pixels" || unit == "pixel") v.width_unit = ViewSettings::WidthUnit::Pixels;
+        else src.fail(vb + k, "a line width is in 'pixels' or 'polygons', not '" + shorten(unit) + "'");
+    } else if (label == "line style") {
+        std::string style;
+        for (const char c : value)
+            if (!is_blank(c)) style += lower(c);
+        if (style == "pixel" || style == "pixels") v.width_unit = ViewSettings::WidthUnit::Pixels;
+        else if (style == "polygon" || style == "polygons" || style == "cylinder" || style == "cylinders")
+            v.width_unit = ViewSettings::WidthUnit::Model;
+        else src.fail(vb, "'line style' is pixel, polygon or cylinder, not '" + shorten(value) + "'");
     } else if (label == "line width increment") {
         v.line_width_increment = numbers(1, false)[0];
     } else if (label == "scale factor") {

@@ -401,22 +401,29 @@ void Walker::finish()
     TurtleResult& r = *out_;
     TreeGraph& tree = r.tree;
     double k = options_->metres_per_unit;
-    if (options_->fit_height_m > 0.0 && !tree.empty()) {
-        // The tree's height above its first node, else its largest extent.
+    double extent = 0.0; // the drawing's largest extent, model units
+    if (!tree.empty()) {
         glm::dvec3 lo(tree.nodes[0].position), hi = lo;
         for (const TreeNode& n : tree.nodes) {
             lo = glm::min(lo, glm::dvec3(n.position));
             hi = glm::max(hi, glm::dvec3(n.position));
         }
+        extent = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
+        // The tree's height above its first node, else its largest extent.
         double height = hi.y - static_cast<double>(tree.nodes[0].position.y);
-        if (!(height > 1e-9)) height = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
-        if (height > 1e-9 && std::isfinite(height)) k = options_->fit_height_m / height;
+        if (!(height > 1e-9)) height = extent;
+        if (options_->fit_height_m > 0.0 && height > 1e-9 && std::isfinite(height)) k = options_->fit_height_m / height;
     }
     r.metres_per_unit = k;
+    // Widths in model units scale with the model; cpfg's pixel widths are drawn as if the
+    // whole drawing were kPixelsAcrossDrawing pixels across.
+    const double radius_k = view_.width_unit == ViewSettings::WidthUnit::Model || !(extent > 1e-9) || !std::isfinite(extent)
+                                ? k
+                                : k * extent / kPixelsAcrossDrawing;
     const glm::dvec3 o = options_->origin;
     for (TreeNode& n : tree.nodes) {
         n.position = glm::vec3(o + k * glm::dvec3(n.position));
-        n.radius = static_cast<float>(k * static_cast<double>(n.radius));
+        n.radius = static_cast<float>(radius_k * static_cast<double>(n.radius));
     }
     for (std::size_t i = 0; i < r.leaves.size(); ++i) {
         PlacedLeaf& p = r.leaves[i];

@@ -29,8 +29,12 @@
 /// A step that would take the turtle more than 10⁹ units from the origin stops it (what is
 /// drawn so far is kept, with a message).
 ///
-/// Widths: the view file's initial line width, in model units; a node's radius is half the
-/// width of the segment that ends at it, times metres_per_unit. Tropism (ABOP §2.4), when the
+/// Widths: the view file's initial line width, then `!` and `#`; a node's radius is half the
+/// width of the segment that ends at it. Widths in model units (ViewSettings::width_unit,
+/// the view file's `polygons` or `line style: cylinder`) scale with the model (times
+/// metres_per_unit); cpfg's default, pixels, is drawn as if the whole drawing were
+/// kPixelsAcrossDrawing pixels across (about the size of the book's figures), so that the
+/// book's `!(10)` trunk is 2.5 % of the tree's largest extent across. Tropism (ABOP §2.4), when the
 /// view file gives one: after each drawn step H turns towards the tropism vector T by
 /// α = e·|H × T| radians (never past T), L and U with it, e the turtle's elasticity.
 ///
@@ -54,6 +58,9 @@
 #include "growth/lsystem/lsystem.h"
 
 namespace lobe::lsystem {
+
+/// How many pixels a drawing is across when its widths are cpfg's pixel widths (turtle.h).
+inline constexpr double kPixelsAcrossDrawing = 400.0;
 
 /// What the turtle does with a module.
 enum class TurtleOp : std::uint8_t {

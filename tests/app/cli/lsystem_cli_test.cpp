@@ -98,6 +98,7 @@ TEST(LSystemCli, SkeletonOutWritesTheTreeGraphInMetres)
 {
     const std::string dir = test::temp_dir("lsystem-cli-skeleton");
     write(dir + "/gap.l", "Lsystem: 1\nAxiom: !(0.5)F(1)f(1)F(2)\nendlsystem\n");
+    write(dir + "/gap.v", "line style: cylinder\n"); // widths in model units
     const test::CliRun r = run("lsystem " + dir + "/gap.l --height 4 --out " + dir + "/t.glb --skeleton-out " + dir + "/t.json");
     ASSERT_EQ(r.code, 0) << r.out;
     const nlohmann::json j = nlohmann::json::parse(read(dir + "/t.json"));
@@ -151,6 +152,20 @@ TEST(LSystemCli, GrowsInTheLobesOfASessionAndWithGrow)
     r = run("grow " + recording + " --grower subtrees --lsystem " + dir + "/topiary.l --out " + dir + "/h.glb");
     EXPECT_EQ(r.code, 1) << r.out;
     EXPECT_NE(r.out.find("--lsystem"), std::string::npos) << r.out;
+}
+
+TEST(LSystemCli, APresetsNameStandsForItsShippedFile)
+{
+    const std::string dir = test::temp_dir("lsystem-cli-preset");
+    const test::CliRun named = run("lsystem abop-monopodial --out " + dir + "/named.glb");
+    ASSERT_EQ(named.code, 0) << named.out;
+    const test::CliRun file =
+        run("lsystem " + test::source_path("growth/data/lsystems/abop-monopodial.l") + " --out " + dir + "/file.glb");
+    ASSERT_EQ(file.code, 0) << file.out;
+    EXPECT_EQ(read(dir + "/named.glb"), read(dir + "/file.glb"));
+    const test::CliRun neither = run("lsystem no-such-preset --out " + dir + "/x.glb");
+    EXPECT_NE(neither.code, 0);
+    EXPECT_NE(neither.out.find("no-such-preset"), std::string::npos) << neither.out;
 }
 
 TEST(LSystemCli, RenderDrawsAnLSystemFile)

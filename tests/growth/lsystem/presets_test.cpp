@@ -32,8 +32,8 @@ namespace fs = std::filesystem;
 namespace {
 
 const std::vector<std::string> kPresets = {
-    "abop-monopodial", "abop-sympodial", "bush",          "lobe-filler", "ordinary-tree",
-    "seaweed",         "stochastic-bush", "sympodial-tree", "willow",
+    "abop-monopodial", "abop-sympodial", "bush",           "default", "lobe-filler",
+    "ordinary-tree",   "seaweed",        "stochastic-bush", "sympodial-tree", "willow",
 };
 
 /// How many modules named `name` the word holds.

@@ -78,10 +78,12 @@ TurtleResult draw(const std::string& text, TurtleOptions options = {})
     return interpret(h.symbols(), h.word, options);
 }
 
+/// A view with `angle` as its increment and widths in model units.
 ViewSettings view_deg(double angle)
 {
     ViewSettings v;
     v.angle_increment_deg = angle;
+    v.width_unit = ViewSettings::WidthUnit::Model;
     return v;
 }
 
@@ -185,6 +187,7 @@ TEST(LSystemTurtle, WidthsBecomeRadiiInMetres)
 {
     TurtleOptions o;
     o.metres_per_unit = 0.5;
+    o.view.width_unit = ViewSettings::WidthUnit::Model;
     o.view.initial_line_width = 0.8;
     o.view.line_width_increment = 0.3;
     const TurtleResult r = draw("F!F#(0.4)F!(0.1)F#F", o);
@@ -196,6 +199,20 @@ TEST(LSystemTurtle, WidthsBecomeRadiiInMetres)
     // Widths never go below zero; a word without ! or # says so.
     EXPECT_FLOAT_EQ(draw("!(0.1)!!F").tree.nodes[1].radius, 0.0f);
     EXPECT_FALSE(draw("F+F").widths_set);
+}
+
+TEST(LSystemTurtle, PixelWidthsAreAShareOfTheDrawingsExtentWhateverItsScale)
+{
+    // cpfg's default: widths in pixels, the drawing kPixelsAcrossDrawing pixels across. A
+    // trunk of !(10) in a drawing 4 units tall is 10/400 of 4 units across, at any scale.
+    for (const double metres_per_unit : {0.01, 1.0, 30.0}) {
+        TurtleOptions o;
+        o.metres_per_unit = metres_per_unit;
+        const TurtleResult r = draw("!(10)F(3)!(5)F", o);
+        ASSERT_EQ(r.tree.size(), 3u);
+        EXPECT_NEAR(r.tree.nodes[1].radius, 0.5 * 10 / kPixelsAcrossDrawing * 4 * metres_per_unit, 1e-6 * metres_per_unit);
+        EXPECT_NEAR(r.tree.nodes[2].radius, 0.5 * 5 / kPixelsAcrossDrawing * 4 * metres_per_unit, 1e-6 * metres_per_unit);
+    }
 }
 
 TEST(LSystemTurtle, TropismBendsTowardsTheTropismVectorAndMoreWithLargerElasticity)
@@ -363,6 +380,7 @@ TEST(LSystemTurtle, FitsTheTreeToAHeightAroundItsOrigin)
     TurtleOptions o;
     o.origin = {1.0, 0.0, 2.0};
     o.fit_height_m = 3.0;
+    o.view.width_unit = ViewSettings::WidthUnit::Model;
     o.view.initial_line_width = 0.2;
     const TurtleResult r = draw("F(10)[+F(5)~l]F(10)@o(1)", o);
     EXPECT_NEAR(r.metres_per_unit, 0.15, 1e-9);
