@@ -8,8 +8,10 @@
 #include <variant>
 
 #include <glm/common.hpp>
+#include <glm/geometric.hpp>
 
 #include "core/errors.h"
+#include "core/random.h"
 #include "growth/lsystem/turtle.h"
 #include "growth/skeleton.h"
 
@@ -17,8 +19,6 @@ namespace lobe {
 namespace lsystem {
 
 namespace {
-
-/// The built-in preset "default": a tree that fills the lobes (lengths in metres).
 
 constexpr char kPresetFolder[] = "lsystems/";
 
@@ -209,6 +209,94 @@ LSystemSource preset_source(const std::string& name)
     return src;
 }
 
+namespace {
+
+/// Where a lobe's crown starts: the first skeleton node (in node order, so nearest the root
+/// along the trunk) inside the lobe, else the skeleton node nearest the lobe's centre.
+int crown_entry(const Skeleton& skeleton, const LobeEnvironment& lobe_env, const GrowthLobe& lobe)
+{
+    const std::vector<TreeNode>& nodes = skeleton.graph.nodes;
+    for (std::size_t k = 0; k < nodes.size(); ++k)
+        if (lobe_env.lobe_at(nodes[k].position) == 0) return static_cast<int>(k);
+    glm::dvec3 centre(0.0);
+    for (const glm::vec3& p : lobe.mesh.positions) centre += glm::dvec3(p);
+    if (!lobe.mesh.positions.empty()) centre /= static_cast<double>(lobe.mesh.positions.size());
+    int best = 0;
+    double best_d = std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < nodes.size(); ++k) {
+        const double d = glm::length(glm::dvec3(nodes[k].position) - centre);
+        if (d < best_d) {
+            best_d = d;
+            best = static_cast<int>(k);
+        }
+    }
+    return best;
+}
+
+/// Appends `crown` (its root at node `entry` of `g.tree`) to the tree, its nodes marked as
+/// grown in lobe `lobe`; its leaves too.
+void graft(GrowthResult& g, TurtleResult& crown, int entry, int lobe)
+{
+    const int offset = static_cast<int>(g.tree.nodes.size()) - 1; // crown node k → offset + k, k ≥ 1
+    for (std::size_t k = 1; k < crown.tree.nodes.size(); ++k) {
+        TreeNode n = crown.tree.nodes[k];
+        n.parent = n.parent == 0 ? entry : n.parent + offset;
+        n.lobe = lobe;
+        g.tree.nodes.push_back(n);
+    }
+    if (!g.leaves) g.leaves.emplace();
+    for (PlacedLeaf& leaf : crown.leaves) g.leaves->push_back(leaf);
+}
+
+/// A model that asks where it is, in lobes: the sketched skeleton (§5.1: trunk strokes, or
+/// the default trunk, with limbs into lobes it misses) and, in each lobe, the model derived
+/// and drawn from where the skeleton enters the lobe, heading along it, in the lobe alone.
+/// Radii come from the pipe model over the whole tree, so the trunk narrows into the crowns.
+void grow_crowns_on_skeleton(const GrowerInput& in, const LSystem& system, const ViewSettings& view,
+                             DeriveOptions derive_options, TurtleOptions turtle, LSystemRun& run)
+{
+    std::vector<TriangleMesh> meshes;
+    for (const GrowthLobe& l : in.lobes) meshes.push_back(l.mesh);
+    SkeletonOptions so;
+    so.spacing_m = in.settings.growth.skeleton_spacing_m;
+    Skeleton skeleton = build_skeleton(in.trunk_strokes, meshes, so);
+    GrowthResult& g = run.growth;
+    for (std::string& m : skeleton.messages) g.messages.push_back(std::move(m));
+    g.tree = skeleton.graph;
+    g.skeleton_nodes = g.tree.size();
+    g.lobes.assign(in.lobes.size(), LobeGrowthStats{});
+    g.leaves.emplace(); // the model's own leaves only (none without surfaces)
+    if (g.tree.empty()) return;
+    for (std::size_t i = 0; i < in.lobes.size(); ++i) {
+        const int entry = crown_entry(skeleton, LobeEnvironment({in.lobes[i]}, glm::dvec3(0.0)), in.lobes[i]);
+        const TreeNode& at = g.tree.nodes[static_cast<std::size_t>(entry)];
+        const glm::dvec3 origin(at.position);
+        glm::dvec3 heading(0.0, 1.0, 0.0);
+        if (at.parent >= 0) heading = origin - glm::dvec3(g.tree.nodes[static_cast<std::size_t>(at.parent)].position);
+        const LobeEnvironment lobe_env({in.lobes[i]}, origin);
+        // Each lobe draws its own numbers: its seed, else the tree's keyed by the lobe's id.
+        derive_options.seed = in.lobes[i].seed.value_or(splitmix64(in.seed ^ splitmix64(static_cast<std::uint64_t>(in.lobes[i].id))));
+        derive_options.environment = &lobe_env;
+        derive_options.answer_queries = query_answerer(system, view, &lobe_env, heading);
+        const Word word = derive(system, derive_options);
+        turtle.origin = origin;
+        turtle.heading = heading;
+        turtle.max_nodes = in.max_tree_nodes > g.tree.size() ? in.max_tree_nodes - g.tree.size() : 0;
+        if (turtle.max_nodes == 0) {
+            g.messages.push_back("lobe " + std::to_string(i + 1) + ": the tree's node cap is reached; not grown");
+            continue;
+        }
+        TurtleResult crown = interpret(system, interpretation_word(system, word, derive_options), turtle);
+        for (std::string& m : crown.messages) g.messages.push_back("lobe " + std::to_string(i + 1) + ": " + m);
+        g.lobes[i].nodes = crown.tree.empty() ? 0 : crown.tree.size() - 1;
+        graft(g, crown, entry, static_cast<int>(i));
+        run.word = word;
+    }
+    g.radii_set = false;
+}
+
+} // namespace
+
 LSystemRun run_lsystem(const GrowerInput& in)
 {
     kLSystemGrower.check_params(in.choice, "grower");
@@ -218,28 +306,31 @@ LSystemRun run_lsystem(const GrowerInput& in)
     run.system = parse_lsystem(src.text, src.name, &messages);
     const ViewSettings view = src.has_view ? parse_view(src.view_text, src.view_name, &messages) : ViewSettings{};
 
-    const glm::dvec3 base = trunk_base(in);
-    const LobeEnvironment environment(in.lobes, base);
     const bool in_lobes = !in.lobes.empty();
     DeriveOptions derive_options;
     if (const auto it = in.choice.params.find("steps"); it != in.choice.params.end())
         derive_options.steps = static_cast<int>(std::get<std::int64_t>(it->second));
     derive_options.seed = in.seed;
-    derive_options.environment = in_lobes ? &environment : nullptr;
-    if (run.system.has_queries()) derive_options.answer_queries = query_answerer(run.system, view, derive_options.environment);
-    run.word = derive(run.system, derive_options);
-
     TurtleOptions turtle;
     turtle.view = view;
-    turtle.origin = base;
     turtle.surface_length_m = in.settings.leaves.length_m;
     turtle.surface_width_m = in.settings.leaves.width_m;
     turtle.max_nodes = in.max_tree_nodes;
-    if (!(in_lobes && run.system.has_queries())) {
-        // Drawn in its own units, then scaled: to the lobes' top, or to the free height.
-        const double top = lobes_top(in.lobes) - base.y;
-        turtle.fit_height_m = in_lobes && top > 0.01 ? top : number_param(in.choice, "height_m").value_or(kDefaultFreeHeightM);
+    if (in_lobes && run.system.has_queries()) {
+        grow_crowns_on_skeleton(in, run.system, view, derive_options, turtle, run);
+        return run;
     }
+
+    // Free, or a model that does not ask where it is: one drawing from the trunk base, in
+    // its own units, scaled to the lobes' top or to the free height.
+    const glm::dvec3 base = trunk_base(in);
+    const LobeEnvironment environment(in.lobes, base);
+    derive_options.environment = in_lobes ? &environment : nullptr;
+    if (run.system.has_queries()) derive_options.answer_queries = query_answerer(run.system, view, derive_options.environment);
+    run.word = derive(run.system, derive_options);
+    turtle.origin = base;
+    const double top = lobes_top(in.lobes) - base.y;
+    turtle.fit_height_m = in_lobes && top > 0.01 ? top : number_param(in.choice, "height_m").value_or(kDefaultFreeHeightM);
     TurtleResult drawn = interpret(run.system, interpretation_word(run.system, run.word, derive_options), turtle);
     run.metres_per_unit = drawn.metres_per_unit;
 

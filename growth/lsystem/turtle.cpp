@@ -46,11 +46,34 @@ inline glm::dvec3 rotate(const glm::dvec3& v, const glm::dvec3& axis, double c, 
     return v * c + glm::cross(axis, v) * s + axis * (glm::dot(axis, v) * (1.0 - c));
 }
 
+} // namespace
+
+void start_frame(const glm::dvec3& heading, glm::dvec3& h, glm::dvec3& l, glm::dvec3& u)
+{
+    h = glm::dvec3(0.0, 1.0, 0.0);
+    l = glm::dvec3(-1.0, 0.0, 0.0);
+    const double n = glm::length(heading);
+    if (!(n > 1e-12) || !finite3(heading)) {
+        u = glm::cross(h, l);
+        return;
+    }
+    h = heading / n;
+    // L is horizontal: +Z × H, which is −X for H = +Y; for H along ±Z, −X.
+    const glm::dvec3 side = glm::cross(glm::dvec3(0.0, 0.0, 1.0), h);
+    const double s = glm::length(side);
+    l = s > 1e-9 ? side / s : glm::dvec3(-1.0, 0.0, 0.0);
+    u = glm::cross(h, l);
+}
+
+namespace {
+
 /// One walk of the turtle over a word: drawing into a TurtleResult, or answering queries.
 class Walker {
 public:
-    Walker(const TurtleSymbols& symbols, const ViewSettings& view) : symbols_(symbols), view_(view)
+    Walker(const TurtleSymbols& symbols, const ViewSettings& view, const glm::dvec3& heading)
+        : symbols_(symbols), view_(view)
     {
+        start_frame(heading, state_.h, state_.l, state_.u);
         const double a = view.angle_increment_deg * kDegToRad;
         default_cos_ = std::cos(a);
         default_sin_ = std::sin(a);
@@ -506,7 +529,7 @@ TurtleSymbols::TurtleSymbols(std::span<const std::string_view> names)
 TurtleResult interpret(const TurtleSymbols& symbols, const Word& word, const TurtleOptions& options)
 {
     TurtleResult result;
-    Walker walker(symbols, options.view);
+    Walker walker(symbols, options.view, options.heading);
     walker.draw_into(result, options);
     walker.walk(word);
     walker.finish();
@@ -518,17 +541,19 @@ TurtleResult interpret(const LSystem& system, const Word& word, const TurtleOpti
     return interpret(TurtleSymbols(system), word, options);
 }
 
-void answer_queries(const TurtleSymbols& symbols, Word& word, const ViewSettings& view, const Environment* environment)
+void answer_queries(const TurtleSymbols& symbols, Word& word, const ViewSettings& view, const Environment* environment,
+                    const glm::dvec3& heading)
 {
-    Walker walker(symbols, view);
+    Walker walker(symbols, view, heading);
     walker.answer_into(word.params.data(), environment);
     walker.walk(word);
 }
 
-std::function<void(Word&)> query_answerer(const LSystem& system, const ViewSettings& view, const Environment* environment)
+std::function<void(Word&)> query_answerer(const LSystem& system, const ViewSettings& view, const Environment* environment,
+                                          const glm::dvec3& heading)
 {
     auto symbols = std::make_shared<const TurtleSymbols>(system);
-    return [symbols, view, environment](Word& word) { answer_queries(*symbols, word, view, environment); };
+    return [symbols, view, environment, heading](Word& word) { answer_queries(*symbols, word, view, environment, heading); };
 }
 
 } // namespace lobe::lsystem

@@ -119,6 +119,8 @@ struct TurtleOptions {
     ViewSettings view;
     /// Where the model's origin is, metres, stage space; the model's axes are the stage's.
     glm::dvec3 origin{0.0};
+    /// The turtle's first heading (start_frame); +Y, the default, gives the frame above.
+    glm::dvec3 heading{0.0, 1.0, 0.0};
     /// Metres per model unit (positions, radii and disc sizes).
     double metres_per_unit = 1.0;
     /// When > 0: metres_per_unit is chosen instead so that the drawn tree is this tall (its
@@ -154,10 +156,16 @@ TurtleResult interpret(const LSystem& system, const Word& word, const TurtleOpti
 /// query with fewer parameters gets the first ones. The word is read as derived (before
 /// homomorphism). \throw InvalidInput as interpret.
 void answer_queries(const TurtleSymbols& symbols, Word& word, const ViewSettings& view,
-                    const Environment* environment = nullptr);
+                    const Environment* environment = nullptr, const glm::dvec3& heading = {0.0, 1.0, 0.0});
 
 /// answer_queries for DeriveOptions::answer_queries; `environment` must outlive it.
 std::function<void(Word&)> query_answerer(const LSystem& system, const ViewSettings& view,
-                                          const Environment* environment = nullptr);
+                                          const Environment* environment = nullptr,
+                                          const glm::dvec3& heading = {0.0, 1.0, 0.0});
+
+/// The turtle's first frame for a first heading: H = heading (normalised), L horizontal
+/// (+Z × H; −X when H is along ±Z), U = H × L. +Y gives H = +Y, L = −X, U = +Z; a zero or
+/// non-finite heading gives that too.
+void start_frame(const glm::dvec3& heading, glm::dvec3& h, glm::dvec3& l, glm::dvec3& u);
 
 } // namespace lobe::lsystem

@@ -207,6 +207,48 @@ TEST(LSystemGrower, TheDefaultRisesFromTheGroundAndFillsTheLobeAboveIt)
     EXPECT_GT(in_lobe, r.leaves->size() * 9 / 10);
 }
 
+TEST(LSystemGrower, EveryLobeGetsItsOwnCrownWhereTheSketchedSkeletonEntersIt)
+{
+    // Two lobes apart and a third high above: the default trunk reaches into each (with limbs
+    // where it misses one), and the model grows a crown from each entry, in that lobe alone.
+    GrowerInput in = lsystem_input({{"source", std::string(kTopiary)}});
+    in.lobes.push_back(sphere_lobe({0.6, 1.0, 0.0}, 0.3, 1));
+    in.lobes.push_back(sphere_lobe({-0.6, 1.1, 0.1}, 0.3, 2));
+    in.lobes.push_back(sphere_lobe({0.0, 1.9, 0.0}, 0.3, 3));
+    const GrowthResult r = lsystem_grower().grow(in);
+    ASSERT_EQ(r.lobes.size(), 3u);
+    ASSERT_GT(r.skeleton_nodes, 1u);
+    for (std::size_t i = 0; i < 3; ++i) {
+        EXPECT_GT(r.lobes[i].nodes, 20u) << "lobe " << i;
+        // The crown hangs from the skeleton: its first node's parent is a skeleton node.
+        TreeGraph crown;
+        crown.nodes.push_back(r.tree.nodes[0]);
+        std::size_t first = 0;
+        for (std::size_t k = r.skeleton_nodes; k < r.tree.size(); ++k) {
+            if (r.tree.nodes[k].lobe != static_cast<int>(i)) continue;
+            if (first == 0) {
+                first = k;
+                EXPECT_LT(r.tree.nodes[k].parent, static_cast<int>(r.skeleton_nodes)) << "lobe " << i;
+            }
+            TreeNode n = r.tree.nodes[k];
+            // Measured on its own: parents in this crown keep their place, its root stands for the entry.
+            n.parent = n.parent < static_cast<int>(r.skeleton_nodes) ? 0 : n.parent;
+            crown.nodes.push_back(n);
+        }
+        // Re-index the crown's parents (global → local).
+        std::map<int, int> local;
+        for (std::size_t k = r.skeleton_nodes, c = 1; k < r.tree.size(); ++k)
+            if (r.tree.nodes[k].lobe == static_cast<int>(i)) local[static_cast<int>(k)] = static_cast<int>(c++);
+        for (std::size_t c = 1; c < crown.nodes.size(); ++c)
+            if (crown.nodes[c].parent != 0) crown.nodes[c].parent = local.at(crown.nodes[c].parent);
+        crown.nodes[0].position = r.tree.nodes[static_cast<std::size_t>(r.tree.nodes[first].parent)].position;
+        const MeshRaycaster ray(in.lobes[i].mesh);
+        const auto [outside, total] = length_outside(crown, ray, -1.0);
+        EXPECT_GT(total, 1.0) << "lobe " << i;
+        EXPECT_LE(outside / total, 0.02) << "lobe " << i << ": " << outside << " of " << total << " m outside";
+    }
+}
+
 TEST(LSystemGrower, AModelThatDoesNotAskIsScaledToReachTheTopOfTheLobes)
 {
     GrowerInput in = lsystem_input({{"source", std::string("Lsystem: 1\nAxiom: F(3)[+F(2)]F(7)\nendlsystem\n")}});
