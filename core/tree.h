@@ -16,6 +16,11 @@ enum class TreeNodeKind : std::uint8_t {
     Root = 0,     ///< nodes[0]: the trunk base, on the ground
     Skeleton = 1, ///< on a sketched trunk stroke, or on the default trunk
     Grown = 2,    ///< grown by rule inside a lobe
+    /// Reached from its parent without a branch between them (an L-system's turtle moving
+    /// without drawing, `f` or `g`): it starts a branch of its own, as the root does, and
+    /// nothing is drawn from its parent to it. Its parent is where the move began, so the
+    /// graph stays one tree (radii, pruning and order work as for any node).
+    Detached = 3,
 };
 
 struct TreeNode {

@@ -558,7 +558,11 @@ std::vector<char> keep_by_min_radius(const std::vector<BranchCurve>& curves, dou
     std::vector<char> keep(curves.size(), 1);
     for (std::size_t c = 0; c < curves.size(); ++c) {
         const int p = curves[c].parent;
-        if (p < 0) continue;
+        if (c == 0) continue; // the root curve
+        if (p < 0) { // from a Detached node: by its own radius
+            keep[c] = !curves[c].radii.empty() && static_cast<double>(curves[c].radii[0]) >= min_radius;
+            continue;
+        }
         const bool parent_kept = static_cast<std::size_t>(p) < c && keep[static_cast<std::size_t>(p)];
         keep[c] = parent_kept && !curves[c].radii.empty() && static_cast<double>(curves[c].radii[0]) >= min_radius;
     }
@@ -582,6 +586,7 @@ std::vector<BranchChain> decompose_branch_chains(const TreeGraph& graph)
         int best = -1;
         for (int k = ci.first[i]; k < ci.first[i + 1]; ++k) {
             const int c = ci.child[static_cast<std::size_t>(k)];
+            if (graph.nodes[static_cast<std::size_t>(c)].kind == TreeNodeKind::Detached) continue; // starts its own chain
             if (best < 0 || graph.nodes[static_cast<std::size_t>(c)].radius > graph.nodes[static_cast<std::size_t>(best)].radius)
                 best = c;
         }
@@ -597,9 +602,20 @@ std::vector<BranchChain> decompose_branch_chains(const TreeGraph& graph)
     index_in_chain[0] = 0;
     for (std::size_t i = 1; i < n; ++i) {
         const int p = graph.nodes[i].parent;
-        if (p < 0 || static_cast<std::size_t>(p) >= i || chain_of[static_cast<std::size_t>(p)] < 0) continue; // unreachable
+        if (p < 0 || static_cast<std::size_t>(p) >= i) continue; // unreachable
         const auto pu = static_cast<std::size_t>(p);
-        if (continuing[pu] == static_cast<int>(i)) {
+        if (graph.nodes[i].kind == TreeNodeKind::Detached) {
+            // Nothing joins it to its parent: a chain of its own, like the root's, when a
+            // drawn branch leaves it.
+            if (continuing[i] < 0) continue;
+            BranchChain ch;
+            ch.nodes = {static_cast<int>(i)};
+            chain_of[i] = static_cast<int>(chains.size());
+            index_in_chain[i] = 0;
+            chains.push_back(std::move(ch));
+        } else if (chain_of[pu] < 0) {
+            continue; // unreachable
+        } else if (continuing[pu] == static_cast<int>(i)) {
             BranchChain& ch = chains[static_cast<std::size_t>(chain_of[pu])];
             index_in_chain[i] = static_cast<int>(ch.nodes.size());
             chain_of[i] = chain_of[pu];
@@ -753,9 +769,12 @@ TreeGraph prune_twigs(const TreeGraph& graph, float min_radius_m, std::vector<in
     for (std::size_t c = 1; c < chains.size(); ++c) {
         const BranchChain& ch = chains[c];
         const bool parent_removed = ch.parent_chain >= 0 && removed_chain[static_cast<std::size_t>(ch.parent_chain)];
+        // A chain from a fork starts at the fork node, which stays; one from a Detached node
+        // starts at that node.
+        const std::size_t own = ch.parent_chain >= 0 ? 1 : 0;
         if (parent_removed || graph.nodes[static_cast<std::size_t>(ch.nodes[1])].radius < min_radius_m) {
             removed_chain[c] = 1;
-            for (std::size_t k = 1; k < ch.nodes.size(); ++k) removed[static_cast<std::size_t>(ch.nodes[k])] = 1;
+            for (std::size_t k = own; k < ch.nodes.size(); ++k) removed[static_cast<std::size_t>(ch.nodes[k])] = 1;
         }
     }
     TreeGraph out;
@@ -795,7 +814,7 @@ double lod_triangle_budget(int lod)
 
 void build_tree_geometry_into(TreeGeometry& geo, const TreeGraph& graph, const BranchSettings& branches,
                               const LeafSettings& leaves, std::uint64_t seed, const std::string& species,
-                              const LobeLeafOverrides& lobe_leaves)
+                              const LobeLeafOverrides& lobe_leaves, const std::vector<PlacedLeaf>* placed_leaves)
 {
     if (branches.lod_count < 1 || branches.lod_count > 6) throw InvalidInput("tree geometry: lod_count must be in [1, 6]");
     check_mesh_options(branch_lod_options(branches, 0));
@@ -816,7 +835,9 @@ void build_tree_geometry_into(TreeGeometry& geo, const TreeGraph& graph, const B
         // Leaves: at most the most leaves per tip (the tree's or a lobe's) at every tip.
         int most = std::max(0, leaves.per_node);
         for (const LobeLeafOverride& o : lobe_leaves) most = std::max(most, o.per_node.value_or(0));
-        const double leaf_count = most > 0 ? static_cast<double>(leaf_tip_nodes(graph).size()) * most : 0.0;
+        const double leaf_count = placed_leaves ? static_cast<double>(placed_leaves->size())
+                                  : most > 0    ? static_cast<double>(leaf_tip_nodes(graph).size()) * most
+                                                : 0.0;
         double triangles = 2.0 * leaf_count;
         for (const RingRange& r : ranges)
             if (r.count >= 2) triangles += 2.0 * lod0.radial_segments * (r.count - 1.0) + 2.0 * lod0.radial_segments;
@@ -825,7 +846,8 @@ void build_tree_geometry_into(TreeGeometry& geo, const TreeGraph& graph, const B
                                " triangles, more than the " + std::to_string(kMaxTreeTriangles) +
                                " allowed (lower max_nodes, radial_segments or leaves per node)");
     }
-    const LeafCloud cloud = make_leaf_cloud(graph, leaves, seed, lobe_leaves);
+    const LeafCloud cloud =
+        placed_leaves ? make_placed_leaf_cloud(*placed_leaves, seed) : make_leaf_cloud(graph, leaves, seed, lobe_leaves);
 
     // Nothing can throw past this point: `geo` is only changed when the whole build succeeds.
     geo.species = species;
@@ -867,8 +889,11 @@ void build_tree_geometry_into(TreeGeometry& geo, const TreeGraph& graph, const B
         const double branch_budget = budget - static_cast<double>(out.leaves.triangle_count());
         for (std::size_t c = 0; c < curves.size(); ++c) {
             const int p = curves[c].parent;
-            eff[c] = p < 0 ? std::numeric_limits<double>::infinity()
-                           : std::min(static_cast<double>(curves[c].radii[0]), eff[static_cast<std::size_t>(p)]);
+            // The root curve is always kept; a curve from a Detached node (p < 0, c > 0) is
+            // pruned by its own radius.
+            eff[c] = c == 0  ? std::numeric_limits<double>::infinity()
+                     : p < 0 ? static_cast<double>(curves[c].radii[0])
+                             : std::min(static_cast<double>(curves[c].radii[0]), eff[static_cast<std::size_t>(p)]);
             length[c] = ranges[c].count ? samples[ranges[c].first + ranges[c].count - 1].arc : 0.0f;
         }
         double all = 0.0;
@@ -895,7 +920,7 @@ void build_tree_geometry_into(TreeGeometry& geo, const TreeGraph& graph, const B
             const int p = curves[c].parent;
             if (p >= 0 && !keep_curve[static_cast<std::size_t>(p)]) continue; // only below a kept parent
             const double t = static_cast<double>(curve_triangles(curves[c], ranges[c].count, o.radial_segments));
-            if (p >= 0 && used + t > branch_budget) break; // the root curve is always kept
+            if (c != 0 && used + t > branch_budget) break; // the root curve is always kept
             used += t;
             keep_curve[c] = 1;
         }
@@ -904,10 +929,11 @@ void build_tree_geometry_into(TreeGeometry& geo, const TreeGraph& graph, const B
 }
 
 TreeGeometry build_tree_geometry(const TreeGraph& graph, const BranchSettings& branches, const LeafSettings& leaves,
-                                 std::uint64_t seed, const std::string& species, const LobeLeafOverrides& lobe_leaves)
+                                 std::uint64_t seed, const std::string& species, const LobeLeafOverrides& lobe_leaves,
+                                 const std::vector<PlacedLeaf>* placed_leaves)
 {
     TreeGeometry geo;
-    build_tree_geometry_into(geo, graph, branches, leaves, seed, species, lobe_leaves);
+    build_tree_geometry_into(geo, graph, branches, leaves, seed, species, lobe_leaves, placed_leaves);
     return geo;
 }
 

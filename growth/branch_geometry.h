@@ -27,17 +27,21 @@ namespace lobe {
 
 /// A branch: a path through the graph from its base to a tip. At each fork the child whose
 /// radius is largest (ties: the lowest index) continues the chain; every other child starts
-/// a chain of its own whose first point is the fork node.
+/// a chain of its own whose first point is the fork node. A TreeNodeKind::Detached node
+/// (core/tree.h: reached without drawing) never continues its parent's chain: it starts a
+/// chain of its own, with no parent chain, as the root does.
 struct BranchChain {
     std::vector<int> nodes; ///< node indices, base to tip; for a chain that starts at a fork, nodes[0] is the fork (parent) node
-    int parent_chain = -1;  ///< chain holding nodes[0] as an interior point; -1 for the chain from the root
+    int parent_chain = -1;  ///< chain holding nodes[0] as an interior point; -1 for the chain from the root and those from Detached nodes
     int fork_index = -1;    ///< index of nodes[0] in the parent chain's `nodes`; -1 for the root chain
     int sibling_ordinal = 0; ///< 1-based rank among the chains starting at the same fork (the continuing child is rank 0)
     int sibling_count = 1;   ///< number of children of the fork node
 };
 
 /// Cuts `graph` into branch chains. Chains come in topological order: a chain's parent
-/// chain precedes it. Chains with fewer than two nodes (a lone root) are not returned.
+/// chain precedes it. Chains with fewer than two nodes (a lone root, a Detached node no drawn
+/// branch leaves) are not returned, except the root's (chains[0]) when only Detached nodes
+/// leave the root: it is then one node and draws nothing.
 /// \pre the graph's parents precede their children (TreeGraph).
 std::vector<BranchChain> decompose_branch_chains(const TreeGraph& graph);
 
@@ -143,9 +147,13 @@ inline constexpr std::size_t kMaxTreeTriangles = 50000000;
 /// [1, 6], radial_segments outside [3, 1024], ring_spacing_m ≤ 0, an unknown leaf shape, a
 /// lobe override make_leaf_cloud refuses, or a LOD0 beyond kMaxTreeTriangles.
 /// `lobe_leaves`: per-lobe leaf length, count and seed (make_leaf_cloud).
+/// `placed_leaves` (when not null): the leaves a grower placed itself (GrowthResult::leaves),
+/// drawn instead of the leaves at the tips (make_placed_leaf_cloud); `leaves` then gives only
+/// the texture's shape and the colour, `lobe_leaves` is not used.
 TreeGeometry build_tree_geometry(const TreeGraph& graph, const BranchSettings& branches, const LeafSettings& leaves,
                                  std::uint64_t seed, const std::string& species = {},
-                                 const LobeLeafOverrides& lobe_leaves = {});
+                                 const LobeLeafOverrides& lobe_leaves = {},
+                                 const std::vector<PlacedLeaf>* placed_leaves = nullptr);
 
 /// build_tree_geometry into an existing TreeGeometry, reusing the storage of its meshes: a
 /// caller that regrows the tree often (the editor, while the person sketches) keeps two
@@ -154,6 +162,7 @@ TreeGeometry build_tree_geometry(const TreeGraph& graph, const BranchSettings& b
 /// \throw InvalidInput as build_tree_geometry.
 void build_tree_geometry_into(TreeGeometry& out, const TreeGraph& graph, const BranchSettings& branches,
                               const LeafSettings& leaves, std::uint64_t seed, const std::string& species = {},
-                              const LobeLeafOverrides& lobe_leaves = {});
+                              const LobeLeafOverrides& lobe_leaves = {},
+                              const std::vector<PlacedLeaf>* placed_leaves = nullptr);
 
 } // namespace lobe

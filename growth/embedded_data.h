@@ -1,6 +1,7 @@
 #pragma once
 /// \file embedded_data.h
-/// The files of growth/data/ (subtree library, species presets), compiled into the program.
+/// The files of growth/data/ (subtree library, species presets, L-system presets), compiled
+/// into the program.
 
 #include <string>
 #include <string_view>
@@ -9,7 +10,8 @@
 namespace lobe {
 
 struct EmbeddedFile {
-    std::string name;      ///< path relative to growth/data/, e.g. "species/broadleaf.json"
+    std::string name;      ///< path relative to growth/data/, e.g. "species/broadleaf.json",
+                           ///< "lsystems/willow.l"
     std::string_view text; ///< the file's bytes
 };
 

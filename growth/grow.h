@@ -22,6 +22,7 @@
 #include "core/mesh.h"
 #include "core/settings.h"
 #include "core/tree.h"
+#include "growth/leaves.h"
 #include "growth/skeleton.h"
 #include "growth/subtree_library.h"
 
@@ -55,6 +56,12 @@ struct GrowthResult {
     std::size_t skeleton_nodes = 0;
     std::vector<LobeGrowthStats> lobes;
     std::vector<std::string> messages; ///< one line each (skeleton messages, caps hit)
+    /// The grower set every node's radius itself (an L-system's widths): the pipe model
+    /// (growth/radii.h) is not applied. False: radii are left to the caller.
+    bool radii_set = false;
+    /// Leaves the grower placed itself (an L-system's surfaces), drawn instead of the leaves
+    /// at the tips; nullopt: leaves at the tips (growth/leaves.h). An empty list: no leaves.
+    std::optional<std::vector<PlacedLeaf>> leaves;
 };
 
 /// Most nodes a single piece's cluster split may make (⌈θh/t⌉ × ⌈θv/t⌉ is capped to this).

@@ -3,6 +3,7 @@
 #include <array>
 
 #include "core/errors.h"
+#include "growth/lsystem/lsystem_grower.h"
 #include "growth/selforg/selforg_grower.h"
 #include "growth/subtree_library.h"
 
@@ -39,25 +40,30 @@ public:
 };
 
 const SubtreeGrower kSubtrees;
-const std::array<const Grower*, 2> kGrowers{&kSubtrees, &self_organizing_grower()};
 
 } // namespace
 
-std::span<const Grower* const> growers() { return kGrowers; }
+std::span<const Grower* const> growers()
+{
+    // Made on first use: the list is ready whichever static initialiser asks first.
+    static const std::array<const Grower*, 3> list{&kSubtrees, &lsystem_grower(), &self_organizing_grower()};
+    return list;
+}
 
 const Grower* find_grower(std::string_view name)
 {
-    for (const Grower* g : kGrowers)
+    for (const Grower* g : growers())
         if (g->name() == name) return g;
     return nullptr;
 }
 
 std::string grower_names()
 {
+    const auto list = growers();
     std::string out;
-    for (std::size_t i = 0; i < kGrowers.size(); ++i) {
-        if (i > 0) out += i + 1 == kGrowers.size() ? " and " : ", ";
-        out += kGrowers[i]->name();
+    for (std::size_t i = 0; i < list.size(); ++i) {
+        if (i > 0) out += i + 1 == list.size() ? " and " : ", ";
+        out += list[i]->name();
     }
     return out;
 }

@@ -260,6 +260,27 @@ LeafCloud make_leaf_cloud(const TreeGraph& graph, const LeafSettings& leaves, st
     return cloud;
 }
 
+LeafCloud make_placed_leaf_cloud(const std::vector<PlacedLeaf>& placed, std::uint64_t seed)
+{
+    auto finite3 = [](const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+    LeafCloud cloud;
+    cloud.per_node = 1;
+    cloud.leaves.reserve(placed.size());
+    // Keyed apart from the tip leaves' streams (leaf_stream's lobe −2 is used by no lobe).
+    constexpr int kPlacedStream = -2;
+    for (std::size_t i = 0; i < placed.size(); ++i) {
+        const PlacedLeaf& p = placed[i];
+        if (!finite3(p.base) || !finite3(p.axis) || !finite3(p.across) || !(p.length_m > 0.0f) || !(p.width_m > 0.0f) ||
+            !std::isfinite(p.length_m) || !std::isfinite(p.width_m))
+            throw InvalidInput("leaves: placed leaf " + std::to_string(i) + " has a non-finite position or direction, or a size not > 0");
+        SplitMix64 rng = leaf_stream(seed, kPlacedStream, i);
+        const auto keep_offset = static_cast<float>(rng.uniform());
+        cloud.leaves.push_back({p.base, p.axis, p.across, p.node, 0, 1, keep_offset, static_cast<double>(p.length_m),
+                                static_cast<double>(p.width_m)});
+    }
+    return cloud;
+}
+
 namespace {
 void check_keep(double keep)
 {

@@ -90,6 +90,24 @@ struct LeafCloud {
 LeafCloud make_leaf_cloud(const TreeGraph& graph, const LeafSettings& leaves, std::uint64_t seed,
                           const LobeLeafOverrides& per_lobe = {});
 
+/// A leaf a grower placed itself (an L-system's surfaces, growth/lsystem/turtle.h) instead
+/// of the leaves at the tips.
+struct PlacedLeaf {
+    glm::vec3 base{0.0f};   ///< metres, stage space: the middle of the leaf's base edge
+    glm::vec3 axis{0.0f, 1.0f, 0.0f};   ///< unit, from the base to the leaf's tip
+    glm::vec3 across{1.0f, 0.0f, 0.0f}; ///< unit, normal to axis: the base edge's direction
+    float length_m = 0.0f;  ///< > 0
+    float width_m = 0.0f;   ///< > 0
+    int node = 0;           ///< the tree node it grew from (reported as the quad's node)
+};
+
+/// The LOD0 leaves of `placed`, one per placement in order: each is its own "tip" of one leaf
+/// (per_node 1), its keep offset drawn from a stream keyed by (seed, its index), so coarser
+/// LODs keep each leaf with probability keep_fraction (emit_leaf_quads) and every LOD thins
+/// the same leaves whatever else changed.
+/// 	hrow InvalidInput for a leaf with a non-finite position or direction, or a size not > 0.
+LeafCloud make_placed_leaf_cloud(const std::vector<PlacedLeaf>& placed, std::uint64_t seed);
+
 /// Number of quads emit_leaf_quads writes for `keep_fraction`.
 std::size_t count_leaf_quads(const LeafCloud& cloud, double keep_fraction);
 

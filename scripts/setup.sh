@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages Lobesketch needs (only those missing, quietly), the Khronos
-# glTF validator the export tests run (npm, pinned, into build/tools/gltf-validator) and
-# builds the given CMake preset (default: release). Safe to run again and again.
+# glTF validator the export tests run (npm, pinned, into build/tools/gltf-validator), the npm
+# L-system library scripts/lsystem-compare.sh runs (build/tools/lindenmayer) and builds the
+# given CMake preset (default: release). Safe to run again and again.
 #
 # The preset `demo` (scripts/demo.sh) installs only what building and running `lobesketch`
 # needs and builds only that program, into build/release: no test frameworks, sanitizer
@@ -65,6 +66,20 @@ if [ "$installed" != "$GLTF_VALIDATOR_VERSION" ]; then
   mkdir -p "$GLTF_VALIDATOR_DIR"
   npm install --prefix "$GLTF_VALIDATOR_DIR" --no-audit --no-fund --save-exact --loglevel=error \
     "gltf-validator@$GLTF_VALIDATOR_VERSION" >/dev/null
+fi
+
+# The npm L-system library `lindenmayer`, pinned: scripts/lsystem-compare.sh runs it beside the
+# L-system benchmarks (docs/lsystems.md, Performance). A dev-time tool only.
+LINDENMAYER_VERSION="1.5.4"
+LINDENMAYER_DIR="build/tools/lindenmayer"
+installed="$(node -p "require('./$LINDENMAYER_DIR/node_modules/lindenmayer/package.json').version" 2>/dev/null || true)"
+if [ "$installed" != "$LINDENMAYER_VERSION" ]; then
+  echo "setup: installing lindenmayer@$LINDENMAYER_VERSION into $LINDENMAYER_DIR"
+  mkdir -p "$LINDENMAYER_DIR"
+  # Only the comparison script needs it: a failed install is said and does not stop the setup.
+  npm install --prefix "$LINDENMAYER_DIR" --no-audit --no-fund --save-exact --loglevel=error \
+    "lindenmayer@$LINDENMAYER_VERSION" >/dev/null ||
+    echo "setup: could not install lindenmayer (only scripts/lsystem-compare.sh needs it)" >&2
 fi
 
 cmake --preset "$PRESET" >/dev/null

@@ -19,6 +19,7 @@
 #include "core/settings_json.h"
 #include "core/settings_table.h"
 #include "growth/grower.h"
+#include "growth/lsystem/lsystem_grower.h"
 #include "growth/selforg/selforg_grower.h"
 #include "growth/species.h"
 #include "input/pipeline.h"
@@ -132,6 +133,8 @@ void add_tree_input_options(CLI::App* cmd, TreeInputOptions& o)
     cmd->add_option("--grower", o.grower, "Growth model: " + grower_names() + " (default: the session's, else " +
                                               std::string(kDefaultGrowerName) + ")")
         ->check(CLI::IsMember(names));
+    cmd->add_option("--lsystem", o.lsystem,
+                    "L-system file (cpfg's .l, with NAME.v beside it) for the lsystem grower; implies --grower lsystem");
     cmd->add_option("--set", o.set,
                     "Sets one setting (repeatable): growth.split_angle_deg=25, leaves.color=0.2,0.4,0.1. Applied "
                     "after --settings and --species, in the order given, before --split-angle and "
@@ -233,7 +236,20 @@ bool is_mesh_file(const std::string& path)
 void apply_document_options(Document& doc, const TreeInputOptions& o)
 {
     if (o.seed) doc.seed = *o.seed;
+    const char* only_selforg = o.environment ? "--environment" : o.bud_fate ? "--bud-fate" : o.iterations ? "--iterations" : nullptr;
     const std::string selforg(self_organizing_grower().name());
+    if (!o.lsystem.empty()) {
+        if (!o.grower.empty() && o.grower != lsystem::kGrowerName)
+            throw InvalidInput("--lsystem: an L-system file grows with --grower " + std::string(lsystem::kGrowerName) +
+                               ", not " + o.grower);
+        if (only_selforg)
+            throw InvalidInput(std::string(only_selforg) + " is only valid with --grower " + selforg + " (the grower is " +
+                               std::string(lsystem::kGrowerName) + ")");
+        GrowerChoice choice = lsystem_file_choice(o.lsystem);
+        if (o.height) choice.params["height_m"] = *o.height;
+        set_scene_grower(doc, std::move(choice));
+        return;
+    }
     GrowerChoice choice;
     if (!o.grower.empty()) {
         choice.name = o.grower;
@@ -241,7 +257,6 @@ void apply_document_options(Document& doc, const TreeInputOptions& o)
     } else {
         choice = scene_grower(doc);
     }
-    const char* only_selforg = o.environment ? "--environment" : o.bud_fate ? "--bud-fate" : o.iterations ? "--iterations" : nullptr;
     if (only_selforg && choice.name != selforg)
         throw InvalidInput(std::string(only_selforg) + " is only valid with --grower " + selforg + " (the grower is " +
                            choice.name + ")");

@@ -44,13 +44,15 @@ struct TreeInputOptions {
     std::optional<std::uint64_t> seed;
     std::optional<double> split_angle, spacing;
     double mesh_size = 1.5; ///< a mesh input's largest side (metres)
+    std::string lsystem;    ///< `--lsystem FILE.l`: the lsystem grower with that file (empty: none)
+    std::optional<double> height; ///< an L-system tree grown without lobes is this tall (metres)
     /// The self-organizing grower's parameters (growth/selforg/selforg_grower.h); only with
     /// that grower. `--species` also sets its `species` when it names one of its presets.
     std::optional<std::string> environment, bud_fate;
     std::optional<std::int64_t> iterations;
 };
 
-/// Registers --settings, --species, --grower, --set, --seed, --split-angle,
+/// Registers --settings, --species, --grower, --lsystem, --set, --seed, --split-angle,
 /// --attractor-spacing, and the self-organizing grower's --environment, --bud-fate and
 /// --iterations. The help and range checks of --set, --split-angle and
 /// --attractor-spacing come from the settings table: a bad value is a bad command line (exit
@@ -71,8 +73,11 @@ void apply_tree_input_options(Settings& s, const TreeInputOptions& o);
 /// Applies the options that are the document's rather than its settings': --seed and
 /// --grower (the scene's tree grows with that grower and its default parameters, or those
 /// --environment, --bud-fate, --iterations and --species give the self-organizing grower;
-/// without --grower they change the session's self-organizing grower).
-/// \throw InvalidInput (one line) for a self-organizing option with another grower.
+/// without --grower they change the session's self-organizing grower); --lsystem FILE.l
+/// makes it the lsystem grower with that file (lsystem_file_choice).
+/// \throw FileError for an unreadable --lsystem file; InvalidInput when --grower names
+/// another grower than lsystem beside --lsystem, or (one line) for a self-organizing option
+/// with another grower.
 void apply_document_options(Document& doc, const TreeInputOptions& o);
 
 /// The local time as "YYYYMMDD-HHMMSS", for default file names.
@@ -103,6 +108,26 @@ struct GrownInput {
 /// \throw FileError, InvalidInput
 GrownInput grow_input_tree(const std::string& input, const TreeInputOptions& o);
 
+/// The lsystem grower's choice for the L-system file `path`: its text as `source`, the path
+/// as `source_name`, the view file beside it (NAME.v) as `view` when there is one.
+/// \throw FileError when a file cannot be read or is larger than lsystem::kMaxFileBytes.
+GrowerChoice lsystem_file_choice(const std::string& path);
+
+/// An L-system file's tree, and what else its growth gives.
+struct LSystemGrown {
+    GrownInput grown;
+    std::string word;        ///< the derived word as text (lsystem::to_string)
+    std::size_t modules = 0; ///< its modules
+    double grow_ms = 0.0;    ///< derivation and turtle, milliseconds
+};
+
+/// Grows the L-system file `path` (`lsystem`, `render FILE.l`): alone, or in the lobes of the
+/// session `lobes_session` (its trunk strokes, settings and seed); --settings, --set, --seed
+/// and --height of `o` applied. The reader's and the turtle's warnings go to stderr, one line
+/// each. \throw FileError, InvalidInput (a malformed file: one line naming file, line and column)
+LSystemGrown grow_lsystem_file(const std::string& path, const std::string& lobes_session, std::optional<int> steps,
+                               const TreeInputOptions& o);
+
 // Subcommand registration; each sets `exit_code` when it runs.
 void add_info_command(CLI::App& app, int& exit_code);
 void add_replay_command(CLI::App& app, int& exit_code);
@@ -113,5 +138,6 @@ void add_grow_command(CLI::App& app, int& exit_code);
 void add_export_command(CLI::App& app, int& exit_code);
 void add_render_command(CLI::App& app, int& exit_code);
 void add_desktop_command(CLI::App& app, int& exit_code);
+void add_lsystem_command(CLI::App& app, int& exit_code);
 
 } // namespace lobe::cli

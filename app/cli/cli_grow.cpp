@@ -66,7 +66,7 @@ void report_and_write(const TreeArgs& a, const Document& doc, const BuiltTree& t
                       int& exit_code)
 {
     for (const std::string& w : tree.warnings) warn(input + ": " + w);
-    if (tree.lobes.empty() || tree.growth.tree.size() <= tree.growth.skeleton_nodes) {
+    if (tree.growth.tree.size() <= tree.growth.skeleton_nodes) {
         error(input + ": no tree could be grown (no lobe could be built)");
         exit_code = kExitFailure;
         return;
@@ -89,8 +89,12 @@ void report_and_write(const TreeArgs& a, const Document& doc, const BuiltTree& t
         attractors += l.attractors;
         reached += l.reached;
     }
-    progress("grew " + std::to_string(tree.growth.tree.size()) + " nodes in " + std::to_string(tree.lobes.size()) +
-             " lobe(s), " + std::to_string(reached) + " of " + std::to_string(attractors) + " attractors reached");
+    if (attractors > 0)
+        progress("grew " + std::to_string(tree.growth.tree.size()) + " nodes in " + std::to_string(tree.lobes.size()) +
+                 " lobe(s), " + std::to_string(reached) + " of " + std::to_string(attractors) + " attractors reached");
+    else
+        progress("grew " + std::to_string(tree.growth.tree.size()) + " nodes (" + std::to_string(tree.lobes.size()) +
+                 " lobe(s))");
     progress("geometry in " + std::to_string(static_cast<int>(geometry_ms)) + " ms, triangles " + lod_triangle_summary(geometry));
     progress("wrote " + a.out);
     exit_code = kExitOk;

@@ -37,6 +37,7 @@ int run_cli(int argc, char** argv)
     cli::add_grow_command(app, exit_code);
     cli::add_export_command(app, exit_code);
     cli::add_render_command(app, exit_code);
+    cli::add_lsystem_command(app, exit_code);
     cli::add_desktop_command(app, exit_code);
     cli::add_vr_command(app, exit_code);
     cli::add_recover_command(app, exit_code);

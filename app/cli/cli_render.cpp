@@ -46,7 +46,8 @@ std::string frame_path(const std::string& out, int frame)
 void add_render_command(CLI::App& app, int& exit_code)
 {
     auto* cmd = app.add_subcommand(
-        "render", "Draw pictures (PNG) of the tree of a recording, a session document (.json), a mesh or a .glb");
+        "render", "Draw pictures (PNG) of the tree of a recording, a session document (.json), a mesh, an L-system "
+        "file (.l) or a .glb");
     struct Args {
         TreeInputOptions in;
         std::string input, out, view = "front", size = "1280x720", show = "tree,leaves";
@@ -54,7 +55,8 @@ void add_render_command(CLI::App& app, int& exit_code)
         bool software = false;
     };
     auto a = std::make_shared<Args>();
-    cmd->add_option("INPUT", a->input, "Recording, session document (.json), mesh (.obj/.ply/.off) or a .glb made by lobesketch")
+    cmd->add_option("INPUT", a->input,
+                    "Recording, session document (.json), mesh (.obj/.ply/.off), L-system (.l) or a .glb made by lobesketch")
         ->required();
     cmd->add_option("-o,--out", a->out, "Picture (.png); with --view orbit, OUT_000.png, OUT_001.png, …")->required();
     cmd->add_option("--view", a->view, "front (looks along -Z), side (along -X), top (down -Y) or orbit (a turntable)")
@@ -104,10 +106,14 @@ void add_render_command(CLI::App& app, int& exit_code)
                                 "--split-angle and --attractor-spacing do not apply");
             scene = glb_render_scene(a->input, content);
         } else {
-            const GrownInput grown = grow_input_tree(a->input, a->in);
+            // An L-system file grows alone (its messages printed as it grows); anything else
+            // as grow does.
+            const bool lsystem_file = lower_extension(a->input) == ".l";
+            const GrownInput grown =
+                lsystem_file ? grow_lsystem_file(a->input, "", std::nullopt, a->in).grown : grow_input_tree(a->input, a->in);
             for (const std::string& w : grown.tree.warnings) warn(a->input + ": " + w);
             const BuiltTree& tree = grown.tree;
-            if (tree.lobes.empty() || tree.growth.tree.size() <= tree.growth.skeleton_nodes) {
+            if (tree.growth.tree.size() <= tree.growth.skeleton_nodes) {
                 error(a->input + ": no tree could be grown (no lobe could be built)");
                 exit_code = kExitFailure;
                 return;

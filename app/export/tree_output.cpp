@@ -31,7 +31,8 @@ LobeLeafOverrides document_lobe_leaves(const Document& doc, const BuiltTree& tre
 TreeGeometry document_tree_geometry(const Document& doc, const BuiltTree& tree)
 {
     return build_tree_geometry(tree.growth.tree, branch_geometry_options(doc.settings), leaf_options(doc.settings), doc.seed,
-                               doc.settings.growth.species, document_lobe_leaves(doc, tree));
+                               doc.settings.growth.species, document_lobe_leaves(doc, tree),
+                               tree.growth.leaves ? &*tree.growth.leaves : nullptr);
 }
 
 std::size_t lod_triangles(const TreeLod& lod) { return lod.branches.triangle_count() + lod.leaves.triangle_count(); }

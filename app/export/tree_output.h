@@ -18,7 +18,8 @@ namespace lobe {
 LobeLeafOverrides document_lobe_leaves(const Document& doc, const BuiltTree& tree);
 
 /// Branch and leaf geometry of `tree` at every LOD, with the document's branch and leaf
-/// settings and seed, and each lobe's leaf overrides.
+/// settings and seed, and each lobe's leaf overrides; the leaves the grower placed itself
+/// when it did (GrowthResult::leaves).
 /// \throw InvalidInput as build_tree_geometry (growth/branch_geometry.h).
 TreeGeometry document_tree_geometry(const Document& doc, const BuiltTree& tree);
 

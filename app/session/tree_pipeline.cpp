@@ -41,10 +41,8 @@ std::vector<GrowthLobe> growth_lobes(const Document& doc, const std::vector<Buil
     return out;
 }
 
-BuiltTree grow_document_tree(const Document& doc, std::vector<BuiltLobe> lobes)
+GrowerInput document_grower_input(const Document& doc, const std::vector<BuiltLobe>& lobes)
 {
-    BuiltTree t;
-    t.lobes = std::move(lobes);
     std::vector<std::vector<glm::vec3>> trunk;
     for (const Stroke& s : effective_strokes(doc)) {
         if (s.kind != StrokeKind::Trunk) continue;
@@ -55,14 +53,29 @@ BuiltTree grow_document_tree(const Document& doc, std::vector<BuiltLobe> lobes)
     }
     GrowerInput in;
     in.trunk_strokes = std::move(trunk);
-    in.lobes = growth_lobes(doc, t.lobes);
+    in.lobes = growth_lobes(doc, lobes);
     in.settings = doc.settings;
     in.seed = doc.seed;
     in.choice = scene_grower(doc);
+    return in;
+}
+
+void finish_grown_tree(const Document& doc, BuiltTree& tree)
+{
+    if (!tree.growth.radii_set) {
+        const PipeRadiiOptions radii = pipe_radii_options(doc.settings);
+        assign_pipe_radii(tree.growth.tree, radii.exponent, radii.tip_radius_m);
+    }
+    for (const std::string& m : tree.growth.messages) tree.warnings.push_back("growth: " + m);
+}
+
+BuiltTree grow_document_tree(const Document& doc, std::vector<BuiltLobe> lobes)
+{
+    BuiltTree t;
+    t.lobes = std::move(lobes);
+    const GrowerInput in = document_grower_input(doc, t.lobes);
     t.growth = checked_grower(in.choice, "trees[0].grower").grow(in);
-    const PipeRadiiOptions radii = pipe_radii_options(doc.settings);
-    assign_pipe_radii(t.growth.tree, radii.exponent, radii.tip_radius_m);
-    for (const std::string& m : t.growth.messages) t.warnings.push_back("growth: " + m);
+    finish_grown_tree(doc, t);
     return t;
 }
 

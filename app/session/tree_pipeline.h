@@ -11,6 +11,7 @@
 
 #include "core/document.h"
 #include "growth/grow.h"
+#include "growth/grower.h"
 #include "app/session/lobe_document.h"
 
 namespace lobe {
@@ -26,8 +27,17 @@ struct BuiltTree {
 /// \throw InvalidInput for an unknown species or subtree name.
 std::vector<GrowthLobe> growth_lobes(const Document& doc, const std::vector<BuiltLobe>& lobes);
 
+/// What the document's grower is given (growth/grower.h): the trunk strokes as drawn and
+/// edited, growth_lobes of `lobes`, the settings, the seed and the grower choice (not checked).
+/// \throw InvalidInput as growth_lobes.
+GrowerInput document_grower_input(const Document& doc, const std::vector<BuiltLobe>& lobes);
+
+/// After the grower: pipe-model radii (growth/radii.h) unless the grower set its own
+/// (GrowthResult::radii_set), and the growth messages as warnings ("growth: …").
+void finish_grown_tree(const Document& doc, BuiltTree& tree);
+
 /// Grows the document's tree in `lobes` (already built) from its trunk strokes, with its
-/// grower. \throw InvalidInput when the document names a grower or parameters no grower
+/// grower: document_grower_input, the grower, finish_grown_tree. \throw InvalidInput when the document names a grower or parameters no grower
 /// takes (documents loaded with load_session are checked already).
 BuiltTree grow_document_tree(const Document& doc, std::vector<BuiltLobe> lobes);
 

@@ -73,7 +73,12 @@ struct Word {
 /// What the view file (`NAME.v` beside `NAME.l`) sets for the turtle; defaults as cpfg's.
 struct ViewSettings {
     double angle_increment_deg = 45.0; ///< `angle increment:` (or 360 / `angle factor:`)
-    double initial_line_width = 1.0;   ///< `initial line width:` (model units, see turtle.h)
+    double initial_line_width = 1.0;   ///< `initial line width:`, in width_unit
+    /// What a width is measured in. cpfg draws widths in screen pixels unless the view file
+    /// says `initial line width: W polygons` or `line style: polygon` / `cylinder`, when they
+    /// are in the model's units (turtle.h says how pixels become metres).
+    enum class WidthUnit : std::uint8_t { Pixels, Model };
+    WidthUnit width_unit = WidthUnit::Pixels;
     double line_width_increment = 1.0; ///< `line width increment:`, the step of `!` and `#` without a parameter
     double scale_factor = 1.0;         ///< `scale factor:`, multiplies the drawn model
     glm::dvec3 tropism_direction{0.0, -1.0, 0.0}; ///< `tropism direction:` (normalised when read)

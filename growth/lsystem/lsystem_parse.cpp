@@ -11,66 +11,11 @@
 #include "growth/lsystem/expr.h"
 #include "growth/lsystem/lsystem.h"
 #include "growth/lsystem/lsystem_impl.h"
+#include "growth/lsystem/lsystem_text.h"
 
 namespace lobe::lsystem {
 
-namespace {
-
-using detail::Expr;
-using detail::PatternModule;
-using detail::Production;
-using detail::ProductionSet;
-using detail::SourceText;
-using detail::SuccessorModule;
-
-/// Most warning lines one file gives; past it, one line says how many more there were.
-constexpr std::size_t kMaxWarnings = 200;
-
-bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v'; }
-bool is_name_start(char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_'; }
-bool is_name_char(char c) { return is_name_start(c) || (c >= '0' && c <= '9'); }
-bool is_letter(char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z'); }
-char lower(char c) { return (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 'A' + 'a') : c; }
-
-std::string shorten(std::string_view s)
-{
-    std::string out(s.substr(0, std::min<std::size_t>(s.size(), 60)));
-    if (s.size() > 60) out += "…";
-    return out;
-}
-
-std::string number_text(double v)
-{
-    char buf[32];
-    const auto r = std::to_chars(buf, buf + sizeof buf, v);
-    return std::string(buf, r.ptr);
-}
-
-/// Collects warnings, one line each, capped.
-class Warnings {
-public:
-    explicit Warnings(std::vector<std::string>* out) : out_(out) {}
-    void add(std::string line)
-    {
-        if (out_ == nullptr) return;
-        ++count_;
-        if (count_ <= kMaxWarnings) out_->push_back(one_line_message(line));
-    }
-    void finish(const std::string& name)
-    {
-        if (out_ != nullptr && count_ > kMaxWarnings)
-            out_->push_back(name + ": " + std::to_string(count_ - kMaxWarnings) + " more warnings not shown");
-    }
-
-private:
-    std::vector<std::string>* out_;
-    std::size_t count_ = 0;
-};
-
-/// Blanks comments (keeping newlines, so positions stay): `/* … */` anywhere, and `//` to the
-/// end of the line where it starts a line or stands between blanks (`F // note`); elsewhere
-/// `//` is two turtle rolls (`F//F`, ABOP's `/////`).
-std::string blank_comments(std::string_view text, const SourceText& src)
+std::string detail::blank_comments(std::string_view text, const SourceText& src)
 {
     std::string out(text);
     std::size_t line_start = 0;
@@ -105,6 +50,24 @@ std::string blank_comments(std::string_view text, const SourceText& src)
     return out;
 }
 
+
+namespace {
+
+using detail::Expr;
+using detail::PatternModule;
+using detail::Production;
+using detail::ProductionSet;
+using detail::SourceText;
+using detail::SuccessorModule;
+using detail::Warnings;
+using detail::is_blank;
+using detail::is_letter;
+using detail::is_name_char;
+using detail::is_name_start;
+using detail::lower;
+using detail::number_text;
+using detail::shorten;
+
 /// The parser of one `.l` file.
 class LParser {
 public:
@@ -116,6 +79,18 @@ public:
     std::shared_ptr<const LSystem::Impl> run();
 
 private:
+    /// What the lines read so far have set.
+    struct State {
+        bool seen_header = false;
+        bool seen_axiom = false;
+        bool ended = false;
+        bool warned_after_end = false;
+        std::vector<SymbolId> ignore_list;
+        std::vector<SymbolId> consider_list;
+        int context_list = 0; ///< 0 none, 1 ignore, 2 consider
+        std::size_t last_offset = 0;
+    };
+
     struct Line {
         std::size_t begin;
         std::size_t end;
@@ -135,6 +110,20 @@ private:
         return end;
     }
 
+    /// Comments blanked, lines split, #defines collected and checked.
+    void prepare();
+    /// Line `i` (moved past the lines a block or a production continues over).
+    void read_line(std::size_t& i);
+    /// A keyword line (`derivation length:`, `Axiom:`, a section, a block…) starting at `p`;
+    /// false when line `i` is none, i.e. a production.
+    bool read_statement(std::size_t& i, std::size_t p);
+    void parse_axiom(std::size_t p, std::size_t after, std::size_t line_end);
+    /// `homomorphism` or `decomposition` (optionally `: warnings`).
+    void start_section(std::size_t p, std::size_t after, std::size_t line_end);
+    /// Where the production starting at `p` on line `i` ends; `i` moves to its last line.
+    std::size_t production_end(std::size_t& i, std::size_t p) const;
+    /// Checks after the last line, the context tables, the production index.
+    void finish();
     void split_lines();
     void collect_defines();
     /// Whether line `i` starts with `keyword` (letters case-insensitive, blanks within the
@@ -152,7 +141,17 @@ private:
     void parse_pattern(std::size_t begin, std::size_t end, std::vector<PatternModule>& out,
                        std::unordered_map<std::string, std::uint32_t>& scope, std::vector<std::size_t>& offsets);
     void parse_symbol_list(std::size_t begin, std::size_t end, std::vector<SymbolId>& out);
+    using Scope = std::unordered_map<std::string, std::uint32_t>;
+    /// `lc < pred > rc : cond --> succ : prob` in [begin, end).
     void parse_production(std::size_t begin, std::size_t end);
+    /// The arrow of the production in [begin, end) and the offset after it; npos when none.
+    std::pair<std::size_t, std::size_t> find_arrow(std::size_t begin, std::size_t end) const;
+    /// `lc < pred > rc` in [begin, ctx_end): the formal parameters go into `scope`.
+    void parse_left_side(Production& prod, std::size_t begin, std::size_t ctx_end, Scope& scope);
+    /// The condition after the ':' at `colon`, up to the arrow.
+    void parse_condition(Production& prod, std::size_t colon, std::size_t arrow);
+    /// `succ : prob` from after the arrow to `end`.
+    void parse_right_side(Production& prod, std::size_t arrow_end, std::size_t end);
     void check_brackets(const std::vector<SuccessorModule>& modules, std::size_t offset, const char* what) const;
     double constant_value(std::size_t begin, std::size_t end, const char* what);
     void finish_probability_groups();
@@ -168,7 +167,7 @@ private:
     std::shared_ptr<LSystem::Impl> sys_ = std::make_shared<LSystem::Impl>();
     std::unique_ptr<detail::ExprCompiler> compiler_;
     ProductionSet* section_ = nullptr;
-    std::vector<std::size_t> production_group_offsets_;
+    State state_;
     struct GroupEntry {
         std::string key;
         double probability;
@@ -435,51 +434,40 @@ std::size_t find_top_level(std::string_view text, std::size_t begin, std::size_t
     return std::string_view::npos;
 }
 
-void LParser::parse_production(std::size_t begin, std::size_t end)
+std::pair<std::size_t, std::size_t> LParser::find_arrow(std::size_t begin, std::size_t end) const
 {
-    // The arrow: the last `->` at depth 0 (successors cannot hold '>'), `-->`, `->` or `-o>`.
+    // The last `->` at depth 0 (successors cannot hold '>'), `-->`, `->` or `-o>`.
     std::size_t arrow = std::string_view::npos;
     std::size_t arrow_end = 0;
-    {
-        int paren = 0;
-        int brace = 0;
-        std::size_t open_paren = 0;
-        for (std::size_t i = begin; i < end; ++i) {
-            const char c = clean_[i];
-            if (c == '(') {
-                if (paren++ == 0) open_paren = i;
-            } else if (c == ')') {
-                if (paren == 0) src().fail(i, "unbalanced ')'");
-                --paren;
-            }
-            else if (c == '{') ++brace;
-            else if (c == '}') brace = std::max(0, brace - 1);
-            else if (paren == 0 && brace == 0 && c == '-' && i + 1 < end && clean_[i + 1] == '>') {
-                arrow = i;
-                arrow_end = i + 2;
-            } else if (paren == 0 && brace == 0 && c == '-' && clean_[i + 1] == 'o' && i + 2 < end && clean_[i + 2] == '>') {
-                arrow = i;
-                arrow_end = i + 3;
-            }
+    int paren = 0;
+    int brace = 0;
+    std::size_t open_paren = 0;
+    for (std::size_t i = begin; i < end; ++i) {
+        const char c = clean_[i];
+        if (c == '(') {
+            if (paren++ == 0) open_paren = i;
+        } else if (c == ')') {
+            if (paren == 0) src().fail(i, "unbalanced ')'");
+            --paren;
         }
-        if (paren > 0) src().fail(open_paren, "unclosed '('");
-        if (arrow != std::string_view::npos && clean_[arrow + 1] == '>' && arrow > begin && clean_[arrow - 1] == '-') --arrow;
+        else if (c == '{') ++brace;
+        else if (c == '}') brace = std::max(0, brace - 1);
+        else if (paren == 0 && brace == 0 && c == '-' && i + 1 < end && clean_[i + 1] == '>') {
+            arrow = i;
+            arrow_end = i + 2;
+        } else if (paren == 0 && brace == 0 && c == '-' && clean_[i + 1] == 'o' && i + 2 < end && clean_[i + 2] == '>') {
+            arrow = i;
+            arrow_end = i + 3;
+        }
     }
-    const std::size_t first = skip_blanks(begin, end);
-    if (arrow == std::string_view::npos)
-        src().fail(first, "not a production (no '-->') nor a statement cpfg knows: '" +
-                              shorten(text().substr(first, trim_end(first, end) - first)) + "'");
-    if (clean_.compare(arrow, 3, "-o>") == 0) warn(arrow, "'-o>' (object productions) read as '-->'");
+    if (paren > 0) src().fail(open_paren, "unclosed '('");
+    if (arrow != std::string_view::npos && clean_[arrow + 1] == '>' && arrow > begin && clean_[arrow - 1] == '-') --arrow;
+    return {arrow, arrow_end};
+}
 
-    Production prod;
-    prod.offset = first;
-    {
-        const auto [line, col] = src().line_col(first);
-        prod.where = name_ + ":" + std::to_string(line) + ":" + std::to_string(col);
-    }
-    // Left side: lc < pred > rc : cond
-    const std::size_t colon = find_top_level(clean_, begin, arrow, ':');
-    const std::size_t ctx_end = colon == std::string_view::npos ? arrow : colon;
+void LParser::parse_left_side(Production& prod, std::size_t begin, std::size_t ctx_end, Scope& scope)
+{
+    // lc < pred > rc
     const std::size_t lt = find_top_level(clean_, begin, ctx_end, '<');
     const std::size_t gt = find_top_level(clean_, lt == std::string_view::npos ? begin : lt + 1, ctx_end, '>');
     const std::size_t pred_begin = lt == std::string_view::npos ? begin : lt + 1;
@@ -489,19 +477,17 @@ void LParser::parse_production(std::size_t begin, std::size_t end)
     if (gt != std::string_view::npos && find_top_level(clean_, gt + 1, ctx_end, '>') != std::string_view::npos)
         src().fail(find_top_level(clean_, gt + 1, ctx_end, '>'), "a production has one '>' at most");
 
-    std::unordered_map<std::string, std::uint32_t> scope;
     std::vector<std::size_t> offsets;
     std::vector<PatternModule> pred;
-    {
-        const std::size_t pb = skip_blanks(pred_begin, pred_end);
-        if (pb >= pred_end) src().fail(pred_begin, "a production needs a predecessor");
-        parse_pattern(pb, trim_end(pb, pred_end), pred, scope, offsets);
-        if (pred.size() != 1)
-            src().fail(offsets[1], "a predecessor is one module (cpfg's predecessors of several modules are not supported)");
-        const std::string& pn = sys_->symbol_names[pred[0].symbol];
-        if (pn == "[" || pn == "]") src().fail(pb, "brackets cannot be rewritten");
-        prod.pred = pred[0];
-    }
+    const std::size_t pb = skip_blanks(pred_begin, pred_end);
+    if (pb >= pred_end) src().fail(pred_begin, "a production needs a predecessor");
+    parse_pattern(pb, trim_end(pb, pred_end), pred, scope, offsets);
+    if (pred.size() != 1)
+        src().fail(offsets[1], "a predecessor is one module (cpfg's predecessors of several modules are not supported)");
+    const std::string& pn = sys_->symbol_names[pred[0].symbol];
+    if (pn == "[" || pn == "]") src().fail(pb, "brackets cannot be rewritten");
+    prod.pred = pred[0];
+
     auto context = [&](std::size_t b, std::size_t e, std::vector<PatternModule>& out, bool is_left) {
         const std::size_t cb = skip_blanks(b, e);
         const std::size_t ce = trim_end(cb, e);
@@ -516,54 +502,54 @@ void LParser::parse_production(std::size_t begin, std::size_t end)
     };
     if (lt != std::string_view::npos) context(begin, lt, prod.left, true);
     if (gt != std::string_view::npos) context(gt + 1, ctx_end, prod.right, false);
-    prod.var_count = static_cast<std::uint32_t>(scope.size());
-    compiler_->set_scope(&scope);
+}
 
-    if (colon != std::string_view::npos) {
-        std::size_t cb = skip_blanks(colon + 1, arrow);
-        std::size_t ce = trim_end(cb, arrow);
-        // cpfg's pre- and post-condition statement blocks: `{ … } cond { … }`.
-        if (cb < ce && clean_[cb] == '{') {
-            std::size_t depth = 0;
-            std::size_t k = cb;
-            for (; k < ce; ++k) {
-                if (clean_[k] == '{') ++depth;
-                else if (clean_[k] == '}' && --depth == 0) break;
-            }
-            if (k >= ce) src().fail(cb, "unclosed '{' block");
-            warn(cb, "statement blocks '{…}' before a condition are not supported; the block is ignored");
-            cb = skip_blanks(k + 1, ce);
+void LParser::parse_condition(Production& prod, std::size_t colon, std::size_t arrow)
+{
+    std::size_t cb = skip_blanks(colon + 1, arrow);
+    std::size_t ce = trim_end(cb, arrow);
+    // cpfg's pre- and post-condition statement blocks: `{ … } cond { … }`.
+    if (cb < ce && clean_[cb] == '{') {
+        std::size_t depth = 0;
+        std::size_t k = cb;
+        for (; k < ce; ++k) {
+            if (clean_[k] == '{') ++depth;
+            else if (clean_[k] == '}' && --depth == 0) break;
         }
-        if (cb < ce && clean_[ce - 1] == '}') {
-            std::size_t depth = 0;
-            std::size_t k = ce;
-            while (k > cb) {
-                --k;
-                if (clean_[k] == '}') ++depth;
-                else if (clean_[k] == '{' && --depth == 0) break;
-            }
-            if (clean_[k] != '{' || depth != 0) src().fail(ce - 1, "unbalanced '}'");
-            warn(k, "statement blocks '{…}' after a condition are not supported; the block is ignored");
-            ce = trim_end(cb, k);
-        }
-        if (cb >= ce) src().fail(colon, "an empty condition (write '*' for none)");
-        if (!(ce == cb + 1 && clean_[cb] == '*')) {
-            prod.condition = compiler_->compile_all(cb, ce);
-            prod.has_condition = !(prod.condition.constant && prod.condition.value != 0.0);
-        }
+        if (k >= ce) src().fail(cb, "unclosed '{' block");
+        warn(cb, "statement blocks '{…}' before a condition are not supported; the block is ignored");
+        cb = skip_blanks(k + 1, ce);
     }
+    if (cb < ce && clean_[ce - 1] == '}') {
+        std::size_t depth = 0;
+        std::size_t k = ce;
+        while (k > cb) {
+            --k;
+            if (clean_[k] == '}') ++depth;
+            else if (clean_[k] == '{' && --depth == 0) break;
+        }
+        if (clean_[k] != '{' || depth != 0) src().fail(ce - 1, "unbalanced '}'");
+        warn(k, "statement blocks '{…}' after a condition are not supported; the block is ignored");
+        ce = trim_end(cb, k);
+    }
+    if (cb >= ce) src().fail(colon, "an empty condition (write '*' for none)");
+    if (!(ce == cb + 1 && clean_[cb] == '*')) {
+        prod.condition = compiler_->compile_all(cb, ce);
+        prod.has_condition = !(prod.condition.constant && prod.condition.value != 0.0);
+    }
+}
 
-    // Right side: succ : prob
+void LParser::parse_right_side(Production& prod, std::size_t arrow_end, std::size_t end)
+{
+    // succ : prob
     const std::size_t prob_colon = find_top_level(clean_, arrow_end, end, ':');
     const std::size_t succ_end = prob_colon == std::string_view::npos ? end : prob_colon;
-    {
-        const std::size_t sb = skip_blanks(arrow_end, succ_end);
-        const std::size_t se = trim_end(sb, succ_end);
-        if (sb >= se) src().fail(arrow_end, "an empty successor (write '*' for the empty word)");
-        if (!(se == sb + 1 && clean_[sb] == '*')) {
-            parse_modules(sb, se, prod.successor, prod.param_exprs, "successor");
-            check_brackets(prod.successor, sb, "successor");
-        }
+    const std::size_t sb = skip_blanks(arrow_end, succ_end);
+    const std::size_t se = trim_end(sb, succ_end);
+    if (sb >= se) src().fail(arrow_end, "an empty successor (write '*' for the empty word)");
+    if (!(se == sb + 1 && clean_[sb] == '*')) {
+        parse_modules(sb, se, prod.successor, prod.param_exprs, "successor");
+        check_brackets(prod.successor, sb, "successor");
     }
     if (prob_colon != std::string_view::npos) {
         const std::size_t pb = skip_blanks(prob_colon + 1, end);
@@ -574,25 +560,52 @@ void LParser::parse_production(std::size_t begin, std::size_t end)
         if (prod.probability.constant && !(prod.probability.value >= 0.0 && std::isfinite(prod.probability.value)))
             src().fail(pb, "a probability must be a finite number of at least 0, not " + number_text(prod.probability.value));
     }
-    compiler_->set_scope(nullptr);
+}
 
-    // Pre-build a constant successor.
+/// A successor whose parameters are all constant becomes a block copied as it is.
+void prebuild_constant_successor(Production& prod)
+{
     for (const Expr& e : prod.param_exprs)
         if (!e.constant) {
             prod.constant_successor = false;
             prod.successor_cost += e.count;
         }
     prod.successor_param_count = static_cast<std::uint32_t>(prod.param_exprs.size());
-    if (prod.constant_successor) {
-        for (const SuccessorModule& s : prod.successor) {
-            Module m;
-            m.symbol = s.symbol;
-            m.param_count = s.param_count;
-            m.first_param = static_cast<std::uint32_t>(prod.block_params.size());
-            for (std::uint32_t k = 0; k < s.param_count; ++k) prod.block_params.push_back(prod.param_exprs[s.first_expr + k].value);
-            prod.block.push_back(m);
-        }
+    if (!prod.constant_successor) return;
+    for (const SuccessorModule& s : prod.successor) {
+        Module m;
+        m.symbol = s.symbol;
+        m.param_count = s.param_count;
+        m.first_param = static_cast<std::uint32_t>(prod.block_params.size());
+        for (std::uint32_t k = 0; k < s.param_count; ++k) prod.block_params.push_back(prod.param_exprs[s.first_expr + k].value);
+        prod.block.push_back(m);
     }
+}
+
+void LParser::parse_production(std::size_t begin, std::size_t end)
+{
+    const auto [arrow, arrow_end] = find_arrow(begin, end);
+    const std::size_t first = skip_blanks(begin, end);
+    if (arrow == std::string_view::npos)
+        src().fail(first, "not a production (no '-->') nor a statement cpfg knows: '" +
+                              shorten(text().substr(first, trim_end(first, end) - first)) + "'");
+    if (clean_.compare(arrow, 3, "-o>") == 0) warn(arrow, "'-o>' (object productions) read as '-->'");
+
+    Production prod;
+    prod.offset = first;
+    const auto [line, col] = src().line_col(first);
+    prod.where = name_ + ":" + std::to_string(line) + ":" + std::to_string(col);
+    // lc < pred > rc : cond --> succ : prob
+    const std::size_t colon = find_top_level(clean_, begin, arrow, ':');
+    const std::size_t ctx_end = colon == std::string_view::npos ? arrow : colon;
+    Scope scope;
+    parse_left_side(prod, begin, ctx_end, scope);
+    prod.var_count = static_cast<std::uint32_t>(scope.size());
+    compiler_->set_scope(&scope);
+    if (colon != std::string_view::npos) parse_condition(prod, colon, arrow);
+    parse_right_side(prod, arrow_end, end);
+    compiler_->set_scope(nullptr);
+    prebuild_constant_successor(prod);
 
     if (section_ != &sys_->main && prod.is_context_sensitive()) {
         warn(first, std::string("context in a ") + (section_ == &sys_->homomorphism ? "homomorphism" : "decomposition") +
@@ -635,12 +648,12 @@ void LParser::finish_probability_groups()
     }
 }
 
-std::shared_ptr<const LSystem::Impl> LParser::run()
+void LParser::prepare()
 {
     if (original_.size() > kMaxFileBytes)
         raw_.fail(0, "the file is " + std::to_string(original_.size()) + " bytes, over the limit of " +
                          std::to_string(kMaxFileBytes) + " bytes");
-    clean_ = blank_comments(original_, raw_);
+    clean_ = detail::blank_comments(original_, raw_);
     src_ = std::make_unique<SourceText>(clean_, name_);
     compiler_ = std::make_unique<detail::ExprCompiler>(
         *src_, sys_->code, defines_, [this](std::size_t off, const std::string& msg) { warn(off, msg); });
@@ -649,183 +662,179 @@ std::shared_ptr<const LSystem::Impl> LParser::run()
     collect_defines();
     // Every #define must be a valid expression (unused ones too: a recursion or a constant
     // division by zero is an error wherever it is).
-    {
-        std::vector<std::pair<std::size_t, std::string>> order;
-        for (const auto& [n, d] : defines_) order.emplace_back(d.name_offset, n);
-        std::sort(order.begin(), order.end());
-        for (const auto& [off, n] : order) compiler_->check_define(n);
-    }
-
+    std::vector<std::pair<std::size_t, std::string>> order;
+    for (const auto& [n, d] : defines_) order.emplace_back(d.name_offset, n);
+    std::sort(order.begin(), order.end());
+    for (const auto& [off, n] : order) compiler_->check_define(n);
     section_ = &sys_->main;
-    bool seen_header = false;
-    bool seen_axiom = false;
-    bool ended = false;
-    bool warned_after_end = false;
-    std::vector<SymbolId> ignore_list;
-    std::vector<SymbolId> consider_list;
-    int context_list = 0; // 0 none, 1 ignore, 2 consider
-    std::size_t last_offset = 0;
+}
 
-    for (std::size_t i = 0; i < lines_.size(); ++i) {
-        const Line line = lines_[i];
-        const std::size_t p = skip_blanks(line.begin, line.end);
-        if (p >= line.end) continue;
-        last_offset = p;
-        std::size_t after = 0;
-        if (clean_[p] == '#') {
-            std::size_t q = skip_blanks(p + 1, line.end);
-            std::size_t w = q;
-            while (w < line.end && is_name_char(clean_[w])) ++w;
-            const std::string_view directive = text().substr(q, w - q);
-            if (directive != "define")
-                warn(p, "preprocessor line '#" + shorten(directive) + "' is not supported; ignored");
-            continue;
-        }
-        if (ended) {
-            if (keyword(line, "lsystem:", after)) {
-                warn(p, "a second L-system in one file (cpfg's sub-L-systems) is not supported; ignored up to its endlsystem");
-                while (i + 1 < lines_.size()) {
-                    ++i;
-                    if (keyword(lines_[i], "endlsystem", after)) break;
-                }
-                continue;
+void LParser::read_line(std::size_t& i)
+{
+    const Line line = lines_[i];
+    const std::size_t p = skip_blanks(line.begin, line.end);
+    if (p >= line.end) return;
+    state_.last_offset = p;
+    std::size_t after = 0;
+    if (clean_[p] == '#') {
+        std::size_t q = skip_blanks(p + 1, line.end);
+        std::size_t w = q;
+        while (w < line.end && is_name_char(clean_[w])) ++w;
+        const std::string_view directive = text().substr(q, w - q);
+        if (directive != "define") warn(p, "preprocessor line '#" + shorten(directive) + "' is not supported; ignored");
+        return;
+    }
+    if (state_.ended) {
+        if (keyword(line, "lsystem:", after)) {
+            warn(p, "a second L-system in one file (cpfg's sub-L-systems) is not supported; ignored up to its endlsystem");
+            while (i + 1 < lines_.size()) {
+                ++i;
+                if (keyword(lines_[i], "endlsystem", after)) break;
             }
-            if (!warned_after_end) warn(p, "text after 'endlsystem' is ignored");
-            warned_after_end = true;
-            continue;
+            return;
         }
-        if (!seen_header) {
-            if (!keyword(line, "lsystem:", after))
-                src().fail(p, "expected 'Lsystem: NAME' before anything else, found '" +
-                                  shorten(text().substr(p, trim_end(p, line.end) - p)) + "'");
-            seen_header = true;
-            continue;
-        }
-        if (keyword(line, "lsystem:", after)) src().fail(p, "'Lsystem:' again before 'endlsystem'");
-        if (keyword(line, "endlsystem", after)) {
-            ended = true;
-            continue;
-        }
-        if (keyword(line, "derivation length:", after)) {
-            const double v = constant_value(after, line.end, "derivation length");
-            if (v < 0.0 || v > static_cast<double>(kMaxDerivationLength))
-                src().fail(skip_blanks(after, line.end), "derivation length " + number_text(v) + " is outside 0 to " +
-                                                             std::to_string(kMaxDerivationLength));
-            sys_->derivation_length = static_cast<int>(v);
-            continue;
-        }
-        if (keyword(line, "maximum depth:", after)) {
-            const double v = constant_value(after, line.end, "maximum depth");
-            if (v < 0.0 || v > kMaxSectionDepth)
-                src().fail(skip_blanks(after, line.end), "maximum depth " + number_text(v) + " is outside 0 to " +
-                                                             std::to_string(kMaxSectionDepth));
-            if (section_ == &sys_->main) warn(p, "'maximum depth:' outside a decomposition or homomorphism section is ignored");
-            else section_->depth = static_cast<int>(v);
-            continue;
-        }
-        if (keyword(line, "seed:", after)) {
-            warn(p, "'seed:' is not used: the seed comes from the caller (--seed)");
-            continue;
-        }
-        if (keyword(line, "ignore:", after)) {
-            ignore_list.clear();
-            parse_symbol_list(after, line.end, ignore_list);
-            if (context_list == 2) warn(p, "'ignore:' after 'consider:': the last one counts");
-            context_list = 1;
-            continue;
-        }
-        if (keyword(line, "consider:", after)) {
-            consider_list.clear();
-            parse_symbol_list(after, line.end, consider_list);
-            if (context_list == 1) warn(p, "'consider:' after 'ignore:': the last one counts");
-            context_list = 2;
-            continue;
-        }
-        if (keyword(line, "axiom:", after)) {
-            if (seen_axiom) src().fail(p, "a second 'Axiom:'");
-            seen_axiom = true;
-            compiler_->set_scope(nullptr);
-            std::vector<SuccessorModule> mods;
-            std::vector<Expr> exprs;
-            const std::size_t b = skip_blanks(after, line.end);
-            const std::size_t e = trim_end(b, line.end);
-            if (b >= e) src().fail(after, "an empty axiom");
-            parse_modules(b, e, mods, exprs, "axiom");
-            check_brackets(mods, b, "axiom");
-            if (mods.size() > kMaxModules) src().fail(b, "the axiom is over the module limit");
-            for (const SuccessorModule& m : mods) {
-                std::vector<double> values;
-                for (std::uint32_t k = 0; k < m.param_count; ++k) {
-                    const Expr& ex = exprs[m.first_expr + k];
-                    const double v = compiler_->evaluate_constant(ex, ex.offset);
-                    if (!std::isfinite(v)) src().fail(ex.offset, "a parameter of the axiom is not a finite number");
-                    values.push_back(v);
-                }
-                sys_->axiom.push(m.symbol, values);
-            }
-            continue;
-        }
-        bool block = false;
+        if (!state_.warned_after_end) warn(p, "text after 'endlsystem' is ignored");
+        state_.warned_after_end = true;
+        return;
+    }
+    if (!state_.seen_header) {
+        if (!keyword(line, "lsystem:", after))
+            src().fail(p, "expected 'Lsystem: NAME' before anything else, found '" +
+                              shorten(text().substr(p, trim_end(p, line.end) - p)) + "'");
+        state_.seen_header = true;
+        return;
+    }
+    if (read_statement(i, p)) return;
+    parse_production(p, production_end(i, p));
+}
+
+bool LParser::read_statement(std::size_t& i, std::size_t p)
+{
+    const Line line = lines_[i];
+    std::size_t after = 0;
+    if (keyword(line, "lsystem:", after)) src().fail(p, "'Lsystem:' again before 'endlsystem'");
+    if (keyword(line, "endlsystem", after)) {
+        state_.ended = true;
+    } else if (keyword(line, "derivation length:", after)) {
+        const double v = constant_value(after, line.end, "derivation length");
+        if (v < 0.0 || v > static_cast<double>(kMaxDerivationLength))
+            src().fail(skip_blanks(after, line.end), "derivation length " + number_text(v) + " is outside 0 to " +
+                                                         std::to_string(kMaxDerivationLength));
+        sys_->derivation_length = static_cast<int>(v);
+    } else if (keyword(line, "maximum depth:", after)) {
+        const double v = constant_value(after, line.end, "maximum depth");
+        if (v < 0.0 || v > kMaxSectionDepth)
+            src().fail(skip_blanks(after, line.end), "maximum depth " + number_text(v) + " is outside 0 to " +
+                                                         std::to_string(kMaxSectionDepth));
+        if (section_ == &sys_->main) warn(p, "'maximum depth:' outside a decomposition or homomorphism section is ignored");
+        else section_->depth = static_cast<int>(v);
+    } else if (keyword(line, "seed:", after)) {
+        warn(p, "'seed:' is not used: the seed comes from the caller (--seed)");
+    } else if (keyword(line, "ignore:", after)) {
+        state_.ignore_list.clear();
+        parse_symbol_list(after, line.end, state_.ignore_list);
+        if (state_.context_list == 2) warn(p, "'ignore:' after 'consider:': the last one counts");
+        state_.context_list = 1;
+    } else if (keyword(line, "consider:", after)) {
+        state_.consider_list.clear();
+        parse_symbol_list(after, line.end, state_.consider_list);
+        if (state_.context_list == 1) warn(p, "'consider:' after 'ignore:': the last one counts");
+        state_.context_list = 2;
+    } else if (keyword(line, "axiom:", after)) {
+        parse_axiom(p, after, line.end);
+    } else if (keyword(line, "ring lsystem", after)) {
+        warn(p, "ring L-systems are not supported; the word is read as an ordinary one");
+    } else if (keyword(line, "homomorphism", after) || keyword(line, "decomposition", after)) {
+        start_section(p, after, line.end);
+    } else {
         for (const char* kw : {"define:", "start each:", "end each:", "start:", "end:"}) {
             if (keyword(line, kw, after)) {
                 skip_block(i, after, kw);
-                block = true;
-                break;
+                return true;
             }
         }
-        if (block) continue;
-        if (keyword(line, "ring lsystem", after)) {
-            warn(p, "ring L-systems are not supported; the word is read as an ordinary one");
-            continue;
-        }
-        if (keyword(line, "homomorphism", after) || keyword(line, "decomposition", after)) {
-            const bool homo = lower(clean_[p]) == 'h';
-            std::size_t q = skip_blanks(after, line.end);
-            if (q < line.end && clean_[q] == ':') q = skip_blanks(q + 1, line.end);
-            const std::string_view rest = text().substr(q, trim_end(q, line.end) - q);
-            if (!rest.empty() && rest != "warnings" && rest != "no warnings")
-                src().fail(q, std::string("unexpected '") + shorten(rest) + "' after '" + (homo ? "homomorphism" : "decomposition") + "'");
-            ProductionSet* next = homo ? &sys_->homomorphism : &sys_->decomposition;
-            if (next == section_ || (section_ == &sys_->homomorphism && !homo))
-                src().fail(p, homo ? "a second 'homomorphism' section" : "'decomposition' comes before 'homomorphism', once");
-            section_ = next;
-            continue;
-        }
-        // A production, possibly continued over lines while a '{' block before its arrow is open.
-        std::size_t end = line.end;
-        {
-            int depth = 0;
-            for (std::size_t k = p; k < end; ++k) {
-                if (clean_[k] == '{') ++depth;
-                else if (clean_[k] == '}') --depth;
-            }
-            bool has_arrow = text().substr(p, end - p).find("->") != std::string_view::npos ||
-                             text().substr(p, end - p).find("-o>") != std::string_view::npos;
-            while (depth > 0 && !has_arrow && i + 1 < lines_.size()) {
-                ++i;
-                for (std::size_t k = lines_[i].begin; k < lines_[i].end; ++k) {
-                    if (clean_[k] == '{') ++depth;
-                    else if (clean_[k] == '}') --depth;
-                }
-                end = lines_[i].end;
-                has_arrow = text().substr(lines_[i].begin, end - lines_[i].begin).find("->") != std::string_view::npos;
-            }
-        }
-        parse_production(p, end);
+        return false;
     }
-    if (!seen_header) raw_.fail(0, "not an L-system: no 'Lsystem:' line");
-    if (!seen_axiom) src().fail(last_offset, "no 'Axiom:'");
-    if (!ended) warn(last_offset, "no 'endlsystem' at the end");
+    return true;
+}
+
+void LParser::parse_axiom(std::size_t p, std::size_t after, std::size_t line_end)
+{
+    if (state_.seen_axiom) src().fail(p, "a second 'Axiom:'");
+    state_.seen_axiom = true;
+    compiler_->set_scope(nullptr);
+    std::vector<SuccessorModule> mods;
+    std::vector<Expr> exprs;
+    const std::size_t b = skip_blanks(after, line_end);
+    const std::size_t e = trim_end(b, line_end);
+    if (b >= e) src().fail(after, "an empty axiom");
+    parse_modules(b, e, mods, exprs, "axiom");
+    check_brackets(mods, b, "axiom");
+    if (mods.size() > kMaxModules) src().fail(b, "the axiom is over the module limit");
+    for (const SuccessorModule& m : mods) {
+        std::vector<double> values;
+        for (std::uint32_t k = 0; k < m.param_count; ++k) {
+            const Expr& ex = exprs[m.first_expr + k];
+            const double v = compiler_->evaluate_constant(ex, ex.offset);
+            if (!std::isfinite(v)) src().fail(ex.offset, "a parameter of the axiom is not a finite number");
+            values.push_back(v);
+        }
+        sys_->axiom.push(m.symbol, values);
+    }
+}
+
+void LParser::start_section(std::size_t p, std::size_t after, std::size_t line_end)
+{
+    const bool homo = lower(clean_[p]) == 'h';
+    std::size_t q = skip_blanks(after, line_end);
+    if (q < line_end && clean_[q] == ':') q = skip_blanks(q + 1, line_end);
+    const std::string_view rest = text().substr(q, trim_end(q, line_end) - q);
+    if (!rest.empty() && rest != "warnings" && rest != "no warnings")
+        src().fail(q, std::string("unexpected '") + shorten(rest) + "' after '" + (homo ? "homomorphism" : "decomposition") + "'");
+    ProductionSet* next = homo ? &sys_->homomorphism : &sys_->decomposition;
+    if (next == section_ || (section_ == &sys_->homomorphism && !homo))
+        src().fail(p, homo ? "a second 'homomorphism' section" : "'decomposition' comes before 'homomorphism', once");
+    section_ = next;
+}
+
+std::size_t LParser::production_end(std::size_t& i, std::size_t p) const
+{
+    // A production goes on over the following lines while a '{' block before its arrow is open.
+    std::size_t end = lines_[i].end;
+    int depth = 0;
+    for (std::size_t k = p; k < end; ++k) {
+        if (clean_[k] == '{') ++depth;
+        else if (clean_[k] == '}') --depth;
+    }
+    bool has_arrow = text().substr(p, end - p).find("->") != std::string_view::npos ||
+                     text().substr(p, end - p).find("-o>") != std::string_view::npos;
+    while (depth > 0 && !has_arrow && i + 1 < lines_.size()) {
+        ++i;
+        for (std::size_t k = lines_[i].begin; k < lines_[i].end; ++k) {
+            if (clean_[k] == '{') ++depth;
+            else if (clean_[k] == '}') --depth;
+        }
+        end = lines_[i].end;
+        has_arrow = text().substr(lines_[i].begin, end - lines_[i].begin).find("->") != std::string_view::npos;
+    }
+    return end;
+}
+
+void LParser::finish()
+{
+    if (!state_.seen_header) raw_.fail(0, "not an L-system: no 'Lsystem:' line");
+    if (!state_.seen_axiom) src().fail(state_.last_offset, "no 'Axiom:'");
+    if (!state_.ended) warn(state_.last_offset, "no 'endlsystem' at the end");
     finish_probability_groups();
 
     // Context: ignore/consider lists over every symbol.
     const std::size_t n = sys_->symbol_names.size();
     sys_->ignored.assign(n, 0);
-    if (context_list == 1) {
-        for (const SymbolId s : ignore_list) sys_->ignored[s] = 1;
-    } else if (context_list == 2) {
+    if (state_.context_list == 1) {
+        for (const SymbolId s : state_.ignore_list) sys_->ignored[s] = 1;
+    } else if (state_.context_list == 2) {
         sys_->ignored.assign(n, 1);
-        for (const SymbolId s : consider_list) sys_->ignored[s] = 0;
+        for (const SymbolId s : state_.consider_list) sys_->ignored[s] = 0;
     }
     auto find = [&](const char* s) {
         const auto it = sys_->symbol_ids.find(s);
@@ -854,28 +863,14 @@ std::shared_ptr<const LSystem::Impl> LParser::run()
     detail::index_productions(sys_->decomposition, n);
     detail::index_productions(sys_->homomorphism, n);
     warnings_.finish(name_);
-    return sys_;
 }
 
-// ---------------------------------------------------------------------------------------------
-// View files
-
-bool parse_numbers(std::string_view s, std::vector<double>& out)
+std::shared_ptr<const LSystem::Impl> LParser::run()
 {
-    std::size_t p = 0;
-    while (p < s.size()) {
-        while (p < s.size() && (is_blank(s[p]) || s[p] == ',')) ++p;
-        if (p >= s.size()) break;
-        double v = 0.0;
-        const char* b = s.data() + p;
-        if (*b == '+') ++b;
-        const auto r = std::from_chars(b, s.data() + s.size(), v);
-        if (r.ec != std::errc() || !std::isfinite(v)) return false;
-        out.push_back(v);
-        p = static_cast<std::size_t>(r.ptr - s.data());
-        if (p < s.size() && !is_blank(s[p]) && s[p] != ',') return false;
-    }
-    return true;
+    prepare();
+    for (std::size_t i = 0; i < lines_.size(); ++i) read_line(i);
+    finish();
+    return sys_;
 }
 
 } // namespace
@@ -884,150 +879,6 @@ LSystem parse_lsystem(std::string_view text, const std::string& source_name, std
 {
     LParser parser(text, source_name, warnings);
     return LSystem(parser.run());
-}
-
-ViewSettings parse_view(std::string_view text, const std::string& source_name, std::vector<std::string>* warnings)
-{
-    SourceText raw(text, source_name);
-    if (text.size() > kMaxFileBytes)
-        raw.fail(0, "the file is " + std::to_string(text.size()) + " bytes, over the limit of " + std::to_string(kMaxFileBytes) + " bytes");
-    const std::string clean = blank_comments(text, raw);
-    const SourceText src(clean, source_name);
-    Warnings warn(warnings);
-    ViewSettings v;
-    std::size_t b = 0;
-    while (b <= clean.size()) {
-        std::size_t e = clean.find('\n', b);
-        if (e == std::string::npos) e = clean.size();
-        std::size_t p = b;
-        while (p < e && is_blank(clean[p])) ++p;
-        std::size_t end = e;
-        while (end > p && is_blank(clean[end - 1])) --end;
-        if (p < end) {
-            const std::size_t colon = clean.find(':', p);
-            std::string label;
-            if (colon != std::string::npos && colon < end) {
-                for (std::size_t k = p; k < colon; ++k) {
-                    const char c = lower(clean[k]);
-                    if (is_blank(c)) {
-                        if (!label.empty() && label.back() != ' ') label += ' ';
-                    } else {
-                        label += c;
-                    }
-                }
-                while (!label.empty() && label.back() == ' ') label.pop_back();
-            }
-            const std::size_t vb = colon == std::string::npos ? end : colon + 1;
-            const std::string_view value = std::string_view(clean).substr(vb, end > vb ? end - vb : 0);
-            auto numbers = [&](std::size_t min_count, std::size_t max_count, bool allow_unit) {
-                std::vector<double> out;
-                std::string_view s = value;
-                if (allow_unit) {
-                    // `initial line width: 2 pixels` / `polygons`
-                    std::size_t k = s.size();
-                    while (k > 0 && is_letter(s[k - 1])) --k;
-                    s = s.substr(0, k);
-                }
-                if (!parse_numbers(s, out) || out.size() < min_count || out.size() > max_count)
-                    src.fail(vb, "malformed value for '" + label + "': '" + shorten(value) + "'");
-                return out;
-            };
-            if (label == "angle increment") {
-                v.angle_increment_deg = numbers(1, 1, false)[0];
-            } else if (label == "angle factor") {
-                const double f = numbers(1, 1, false)[0];
-                if (f == 0.0) src.fail(vb, "'angle factor' must not be 0");
-                v.angle_increment_deg = 360.0 / f;
-            } else if (label == "initial line width") {
-                v.initial_line_width = numbers(1, 1, true)[0];
-            } else if (label == "line width increment") {
-                v.line_width_increment = numbers(1, 1, false)[0];
-            } else if (label == "scale factor") {
-                v.scale_factor = numbers(1, 1, false)[0];
-            } else if (label == "tropism direction") {
-                const std::vector<double> d = numbers(3, 3, false);
-                const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-                if (!(len > 0.0) || !std::isfinite(len)) src.fail(vb, "'tropism direction' must not be zero");
-                v.tropism_direction = glm::dvec3(d[0], d[1], d[2]) / len;
-                v.tropism = true;
-            } else if (label == "initial elasticity" || label == "elasticity") {
-                v.elasticity = numbers(1, 1, false)[0];
-                v.tropism = true;
-            } else if (label == "elasticity increment") {
-                v.elasticity_increment = numbers(1, 1, false)[0];
-            } else if (label == "tropism") {
-                // cpfg 4: `tropism: T: x,y,z, A: angle, I: intensity, E: elasticity, S: step`
-                std::string_view s = value;
-                bool any = false;
-                for (std::size_t k = 0; k + 1 < s.size(); ++k) {
-                    const char key = s[k];
-                    if (!((key == 'T' || key == 'E' || key == 'A' || key == 'I' || key == 'S') && s[k + 1] == ':')) continue;
-                    if (k > 0 && is_letter(s[k - 1])) continue;
-                    std::size_t stop = k + 2;
-                    while (stop < s.size()) {
-                        if (stop + 1 < s.size() && is_letter(s[stop]) && s[stop + 1] == ':') break;
-                        ++stop;
-                    }
-                    std::vector<double> vals;
-                    std::string_view field = s.substr(k + 2, stop - k - 2);
-                    while (!field.empty() && (is_blank(field.back()) || field.back() == ',')) field.remove_suffix(1);
-                    if (!parse_numbers(field, vals)) src.fail(vb + k, "malformed 'tropism' field '" + std::string(1, key) + ":'");
-                    if (key == 'T') {
-                        if (vals.size() != 3) src.fail(vb + k, "'tropism' T: needs x,y,z");
-                        const double len = std::sqrt(vals[0] * vals[0] + vals[1] * vals[1] + vals[2] * vals[2]);
-                        if (!(len > 0.0)) src.fail(vb + k, "'tropism direction' must not be zero");
-                        v.tropism_direction = glm::dvec3(vals[0], vals[1], vals[2]) / len;
-                        any = true;
-                    } else if (key == 'E') {
-                        if (vals.size() != 1) src.fail(vb + k, "'tropism' E: needs one value");
-                        v.elasticity = vals[0];
-                        any = true;
-                    }
-                    k = stop - 1;
-                }
-                if (!any) src.fail(vb, "a 'tropism:' line without T: or E:");
-                v.tropism = true;
-            } else {
-                const std::string shown = label.empty() ? shorten(std::string_view(clean).substr(p, end - p)) : label;
-                warn.add(src.where(p) + "view line '" + shown + "' is not used; skipped");
-            }
-        }
-        if (e >= clean.size()) break;
-        b = e + 1;
-    }
-    warn.finish(source_name);
-    return v;
-}
-
-LSystemFile load_lsystem_file(const std::filesystem::path& path)
-{
-    auto read = [](const std::filesystem::path& p) {
-        std::error_code ec;
-        const auto size = std::filesystem::file_size(p, ec);
-        if (ec) throw FileError(p.string(), "cannot read: " + ec.message());
-        if (size > kMaxFileBytes)
-            throw InvalidInput(p.string() + ":1:1: the file is " + std::to_string(size) + " bytes, over the limit of " +
-                               std::to_string(kMaxFileBytes) + " bytes");
-        std::ifstream in(p, std::ios::binary);
-        if (!in) throw FileError(p.string(), "cannot open");
-        std::string text;
-        text.resize(static_cast<std::size_t>(size));
-        in.read(text.data(), static_cast<std::streamsize>(size));
-        if (static_cast<std::size_t>(in.gcount()) != size) throw FileError(p.string(), "cannot read the whole file");
-        return text;
-    };
-    LSystemFile f;
-    const std::string text = read(path);
-    f.system = parse_lsystem(text, path.string(), &f.warnings);
-    std::filesystem::path view = path;
-    view.replace_extension(".v");
-    std::error_code ec;
-    if (view != path && std::filesystem::is_regular_file(view, ec)) {
-        const std::string vtext = read(view);
-        f.view = parse_view(vtext, view.string(), &f.warnings);
-        f.has_view = true;
-    }
-    return f;
 }
 
 } // namespace lobe::lsystem

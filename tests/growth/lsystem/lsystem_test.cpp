@@ -11,6 +11,7 @@
 
 #include "core/errors.h"
 #include "growth/lsystem/lsystem.h"
+#include "tests/support/expect_throw.h"
 
 namespace lobe::lsystem {
 namespace {
@@ -561,6 +562,23 @@ elasticity increment: 0.05
     EXPECT_DOUBLE_EQ(t.angle_increment_deg, 30.0);
     EXPECT_EQ(t.tropism_direction, glm::dvec3(1, 0, 0));
     EXPECT_DOUBLE_EQ(t.elasticity, 0.4);
+}
+
+TEST(LSystemView, WidthsArePixelsUnlessTheViewSaysPolygonsOrACylinderLineStyle)
+{
+    using Unit = ViewSettings::WidthUnit;
+    EXPECT_EQ(ViewSettings{}.width_unit, Unit::Pixels); // cpfg's default
+    EXPECT_EQ(parse_view("initial line width: 3\n", "a.v").width_unit, Unit::Pixels);
+    EXPECT_EQ(parse_view("initial line width: 3 pixels\n", "a.v").width_unit, Unit::Pixels);
+    EXPECT_EQ(parse_view("initial line width: 0.2 polygons\n", "a.v").width_unit, Unit::Model);
+    EXPECT_EQ(parse_view("line style: cylinder\n", "a.v").width_unit, Unit::Model);
+    EXPECT_EQ(parse_view("line style: polygon\n", "a.v").width_unit, Unit::Model);
+    EXPECT_EQ(parse_view("line style: polygon\nline style: pixel\n", "a.v").width_unit, Unit::Pixels);
+    EXPECT_DOUBLE_EQ(parse_view("initial line width: 0.2 polygons\n", "a.v").initial_line_width, 0.2);
+    const std::string style = test::invalid_input_message([] { parse_view("line style: dotted\n", "b.v"); });
+    EXPECT_EQ(style.rfind("b.v:1:12: ", 0), 0u) << style;
+    const std::string unit = test::invalid_input_message([] { parse_view("initial line width: 2 inches\n", "c.v"); });
+    EXPECT_EQ(unit.rfind("c.v:1:", 0), 0u) << unit;
 }
 
 TEST(LSystemView, LoadReadsTheViewFileBesideTheLFile)

@@ -1,0 +1,2 @@
+/* View of default.l: widths in metres, like lengths. */
+line style: cylinder

@@ -1,0 +1,2 @@
+/* View of lobe-filler.l: widths in metres, like lengths. */
+line style: cylinder

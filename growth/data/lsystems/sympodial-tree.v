@@ -1,0 +1,2 @@
+/* View of sympodial-tree.l: widths in model units, like lengths. */
+line style: cylinder
