@@ -75,7 +75,8 @@ MetamerTree skeleton_metamers(const Skeleton& sk, const std::vector<MeshRaycaste
             if (rays[l].inside(m.tip)) m.lobe = static_cast<int>(l);
         m.phyllotaxis = static_cast<float>(static_cast<double>(i) * run.species.phyllotaxis_deg * std::numbers::pi / 180.0);
         m.lateral_dir = lateral_bud_direction(m.dir, m.phyllotaxis, angle);
-        m.lateral_bud = m.lobe >= 0 && rays[static_cast<std::size_t>(m.lobe)].inside(m.tip);
+        m.lateral_bud = m.lobe >= 0 && static_cast<std::size_t>(m.lobe) < rays.size() &&
+                        rays[static_cast<std::size_t>(m.lobe)].inside(m.tip);
         m.terminal_bud = !has_child[i];
         const bool lateral = m.parent >= 0 ? tree.metamers[static_cast<std::size_t>(m.parent)].main_child >= 0
                                            : tree.first_root >= 0;
