@@ -1,4 +1,5 @@
-// `lobesketch info REC`: what a recording holds.
+// `lobesketch info REC`: what a recording holds; `lobesketch info SESSION.json`: its tree and
+// the wood, carbon and CO₂ in it (growth/wood.h).
 #include <cstdio>
 #include <iostream>
 #include <map>
@@ -8,6 +9,9 @@
 
 #include "app/cli/cli.h"
 #include "app/cli/cli_common.h"
+#include "app/session/session_file.h"
+#include "app/session/tree_pipeline.h"
+#include "growth/wood.h"
 
 namespace lobe::cli {
 
@@ -49,16 +53,51 @@ HandStats hand_stats(const Recording& rec, int h)
 }
 
 
+/// A session's tree: its grower, nodes and wood estimate, as text or JSON.
+void session_info(const std::string& path, bool as_json)
+{
+    const Document doc = load_session(path);
+    const BuiltTree tree = build_document_tree(doc);
+    for (const std::string& w : tree.warnings) warn(path + ": " + w);
+    const WoodEstimate e = estimate_wood(tree.growth.tree, basic_wood_density(doc.settings.growth.species));
+    const GrowerChoice& grower = scene_grower(doc);
+    if (as_json) {
+        const nlohmann::json j = {{"file", path},
+                                  {"grower", grower.name},
+                                  {"lobes", tree.lobes.size()},
+                                  {"nodes", tree.growth.tree.size()},
+                                  {"species", doc.settings.growth.species},
+                                  {"wood",
+                                   {{"wood_volume_m3", e.wood_volume_m3},
+                                    {"dry_biomass_kg", e.dry_biomass_kg},
+                                    {"carbon_kg", e.carbon_kg},
+                                    {"co2_kg", e.co2_kg},
+                                    {"density_kg_m3", e.density_kg_m3}}}};
+        std::cout << j.dump(2) << "\n";
+        return;
+    }
+    std::printf("%s\n  grower %s, %zu lobe(s), %zu nodes, species %s\n", path.c_str(), grower.name.c_str(),
+                tree.lobes.size(), tree.growth.tree.size(), doc.settings.growth.species.c_str());
+    std::printf("  wood %.6g m3, dry biomass %.6g kg (%.0f kg/m3), carbon %.6g kg, CO2 %.6g kg (as sketched)\n",
+                e.wood_volume_m3, e.dry_biomass_kg, e.density_kg_m3, e.carbon_kg, e.co2_kg);
+}
+
 } // namespace
 
 void add_info_command(CLI::App& app, int& exit_code)
 {
-    auto* cmd = app.add_subcommand("info", "Summarise a recording: duration, frames per hand, drop-outs, events");
+    auto* cmd = app.add_subcommand("info", "Summarise a recording (duration, frames per hand, drop-outs, events) or a "
+                                           "session document (its tree, wood, carbon and CO2)");
     auto path = std::make_shared<std::string>();
     auto as_json = std::make_shared<bool>(false);
-    cmd->add_option("REC", *path, "Recording (binary or text form)")->required();
+    cmd->add_option("REC", *path, "Recording (binary or text form), or session document (.json)")->required();
     cmd->add_flag("--json", *as_json, "Print the summary as JSON");
     cmd->callback([path, as_json, &exit_code] {
+        if (lower_extension(*path) == ".json") {
+            session_info(*path, *as_json);
+            exit_code = kExitOk;
+            return;
+        }
         Recording rec = load_recording_verbose(*path);
         const double duration = rec.frames.size() > 1 ? rec.frames.back().time - rec.frames.front().time : 0.0;
         std::map<std::string, std::size_t> events;

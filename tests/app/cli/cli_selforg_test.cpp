@@ -121,5 +121,23 @@ TEST(WoodReportCli, EveryGrowerWritesTheWoodReportAndHeightScalesItByTheCube)
     }
 }
 
+TEST(WoodReportCli, InfoOnASessionPrintsTheSameWoodAsTheGrowReport)
+{
+    const std::string out = test::temp_dir("wood-info-cli");
+    const std::string session = test::source_path("tests/data/sessions/edit-stroke-transform.json");
+    const test::CliRun info = test::run_cli("info " + session + " --json");
+    ASSERT_EQ(info.code, 0) << info.out;
+    const nlohmann::json j = nlohmann::json::parse(info.out.substr(info.out.find('{')));
+    const test::CliRun grow = test::run_cli("grow " + session + " --out " + out + "/t.glb --report " + out + "/r.json");
+    ASSERT_EQ(grow.code, 0) << grow.out;
+    const nlohmann::json r = nlohmann::json::parse(bytes(out + "/r.json"));
+    EXPECT_GT(j["nodes"].get<std::size_t>(), 100u);
+    for (const char* key : {"wood_volume_m3", "dry_biomass_kg", "carbon_kg", "co2_kg", "density_kg_m3"})
+        EXPECT_EQ(j["wood"][key], r[key]) << key;
+    const test::CliRun text = test::run_cli("info " + session);
+    ASSERT_EQ(text.code, 0) << text.out;
+    EXPECT_NE(text.out.find("CO2"), std::string::npos) << text.out;
+}
+
 } // namespace
 } // namespace lobe
