@@ -11,6 +11,7 @@
 #include "app/cli/cli_common.h"
 #include "app/export/tree_output.h"
 #include "app/export/export_scene.h"
+#include "app/export/skeleton_json.h"
 #include "app/session/tree_pipeline.h"
 #include "core/atomic_file.h"
 #include "core/errors.h"
@@ -22,7 +23,7 @@ namespace {
 
 struct TreeArgs {
     TreeInputOptions in;
-    std::string input, out, lod = "all", report;
+    std::string input, out, lod = "all", report, skeleton_out;
     double height = 0.0;
     bool lobes = false, strokes = false;
 };
@@ -37,6 +38,8 @@ void add_tree_options(CLI::App* cmd, TreeArgs& a)
     cmd->add_flag("--strokes", a.strokes, "Also write the strokes as extra nodes");
     cmd->add_option("--report", a.report,
                     "Write the tree's wood volume, dry biomass, carbon and CO2 as JSON (docs/wood-and-co2.md)");
+    cmd->add_option("--skeleton-out", a.skeleton_out,
+                    "Also write the tree graph as JSON: nodes with parents, positions, radii, lobes (docs/growth.md)");
 }
 
 /// The wood report as JSON: the tree as grown, and scaled to --height when given.
@@ -83,6 +86,10 @@ void report_and_write(const TreeArgs& a, const Document& doc, const BuiltTree& t
     if (!a.report.empty()) {
         write_file_atomic(a.report, wood_report(a, doc, tree, geometry));
         progress("wrote " + a.report);
+    }
+    if (!a.skeleton_out.empty()) {
+        write_skeleton_json(a.skeleton_out, tree);
+        progress("wrote " + a.skeleton_out);
     }
     std::size_t attractors = 0, reached = 0;
     for (const LobeGrowthStats& l : tree.growth.lobes) {

@@ -100,7 +100,7 @@ void add_lsystem_command(CLI::App& app, int& exit_code)
     cmd->add_option("--lobes", a->lobes,
                     "Grow in the lobes of this session document (.json): from its trunk base, with its settings");
     cmd->add_option("--string-out", a->string_out, "Also write the derived word, one line");
-    cmd->add_option("--skeleton-out", a->skeleton_out, "Also write the tree graph as JSON (docs/lsystem-turtle.md)");
+    cmd->add_option("--skeleton-out", a->skeleton_out, "Also write the tree graph as JSON (docs/growth.md)");
     cmd->add_option("--height", a->in.height, "A tree grown without lobes is scaled to this height in metres (default 3)")
         ->check(CLI::Range(0.01, 100.0));
     cmd->add_option("--settings", a->in.settings, "Settings JSON (a settings object or a session document)");
@@ -118,9 +118,7 @@ void add_lsystem_command(CLI::App& app, int& exit_code)
             progress("wrote " + a->string_out);
         }
         if (!a->skeleton_out.empty()) {
-            std::vector<std::int64_t> ids;
-            for (const BuiltLobe& l : tree.lobes) ids.push_back(l.lobe_id);
-            write_skeleton_json(a->skeleton_out, tree.growth.tree, ids);
+            write_skeleton_json(a->skeleton_out, tree);
             progress("wrote " + a->skeleton_out);
         }
         if (tree.growth.tree.size() <= tree.growth.skeleton_nodes) {

@@ -48,4 +48,11 @@ void write_skeleton_json(const std::string& path, const TreeGraph& tree, const s
     write_file_atomic(path, skeleton_json(tree, lobe_ids));
 }
 
+void write_skeleton_json(const std::string& path, const BuiltTree& tree)
+{
+    std::vector<std::int64_t> ids;
+    for (const BuiltLobe& l : tree.lobes) ids.push_back(l.lobe_id);
+    write_skeleton_json(path, tree.growth.tree, ids);
+}
+
 } // namespace lobe

@@ -1,6 +1,6 @@
 #pragma once
 /// \file skeleton_json.h
-/// The tree graph as a file (`--skeleton-out tree.json`, docs/lsystem-turtle.md):
+/// The tree graph as a file (`--skeleton-out tree.json`, docs/growth.md):
 ///
 ///   {"nodes": [{"id": 0, "parent": -1, "position": [x, y, z], "radius": r, "lobe": 0}, …]}
 ///
@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "app/session/tree_pipeline.h"
 #include "core/tree.h"
 
 namespace lobe {
@@ -25,5 +26,8 @@ std::string skeleton_json(const TreeGraph& tree, const std::vector<std::int64_t>
 
 /// skeleton_json written atomically to `path`. \throw FileError when writing fails.
 void write_skeleton_json(const std::string& path, const TreeGraph& tree, const std::vector<std::int64_t>& lobe_ids);
+
+/// A grown tree's graph, its lobes named by their ids (`--skeleton-out` of every command).
+void write_skeleton_json(const std::string& path, const BuiltTree& tree);
 
 } // namespace lobe
