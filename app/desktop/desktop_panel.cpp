@@ -52,6 +52,7 @@ void draw_desktop_panel(DesktopSession& session, const std::string& session_name
     ImGui::Text("%zu strokes, %zu lobes, %zu edits", st.strokes, st.lobes, st.edits);
     ImGui::Text("depth %.2f m%s%s", st.depth_m, st.regrowing ? "  building..." : "", st.importing ? "  importing..." : "");
     if (st.tree_triangles) ImGui::Text("tree: LOD%d, %zu triangles", st.lod, st.tree_triangles);
+    if (st.co2_kg > 0.0) ImGui::Text("wood %.4f m3, CO2 %.2f kg", st.wood_m3, st.co2_kg);
     if (!st.last_message.empty()) ImGui::TextWrapped("%s", st.last_message.c_str());
 
     if (ImGui::CollapsingHeader("Stages and tools", ImGuiTreeNodeFlags_DefaultOpen)) {

@@ -258,6 +258,9 @@ void DesktopSession::frame(double time, int width, int height)
     status_.tree_error = live_->tree_error();
     status_.lod = live_->view().lod_shown();
     status_.tree_triangles = live_->view().tree_triangles();
+    const RegrowResult* built = live_->grown() ? live_->built() : nullptr;
+    status_.wood_m3 = built ? built->wood.wood_volume_m3 : 0.0;
+    status_.co2_kg = built ? built->wood.co2_kg : 0.0;
     last_hand_ = hand_frame.hand(Hand::Right);
     add_frame_items();
 }

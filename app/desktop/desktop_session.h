@@ -77,6 +77,7 @@ struct DesktopStatus {
     std::string last_message;   ///< newest warning or result line
     std::string tree_error;     ///< why the last regrowth failed (empty: it did not)
     std::size_t tree_triangles = 0; ///< of the LOD drawn
+    double wood_m3 = 0.0, co2_kg = 0.0; ///< of the tree shown (docs/wood-and-co2.md)
     int lod = 0;                    ///< the LOD drawn
 };
 

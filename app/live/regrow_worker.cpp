@@ -91,6 +91,7 @@ void RegrowWorker::run()
                 warnings.insert(warnings.end(), result.tree.warnings.begin(), result.tree.warnings.end());
                 result.tree.warnings = std::move(warnings);
                 result.geometry = document_tree_geometry(doc, result.tree);
+                result.wood = estimate_wood(result.tree.growth.tree, basic_wood_density(doc.settings.growth.species));
                 result.grown = true;
             } else {
                 result.tree.lobes = std::move(lobes);

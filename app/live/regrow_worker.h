@@ -16,6 +16,7 @@
 #include "app/render/renderer.h"
 #include "app/session/tree_pipeline.h"
 #include "growth/tree_geometry.h"
+#include "growth/wood.h"
 
 namespace lobe {
 
@@ -24,6 +25,9 @@ struct RegrowResult {
     bool grown = false;           ///< the tree was grown (else only the lobes were built)
     BuiltTree tree;
     TreeGeometry geometry;
+    /// The grown tree's wood, carbon and CO₂ (growth/wood.h, docs/wood-and-co2.md); zeros
+    /// until grown.
+    WoodEstimate wood;
     std::string error; ///< non-empty when the document could not be grown (one line)
     /// What the app draws of this result, when the worker was given a prepare hook: made on
     /// the worker's thread with the rest, so that taking a result costs a frame nothing.

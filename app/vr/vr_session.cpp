@@ -437,6 +437,12 @@ void VrSession::Impl::update_status()
     std::string label = grabbing_scene ? "MOVING SCENE" : tool_label(s.tool);
     if (s.drawing) label += s.tool == Tool::DrawLobe || s.tool == Tool::DrawTrunk ? " - DRAWING" : " - DRAGGING";
     if (live.grown()) label += s.regrowing ? "  GROWING..." : "  TREE";
+    if (live.grown() && live.built() && live.built()->wood.co2_kg > 0.0) {
+        // The tree's CO2 as grown (docs/wood-and-co2.md), to a tenth of a kilogram.
+        const double kg = std::round(live.built()->wood.co2_kg * 10.0) / 10.0;
+        const std::string text = std::to_string(kg);
+        label += "  CO2 " + text.substr(0, text.find('.') + 2) + " KG";
+    }
     s.label = label;
 }
 

@@ -17,6 +17,8 @@
 #include "app/desktop/desktop_script.h"
 #include "app/desktop/desktop_session.h"
 #include "app/session/edit_hooks.h"
+#include "app/session/tree_pipeline.h"
+#include "growth/wood.h"
 #include "core/atomic_file.h"
 #include "core/errors.h"
 #include "input/desktop_hand.h"
@@ -231,6 +233,12 @@ TEST(DesktopSession, SketchBuildsLobeAndTreeAndEveryChangeIsAutosaved)
     EXPECT_TRUE(s.status().grown);
     EXPECT_TRUE(s.status().tree_error.empty()) << s.status().tree_error;
     EXPECT_GT(s.status().tree_triangles, 1000u);
+    // The panel's wood and CO2 are those of the tree shown (docs/wood-and-co2.md).
+    const BuiltTree shown = build_document_tree(doc);
+    const WoodEstimate wood = estimate_wood(shown.growth.tree, basic_wood_density(doc.settings.growth.species));
+    EXPECT_GT(wood.co2_kg, 0.0);
+    EXPECT_DOUBLE_EQ(s.status().wood_m3, wood.wood_volume_m3);
+    EXPECT_DOUBLE_EQ(s.status().co2_kg, wood.co2_kg);
     // The autosave holds exactly the document as it is now, stamped with how much of the
     // recording it holds (docs/crash-safety.md).
     const auto unstamped = [](Document saved) {

@@ -188,6 +188,7 @@ TEST(VrSession, ScriptedSessionExercisesEveryInteractionAndItsRecordingReplaysTo
     poke(script, s, "GROW");
     EXPECT_TRUE(s.status().grown);
     EXPECT_NE(s.status().label.find("TREE"), std::string::npos) << s.status().label;
+    EXPECT_NE(s.status().label.find("CO2 "), std::string::npos) << s.status().label; // the tree's CO2, kg
     EXPECT_TRUE(s.status().tree_error.empty()) << s.status().tree_error;
     script.wait(0.2);
 
