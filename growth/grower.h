@@ -56,6 +56,21 @@ public:
     /// …"), for a version newer than version(), an unknown parameter, a wrong type or a
     /// value out of range.
     virtual void check_params(const GrowerChoice& choice, const std::string& where) const = 0;
+    /// The name of its whole-number parameter that counts growth steps, or empty when it has
+    /// none. A growth of k steps is the first k steps of the growth (self-organizing:
+    /// iterations; lsystem: derivation steps), so the apps can step a tree's growth forward
+    /// and back and show it as it happens (a Setting event of id GrowthSteps,
+    /// input/recording.h); the same seed gives the same tree at every step. What values the
+    /// parameter takes is check_params's to say.
+    virtual std::string_view steps_param() const { return {}; }
+    /// The number of steps it grows when `choice` does not give steps_param() (it may depend
+    /// on the other parameters, e.g. the species or the L-system's `derivation length:`);
+    /// 0 for a grower without steps. \pre check_params(choice) passed.
+    virtual int default_steps(const GrowerChoice& choice) const
+    {
+        (void)choice;
+        return 0;
+    }
     /// Grows the tree. Deterministic for the same input. Radii are left to the caller
     /// (growth/radii.h). \pre check_params(input.choice) passed.
     virtual GrowthResult grow(const GrowerInput& input) const = 0;

@@ -108,8 +108,22 @@ public:
     int version() const override { return 1; }
     int panel_code() const override { return kGrowerPanelCode; }
     void check_params(const GrowerChoice& choice, const std::string& where) const override;
+    /// Derivation steps 0 … kMaxDerivationLength: k steps derive the first k of a longer
+    /// derivation (the turtle draws the word after them).
+    std::string_view steps_param() const override { return "steps"; }
+    int default_steps(const GrowerChoice& choice) const override;
     GrowthResult grow(const GrowerInput& in) const override { return run_lsystem(in).growth; }
 };
+
+int LSystemGrower::default_steps(const GrowerChoice& choice) const
+{
+    if (const auto it = choice.params.find("steps"); it != choice.params.end())
+        if (const auto* n = std::get_if<std::int64_t>(&it->second)) return static_cast<int>(*n);
+    // The L-system's own `derivation length:` (its messages are the grower's to give).
+    const LSystemSource src = choice_source(choice);
+    std::vector<std::string> messages;
+    return parse_lsystem(src.text, src.name, &messages).derivation_length();
+}
 
 void LSystemGrower::check_params(const GrowerChoice& choice, const std::string& where) const
 {

@@ -237,6 +237,13 @@ public:
                                std::to_string(version()) + ")");
         parse_selforg_choice(choice, where);
     }
+    /// Iterations 1 … 500: k iterations grow the first k of a longer growth.
+    std::string_view steps_param() const override { return "iterations"; }
+    int default_steps(const GrowerChoice& choice) const override
+    {
+        const SelfOrgChoice c = parse_selforg_choice(choice, "grower");
+        return c.iterations > 0 ? c.iterations : selforg_species(c.species).iterations;
+    }
     GrowthResult grow(const GrowerInput& in) const override
     {
         const SelfOrgChoice c = parse_selforg_choice(in.choice, "grower.params");
