@@ -80,6 +80,7 @@ const char* setting_name(SettingId id)
     case SettingId::Species: return "species";
     case SettingId::Seed: return "seed";
     case SettingId::Grower: return "grower";
+    case SettingId::GrowthSteps: return "growth-steps";
     }
     return nullptr;
 }

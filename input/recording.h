@@ -77,12 +77,14 @@ enum class SettingId : std::int32_t {
     Species = 5,          ///< an index into kSettingSpecies; tree-wide or per lobe (LobeRecord::species)
     Seed = 6,             ///< an integer in [1, 2^24) (Document::seed); tree-wide only
     Grower = 7,           ///< a grower's panel code (growth/grower.h); tree-wide only (trees[0].grower)
+    GrowthSteps = 8,      ///< an integer ≥ 0: the scene grower's growth steps (Grower::steps_param), 0 for
+                          ///< its default; tree-wide only
 };
 
 /// "split-angle", "attractor-spacing", "leaf-length", "leaves-per-node", "species", "seed",
-/// "grower"; nullptr for an id this build does not know.
+/// "grower", "growth-steps"; nullptr for an id this build does not know.
 const char* setting_name(SettingId id);
-inline bool known_setting_id(std::int32_t id) { return id >= 1 && id <= 7; }
+inline bool known_setting_id(std::int32_t id) { return id >= 1 && id <= 8; }
 
 /// The species a Setting event of id Species chooses from, by index (x = 0 … 3).
 inline constexpr const char* kSettingSpecies[] = {"broadleaf", "conifer", "willow", "birch"};

@@ -93,6 +93,7 @@ const std::vector<PanelSetting>& panel_settings()
         {"species", static_cast<int>(SettingId::Species)},
         {"seed", static_cast<int>(SettingId::Seed)},
         {"grower", static_cast<int>(SettingId::Grower)},
+        {"growth-steps", static_cast<int>(SettingId::GrowthSteps)},
     };
     return settings;
 }

@@ -1,6 +1,9 @@
 #include "app/session/panel_controls.h"
 
 #include <algorithm>
+#include <variant>
+
+#include "core/errors.h"
 
 #include "growth/grower.h"
 
@@ -29,6 +32,10 @@ const std::vector<PanelControl>& panel_controls()
         {SettingId::Seed, "seed", "seed", 1.0, 16777215.0, 1.0, nullptr},
         {SettingId::Grower, "grower", "grower", 0.0, double(highest_panel_code()), 1.0,
          "the scene's tree grows with one grower"},
+        // The most any grower takes (lsystem's kMaxDerivationLength); each grower's
+        // check_params says what it takes.
+        {SettingId::GrowthSteps, "growth-steps", "step", 0.0, 100000.0, 1.0,
+         "the scene's tree grows with one grower"},
     };
     return controls;
 }
@@ -38,6 +45,27 @@ const PanelControl* find_panel_control(SettingId id)
     for (const PanelControl& c : panel_controls())
         if (c.id == id) return &c;
     return nullptr;
+}
+
+std::optional<int> growth_steps(const GrowerChoice& choice)
+{
+    const Grower* g = find_grower(choice.name);
+    if (!g || g->steps_param().empty()) return std::nullopt;
+    if (const auto it = choice.params.find(std::string(g->steps_param())); it != choice.params.end())
+        if (const auto* n = std::get_if<std::int64_t>(&it->second)) return static_cast<int>(*n);
+    try {
+        return g->default_steps(choice);
+    } catch (const Error&) {
+        return 0;
+    }
+}
+
+std::optional<double> growth_steps_after(const GrowerChoice& choice, int delta)
+{
+    const std::optional<int> now = growth_steps(choice);
+    if (!now) return std::nullopt;
+    // 1 at least: 0 would be the grower's default again.
+    return double(std::clamp(*now + delta, 1, int(find_panel_control(SettingId::GrowthSteps)->hi)));
 }
 
 const SettingInfo* PanelControl::setting() const { return find_setting(key); }

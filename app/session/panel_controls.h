@@ -7,9 +7,11 @@
 /// setting's range in the settings table (core/settings_table.h); the panel's range lies
 /// within it. Formats and per-lobe overrides: docs/recording-format.md, docs/editing.md.
 
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "core/grower_choice.h"
 #include "core/settings_table.h"
 #include "input/recording.h"
 
@@ -18,7 +20,8 @@ namespace lobe {
 struct PanelControl {
     SettingId id;
     /// The settings-table key it sets ("growth.split_angle_deg"), "seed" for Document::seed
-    /// or "grower" for the scene's grower (by its panel code, growth/grower.h). Species sets
+    /// "grower" for the scene's grower (by its panel code, growth/grower.h) or
+    /// "growth-steps" for its growth steps (Grower::steps_param). Species sets
     /// growth.species by an index into kSettingSpecies.
     const char* key;
     const char* label;   ///< shown on the panel
@@ -29,9 +32,16 @@ struct PanelControl {
     /// The settings-table row it sets; nullptr for the seed.
     const SettingInfo* setting() const;
     /// What a Setting event's value must lie in: the setting's range in the table, or for
-    /// Species, Seed and Grower, [lo, hi] (whole numbers).
+    /// Species, Seed, Grower and GrowthSteps, [lo, hi] (whole numbers).
     SettingRange accepts() const;
 };
+
+/// The growth steps of the grower `choice` names: its steps parameter (Grower::steps_param),
+/// else the grower's default; nullopt for a grower that does not grow in steps.
+std::optional<int> growth_steps(const GrowerChoice& choice);
+/// What a panel's step button sends (a GrowthSteps Setting event's value): growth_steps
+/// moved by `delta`, at least 1 (0 would mean the default again); nullopt as growth_steps.
+std::optional<double> growth_steps_after(const GrowerChoice& choice, int delta);
 
 /// Every panel setting, in SettingId order: what the apps' panels show.
 const std::vector<PanelControl>& panel_controls();

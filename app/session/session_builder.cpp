@@ -803,6 +803,24 @@ bool SessionBuilder::apply_setting(const InputAction& a)
             }
             break;
         }
+        case SettingId::GrowthSteps: {
+            // The scene grower's steps parameter (growth/grower.h steps_param); 0 removes it
+            // (the grower's default).
+            const GrowerChoice& now = scene_grower(doc_);
+            const Grower* g = find_grower(now.name);
+            if (!g || g->steps_param().empty())
+                return refuse("the " + now.name + " grower does not grow in steps");
+            if (!whole(accepts.lo, accepts.hi))
+                return refuse("the growth steps must be a whole number from " + number_text(accepts.lo) + " to " +
+                              number_text(accepts.hi) + " (0: the grower's default)");
+            GrowerChoice choice = now;
+            const std::string param(g->steps_param());
+            if (v == 0.0) choice.params.erase(param);
+            else choice.params[param] = static_cast<std::int64_t>(v);
+            g->check_params(choice, "grower");
+            if (choice != now) grower_after = std::move(choice);
+            break;
+        }
         case SettingId::Seed:
             if (!whole(accepts.lo, accepts.hi))
                 return refuse("the seed must be a whole number from " + number_text(accepts.lo) + " to " +

@@ -613,7 +613,8 @@ TEST(RecordingSettings, SettingEventsRoundTripExactlyInBothForms)
     EXPECT_STREQ(event_kind_name(InputEventKind::Setting), "setting");
     EXPECT_STREQ(setting_name(SettingId::LeavesPerNode), "leaves-per-node");
     EXPECT_STREQ(setting_name(SettingId::Grower), "grower");
-    EXPECT_EQ(setting_name(static_cast<SettingId>(8)), nullptr);
+    EXPECT_STREQ(setting_name(SettingId::GrowthSteps), "growth-steps");
+    EXPECT_EQ(setting_name(static_cast<SettingId>(9)), nullptr);
 }
 
 TEST(RecordingSettings, UnknownSettingIdIsSkippedWithAWarningNotACrash)

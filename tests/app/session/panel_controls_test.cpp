@@ -8,6 +8,7 @@
 
 #include "app/session/panel_controls.h"
 #include "app/session/session_builder.h"
+#include "growth/grower.h"
 #include "core/settings_table.h"
 
 using namespace lobe;
@@ -21,7 +22,7 @@ TEST(PanelControls, EverySettingEventIdHasAControlNamingATableSetting)
         EXPECT_EQ(find_panel_control(c.id), &c);
         EXPECT_TRUE(known_setting_id(static_cast<std::int32_t>(c.id)));
         const std::string key = c.key;
-        EXPECT_TRUE(c.setting() || key == "seed" || key == "grower") << c.key;
+        EXPECT_TRUE(c.setting() || key == "seed" || key == "grower" || key == "growth-steps") << c.key;
         EXPECT_FALSE(std::string(c.label).empty());
         // The widget's range lies within what a Setting event may carry, and its step fits it.
         const SettingRange accepts = c.accepts();
@@ -56,9 +57,11 @@ TEST(PanelControls, TheSessionBuilderAcceptsWhatTheControlsSay)
         a.setting.lobe = lobe;
         return a;
     };
-    // Both ends of every control's range are accepted.
+    // Both ends of every control's range are accepted (the growth steps by the grower whose
+    // range is the control's: lsystem's derivation steps, 0 … kMaxDerivationLength).
     for (const PanelControl& c : panel_controls())
         for (double v : {c.lo, c.hi}) {
+            if (c.id == SettingId::GrowthSteps) b.apply(setting(SettingId::Grower, find_grower("lsystem")->panel_code()));
             b.apply(setting(c.id, v));
             EXPECT_TRUE(b.messages().empty()) << c.label << " " << v << ": " << b.messages().back();
         }
