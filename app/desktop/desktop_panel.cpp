@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include <imgui.h>
@@ -87,6 +88,31 @@ void draw_desktop_panel(DesktopSession& session, const std::string& session_name
                 if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", std::string(g->title()).c_str());
             }
             ImGui::EndCombo();
+        }
+        // A grower that grows in steps: its growth one step back or on (growth/grower.h
+        // steps_param), from its default when the session does not give the steps.
+        // (The default may mean parsing an L-system: once per choice, not once per frame.)
+        static GrowerChoice steps_of; // the default grower, which has no steps
+        static std::optional<int> steps_cached;
+        if (steps_of != current) {
+            steps_of = current;
+            steps_cached = growth_steps(current);
+        }
+        if (const std::optional<int> steps = steps_cached) {
+            const Grower* g = find_grower(current.name);
+            const bool given = current.params.count(std::string(g->steps_param())) != 0;
+            const auto step = [&](int delta) {
+                if (const std::optional<double> v = growth_steps_after(current, delta))
+                    session.setting(static_cast<int>(SettingId::GrowthSteps), 0, *v);
+            };
+            if (ImGui::ArrowButton("##step-back", ImGuiDir_Left)) step(-1);
+            if (ImGui::IsItemHovered()) ImGui::SetTooltip("one growth step back");
+            ImGui::SameLine();
+            if (ImGui::ArrowButton("##step-on", ImGuiDir_Right)) step(+1);
+            if (ImGui::IsItemHovered()) ImGui::SetTooltip("one growth step on");
+            ImGui::SameLine();
+            if (given) ImGui::Text("step %d", *steps);
+            else ImGui::Text("step %d (default)", *steps);
         }
     }
     if (ImGui::CollapsingHeader("Appearance", ImGuiTreeNodeFlags_DefaultOpen)) {

@@ -47,6 +47,7 @@ constexpr std::array<float, 4> kDragInkColor{0.25f, 0.65f, 1.0f, 1.0f};
 /// Setting buttons: what they change and by how much (multiplicative steps for sizes).
 enum SettingButton : int {
     kAngleDown = 1, kAngleUp, kLeafDown, kLeafUp, kLeavesDown, kLeavesUp, kNextSpecies, kNextSeed, kNextGrower,
+    kStepBack, kStepOn,
 };
 
 /// The button a key or setting button is made from (positions come from the layout).
@@ -128,7 +129,8 @@ VrPanel vr_panel_layout(const Pose& head)
          setting_button("LEAF -", kLeafDown), setting_button("LEAF +", kLeafUp),
          setting_button("LEAVES -", kLeavesDown), setting_button("LEAVES +", kLeavesUp)},
         {setting_button("SPECIES", kNextSpecies), setting_button("SEED", kNextSeed),
-         key_button("DEL STROKE", keys::kDeleteStroke), setting_button("GROWER", kNextGrower)},
+         key_button("DEL STROKE", keys::kDeleteStroke), setting_button("GROWER", kNextGrower),
+         setting_button("STEP -", kStepBack), setting_button("STEP +", kStepOn)},
     };
     const float pitch_x = kButtonW + kButtonGap, pitch_y = kButtonH + kButtonGap;
     const float top = 0.5f * float(rows.size() - 1) * pitch_y;
@@ -363,6 +365,15 @@ void VrSession::Impl::press(const VrButton& b, int index)
         for (std::size_t i = 0; i < list.size(); ++i)
             if (list[i]->name() == scene_grower(doc).name) current = i;
         v = list[(current + 1) % list.size()]->panel_code();
+        break;
+    }
+    case kStepBack:
+    case kStepOn: {
+        // The scene grower's growth one step back or on (growth/grower.h steps_param); a
+        // grower without steps is told so by the session, as a setting it refuses.
+        e.code = static_cast<int>(SettingId::GrowthSteps);
+        const std::optional<double> after = growth_steps_after(scene_grower(doc), b.setting == kStepOn ? 1 : -1);
+        v = after ? *after : 1.0;
         break;
     }
     case kNextSeed:

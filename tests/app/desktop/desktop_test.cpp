@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -17,10 +18,13 @@
 #include "app/desktop/desktop_script.h"
 #include "app/desktop/desktop_session.h"
 #include "app/session/edit_hooks.h"
+#include "app/session/panel_controls.h"
+#include "app/session/session_file.h"
 #include "app/session/tree_pipeline.h"
 #include "growth/wood.h"
 #include "core/atomic_file.h"
 #include "core/errors.h"
+#include "growth/grower.h"
 #include "input/desktop_hand.h"
 #include "input/gestures.h"
 #include "input/pipeline.h"
@@ -559,6 +563,58 @@ TEST(DesktopSession, RecordingReplaysToTheSameDocument)
     replayed.source_recording = live.source_recording;
     EXPECT_EQ(document_to_json(replayed), document_to_json(live));
     EXPECT_EQ(live.edits.size(), 1u) << "the undo took back the move";
+}
+
+/// A press of the Grower section's step button: what desktop_panel.cpp sends.
+void press_step(DesktopSession& s, int delta)
+{
+    const std::optional<double> v = growth_steps_after(scene_grower(s.document()), delta);
+    ASSERT_TRUE(v) << "the grower has no step buttons";
+    s.setting(static_cast<int>(SettingId::GrowthSteps), 0, *v);
+}
+
+TEST(DesktopSession, TheGrowerStepButtonsStepTheGrowthOnAndBackAndTheRecordingReplaysThem)
+{
+    const std::string dir = temp_dir("desktop_steps");
+    Document start;
+    GrowerChoice selforg;
+    selforg.name = "self-organizing";
+    selforg.params["iterations"] = std::int64_t{3};
+    set_scene_grower(start, selforg);
+    Document live;
+    {
+        DesktopSession s(start, quiet_options(dir));
+        Driver d{s};
+        d.step(2);
+        const auto iterations = [&] { return std::get<std::int64_t>(scene_grower(s.document()).params.at("iterations")); };
+        press_step(s, +1);
+        d.step();
+        EXPECT_EQ(iterations(), 4);
+        press_step(s, -1);
+        d.step();
+        press_step(s, -1);
+        d.step();
+        EXPECT_EQ(iterations(), 2);
+        EXPECT_EQ(growth_steps(scene_grower(s.document())), 2);
+        // The subtrees grower has no step buttons; a step sent anyway is refused, in one line.
+        s.setting(static_cast<int>(SettingId::Grower), 0, find_grower("subtrees")->panel_code());
+        d.step();
+        EXPECT_FALSE(growth_steps_after(scene_grower(s.document()), +1));
+        s.setting(static_cast<int>(SettingId::GrowthSteps), 0, 5);
+        d.step();
+        ASSERT_FALSE(s.messages().empty());
+        EXPECT_NE(s.messages().back().find("does not grow in steps"), std::string::npos) << s.messages().back();
+        EXPECT_EQ(scene_grower(s.document()).name, "subtrees");
+        s.finish(d.frame / 60.0 + 0.1);
+        live = s.document();
+    }
+    const Recording rec = read_recording(dir + "/session.lrec");
+    const InputResult input = run_input_pipeline(rec, start.settings.input);
+    SessionBuilder builder(start, EditPickOptions{}, meshing_edit_hooks());
+    builder.apply(input.actions);
+    Document replayed = builder.take_document();
+    replayed.source_recording = live.source_recording;
+    EXPECT_EQ(document_to_json(replayed), document_to_json(live));
 }
 
 TEST(DesktopSession, ImportedMeshIsALobeAtTheFingertipAndTheRecordingReplaysIt)

@@ -13,6 +13,7 @@
 #include "app/cli/cli_common.h"
 #include "app/render/render_scene.h"
 #include "app/export/tree_output.h"
+#include "app/session/session_file.h"
 #include "app/session/tree_pipeline.h"
 #include "app/vr/vr_session.h"
 #include "core/document.h"
@@ -79,9 +80,12 @@ TEST(VrSession, PanelLayoutStandsInFrontOfAndBelowTheFirstHeadPoseFacingIt)
     EXPECT_LT(p.origin.y, head.position.y - 0.2f); // below the eyes
     const glm::vec3 n = p.orientation * glm::vec3(0, 0, 1);
     EXPECT_GT(glm::dot(n, glm::normalize(head.position - p.origin)), 0.99f); // faces the eyes
-    EXPECT_EQ(p.buttons.size(), 28u);
+    EXPECT_EQ(p.buttons.size(), 30u);
     EXPECT_EQ(std::count_if(p.buttons.begin(), p.buttons.end(), [](const VrButton& b) { return b.text == "GROWER"; }), 1)
         << "the panel lists the growers";
+    for (const char* step : {"STEP -", "STEP +"})
+        EXPECT_EQ(std::count_if(p.buttons.begin(), p.buttons.end(), [&](const VrButton& b) { return b.text == step; }), 1)
+            << step << ": the grower's growth one step back or on";
     for (std::size_t i = 0; i < p.buttons.size(); ++i)
         for (std::size_t j = i + 1; j < p.buttons.size(); ++j)
             EXPECT_GT(glm::distance(p.buttons[i].centre, p.buttons[j].centre), 0.04f) << p.buttons[i].text;
@@ -501,6 +505,35 @@ TEST(VrSession, EventTrackGivenIsAppliedAtItsTimesAndRecorded)
     const Recording rec = read_recording(o.record_path);
     ASSERT_EQ(rec.events.size(), 1u);
     EXPECT_EQ(rec.events[0].time, 0.5);
+}
+
+TEST(VrSession, TheStepButtonsSendTheGrowthStepsSettingAndStepTheGrowthOnAndBack)
+{
+    const fs::path dir = scratch("steps");
+    VrOptions o;
+    o.background_regrowth = false;
+    o.record_path = (dir / "vr.lrec").string();
+    Document start;
+    GrowerChoice selforg;
+    selforg.name = "self-organizing";
+    selforg.params["iterations"] = std::int64_t{3};
+    set_scene_grower(start, selforg);
+    VrSession s(start, o);
+    VrScript script([&](const HandFrame& f) { s.frame(f); });
+    script.hand(Hand::Right) = {true, HandPose::Open, {0.25f, 1.3f, -0.3f}, 0.05f};
+    script.wait(0.3);
+    const auto iterations = [&] { return std::get<std::int64_t>(scene_grower(s.document()).params.at("iterations")); };
+    poke(script, s, "STEP +");
+    EXPECT_EQ(iterations(), 4);
+    poke(script, s, "STEP -");
+    poke(script, s, "STEP -");
+    EXPECT_EQ(iterations(), 2);
+    s.finish(script.time());
+    const Recording rec = read_recording(o.record_path);
+    std::vector<float> sent;
+    for (const InputEvent& e : rec.events)
+        if (e.kind == InputEventKind::Setting && e.code == static_cast<int>(SettingId::GrowthSteps)) sent.push_back(e.x);
+    EXPECT_EQ(sent, (std::vector<float>{4.0f, 3.0f, 2.0f}));
 }
 
 TEST(VrSession, EyeInDocumentSeesTheScaledSceneAsTheStageEyeSeesItsStageImage)
