@@ -296,23 +296,35 @@ TEST(SelfOrganizingShadow, TwoTreesSideBySideShadeEachOtherAndLeanApart)
     run.internode_m = 1.0;
     const ShadowParams sp{run.species.shadow_a, run.species.shadow_b, run.species.shadow_q_max, run.species.light_c};
     const glm::vec3 lo(-40.0f, -1.0f, -40.0f), hi(40.0f, 60.0f, 40.0f);
-    // Alone: each tree on its own grid.
-    std::vector<double> alone;
-    for (float x : {-4.0f, 4.0f}) {
+    // One tree's lean is much a matter of chance (which early shoot wins; another compiler's
+    // rounding can flip it), so what is measured is how far apart the pair leans, over
+    // several seeds: alone (each on its own grid) the two trees are the same tree and lean
+    // alike; on one grid, 8 internodes apart, each shades the other and their tips part.
+    constexpr int kSeeds = 8;
+    double parting = 0.0;
+    int parted = 0;
+    for (int seed = 1; seed <= kSeeds; ++seed) {
+        run.seed = static_cast<std::uint64_t>(seed);
+        std::vector<double> alone;
+        for (float x : {-4.0f, 4.0f}) {
+            ShadowGrid g(lo, hi, 1.0, sp);
+            MetamerTree t = seedling(x);
+            g.cast(t.metamers[0].tip);
+            grow_metamers(t, run, nullptr, g);
+            alone.push_back(lean_x(t));
+        }
+        EXPECT_NEAR(alone[0], alone[1], 1e-4) << "seed " << seed; // alone, the same tree (float positions)
         ShadowGrid g(lo, hi, 1.0, sp);
-        MetamerTree t = seedling(x);
-        g.cast(t.metamers[0].tip);
-        grow_metamers(t, run, nullptr, g);
-        alone.push_back(lean_x(t));
+        std::vector<MetamerTree> pair{seedling(-4.0f), seedling(4.0f)};
+        for (const MetamerTree& t : pair) g.cast(t.metamers[0].tip);
+        grow_metamer_trees(pair, run, nullptr, g);
+        ASSERT_GT(pair[0].metamers.size(), 300u);
+        const double apart = (lean_x(pair[1]) - alone[1]) - (lean_x(pair[0]) - alone[0]);
+        parting += apart / kSeeds;
+        parted += apart > 0.0;
     }
-    // Together: one grid, 8 internodes apart.
-    ShadowGrid g(lo, hi, 1.0, sp);
-    std::vector<MetamerTree> pair{seedling(-4.0f), seedling(4.0f)};
-    for (const MetamerTree& t : pair) g.cast(t.metamers[0].tip);
-    grow_metamer_trees(pair, run, nullptr, g);
-    ASSERT_GT(pair[0].metamers.size(), 300u);
-    EXPECT_LT(lean_x(pair[0]), alone[0] - 0.5) << alone[0];
-    EXPECT_GT(lean_x(pair[1]), alone[1] + 0.5) << alone[1];
+    EXPECT_GT(parting, 1.0) << "internodes";
+    EXPECT_GE(parted, kSeeds * 3 / 4);
 }
 
 GrowerInput lobe_input(std::uint64_t seed)
