@@ -134,6 +134,10 @@ private:
     SymbolId intern(std::string_view name, std::size_t offset);
     /// Reads one module name at `p` (a character, `?X`, `@X`); moves `p` past it.
     std::string_view read_symbol(std::size_t& p, std::size_t end);
+    /// The parenthesised list after a module's name at `p`, when there is one: `item(p)` reads
+    /// one entry and leaves `p` after it; ',' separates, ')' ends; `p` moves past the list.
+    template <class Item>
+    void read_parameter_list(std::size_t& p, std::size_t end, const std::string& unclosed, const char* kind, Item&& item);
     /// Modules with parameter expressions (axiom, successor). Appends to `out`.
     void parse_modules(std::size_t begin, std::size_t end, std::vector<SuccessorModule>& out,
                        std::vector<Expr>& exprs, const char* what);
@@ -292,6 +296,31 @@ std::string_view LParser::read_symbol(std::size_t& p, std::size_t end)
     return text().substr(start, p - start);
 }
 
+template <class Item>
+void LParser::read_parameter_list(std::size_t& p, std::size_t end, const std::string& unclosed, const char* kind, Item&& item)
+{
+    const std::size_t q = skip_blanks(p, end);
+    if (q >= end || clean_[q] != '(') return;
+    p = skip_blanks(q + 1, end);
+    if (p < end && clean_[p] == ')') {
+        ++p;
+        return;
+    }
+    for (;;) {
+        item(p);
+        if (p < end && clean_[p] == ',') {
+            ++p;
+            continue;
+        }
+        if (p < end && clean_[p] == ')') {
+            ++p;
+            return;
+        }
+        if (p >= end) src().fail(q, unclosed);
+        src().fail(p, std::string("expected ',' or ')' after a ") + kind + ", found '" + std::string(text().substr(p, 1)) + "'");
+    }
+}
+
 void LParser::parse_modules(std::size_t begin, std::size_t end, std::vector<SuccessorModule>& out,
                             std::vector<Expr>& exprs, const char* what)
 {
@@ -302,29 +331,10 @@ void LParser::parse_modules(std::size_t begin, std::size_t end, std::vector<Succ
         SuccessorModule m;
         m.symbol = intern(name, at);
         m.first_expr = static_cast<std::uint32_t>(exprs.size());
-        std::size_t q = skip_blanks(p, end);
-        if (q < end && clean_[q] == '(') {
-            p = skip_blanks(q + 1, end);
-            if (p < end && clean_[p] == ')') {
-                ++p;
-            } else {
-                for (;;) {
-                    if (exprs.size() - m.first_expr >= kMaxModuleParams)
-                        src().fail(at, "a module with more than 255 parameters");
-                    exprs.push_back(compiler_->compile(p, end));
-                    if (p < end && clean_[p] == ',') {
-                        ++p;
-                        continue;
-                    }
-                    if (p < end && clean_[p] == ')') {
-                        ++p;
-                        break;
-                    }
-                    if (p >= end) src().fail(q, std::string("unclosed '(' in the ") + what);
-                    src().fail(p, "expected ',' or ')' after a parameter, found '" + std::string(text().substr(p, 1)) + "'");
-                }
-            }
-        }
+        read_parameter_list(p, end, std::string("unclosed '(' in the ") + what, "parameter", [&](std::size_t& at_p) {
+            if (exprs.size() - m.first_expr >= kMaxModuleParams) src().fail(at, "a module with more than 255 parameters");
+            exprs.push_back(compiler_->compile(at_p, end));
+        });
         m.param_count = static_cast<std::uint16_t>(exprs.size() - m.first_expr);
         out.push_back(m);
         p = skip_blanks(p, end);
@@ -341,38 +351,20 @@ void LParser::parse_pattern(std::size_t begin, std::size_t end, std::vector<Patt
         PatternModule m;
         m.symbol = intern(name, at);
         m.first_var = static_cast<std::uint32_t>(scope.size());
-        std::size_t q = skip_blanks(p, end);
         std::uint32_t count = 0;
-        if (q < end && clean_[q] == '(') {
-            p = skip_blanks(q + 1, end);
-            if (p < end && clean_[p] == ')') {
-                ++p;
-            } else {
-                for (;;) {
-                    p = skip_blanks(p, end);
-                    std::size_t e = p;
-                    while (e < end && is_name_char(clean_[e])) ++e;
-                    if (e == p || !is_name_start(clean_[p]))
-                        src().fail(p, "expected a parameter name in '" + std::string(name) + "(…)' of a predecessor or context");
-                    const std::string formal(text().substr(p, e - p));
-                    if (scope.count(formal) != 0) src().fail(p, "parameter '" + formal + "' named twice in one production");
-                    if (scope.size() >= kMaxProductionVars) src().fail(p, "a production with more than 1024 parameters");
-                    if (++count > kMaxModuleParams) src().fail(at, "a module with more than 255 parameters");
-                    scope.emplace(formal, static_cast<std::uint32_t>(scope.size()));
-                    p = skip_blanks(e, end);
-                    if (p < end && clean_[p] == ',') {
-                        ++p;
-                        continue;
-                    }
-                    if (p < end && clean_[p] == ')') {
-                        ++p;
-                        break;
-                    }
-                    if (p >= end) src().fail(q, "unclosed '('");
-                    src().fail(p, "expected ',' or ')' after a parameter name, found '" + std::string(text().substr(p, 1)) + "'");
-                }
-            }
-        }
+        read_parameter_list(p, end, "unclosed '('", "parameter name", [&](std::size_t& at_p) {
+            at_p = skip_blanks(at_p, end);
+            std::size_t e = at_p;
+            while (e < end && is_name_char(clean_[e])) ++e;
+            if (e == at_p || !is_name_start(clean_[at_p]))
+                src().fail(at_p, "expected a parameter name in '" + std::string(name) + "(…)' of a predecessor or context");
+            const std::string formal(text().substr(at_p, e - at_p));
+            if (scope.count(formal) != 0) src().fail(at_p, "parameter '" + formal + "' named twice in one production");
+            if (scope.size() >= kMaxProductionVars) src().fail(at_p, "a production with more than 1024 parameters");
+            if (++count > kMaxModuleParams) src().fail(at, "a module with more than 255 parameters");
+            scope.emplace(formal, static_cast<std::uint32_t>(scope.size()));
+            at_p = skip_blanks(e, end);
+        });
         m.param_count = static_cast<std::uint16_t>(count);
         out.push_back(m);
         offsets.push_back(at);
