@@ -15,7 +15,7 @@ cmake --build --preset asan
 ctest --preset asan -j "$JOBS"
 
 # The application is a function of the hand stream (DESIGN.md), whichever compiler built it:
-# lobes, their remeshing, the tree and the session, byte for byte.
+# lobes, their remeshing, the tree and the session, byte for byte; and so is every grower.
 replays="$(mktemp -d)"
 trap 'rm -rf "$replays"' EXIT
 for rec in recordings/*.lrec; do
@@ -24,8 +24,14 @@ for rec in recordings/*.lrec; do
     "./build/$build/app/lobesketch" replay "$rec" --out "$replays/$build/$name" >/dev/null
   done
 done
+# The other growers too: a self-organizing tree in the demo's lobes and a stochastic L-system.
+for build in release asan; do
+  "./build/$build/app/lobesketch" grow recordings/demo.lrec --grower self-organizing \
+    --out "$replays/$build/demo-self-organizing.glb" >/dev/null
+  "./build/$build/app/lobesketch" lsystem willow --seed 5 --out "$replays/$build/willow.glb" >/dev/null
+done
 diff -r "$replays/release" "$replays/asan" >/dev/null ||
   { echo "the release and asan builds replay a recording to different bytes:" >&2; diff -rq "$replays/release" "$replays/asan" >&2; exit 1; }
-echo "release and asan builds: every recording replays to the same bytes"
+echo "release and asan builds: every recording replays to the same bytes, and the other growers grow the same trees"
 
 ./scripts/fuzz.sh 15

@@ -172,8 +172,13 @@ std::size_t grow_shoot(MetamerTree& tree, std::size_t m, bool lateral, double v,
         glm::vec3 dir = shoot_direction(default_dir, optimal, sp.tropism, sp.xi, sp.eta);
         if (sp.jitter > 0.0) {
             SplitMix64 rng(splitmix64(run.seed ^ splitmix64(static_cast<std::uint64_t>(index))));
-            const glm::vec3 j(static_cast<float>(rng.uniform(-1.0, 1.0)), static_cast<float>(rng.uniform(-1.0, 1.0)),
-                              static_cast<float>(rng.uniform(-1.0, 1.0)));
+            // Drawn z, y, x in sequence: arguments of one call are evaluated in an unspecified
+            // order (GCC right to left, Clang left to right), and a tree must not depend on the
+            // compiler. z first is the order GCC builds drew them in before.
+            const float jz = static_cast<float>(rng.uniform(-1.0, 1.0));
+            const float jy = static_cast<float>(rng.uniform(-1.0, 1.0));
+            const float jx = static_cast<float>(rng.uniform(-1.0, 1.0));
+            const glm::vec3 j(jx, jy, jz);
             dir = shoot_direction(dir, j, glm::vec3(0.0f), sp.jitter, 0.0);
         }
         const glm::vec3 tip = base + dir * length;
