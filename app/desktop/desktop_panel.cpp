@@ -17,6 +17,50 @@
 
 namespace lobe {
 
+namespace {
+
+/// The Grower section: the growth model, and stepping its growth for a grower that grows in
+/// steps.
+void draw_grower_section(DesktopSession& session, const Document& doc, DesktopPanelState& state)
+{
+    // Every growth model there is; the scene's tree grows with the one chosen.
+    const GrowerChoice& current = scene_grower(doc);
+    if (ImGui::BeginCombo("model", current.name.c_str())) {
+        for (const Grower* g : growers()) {
+            const std::string name(g->name());
+            if (ImGui::Selectable(name.c_str(), name == current.name))
+                session.setting(static_cast<int>(SettingId::Grower), 0, g->panel_code());
+            if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", std::string(g->title()).c_str());
+        }
+        ImGui::EndCombo();
+    }
+    // A grower that grows in steps: its growth one step back or on (growth/grower.h
+    // steps_param), from its default when the session does not give the steps.
+    // (The default may mean parsing an L-system: once per choice, not once per frame.)
+    if (state.steps_of != current) {
+        state.steps_of = current;
+        state.steps = growth_steps(current);
+    }
+    if (const std::optional<int> steps = state.steps) {
+        const Grower* g = find_grower(current.name);
+        const bool given = current.params.count(std::string(g->steps_param())) != 0;
+        const auto step = [&](int delta) {
+            if (const std::optional<double> v = growth_steps_after(current, delta))
+                session.setting(static_cast<int>(SettingId::GrowthSteps), 0, *v);
+        };
+        if (ImGui::ArrowButton("##step-back", ImGuiDir_Left)) step(-1);
+        if (ImGui::IsItemHovered()) ImGui::SetTooltip("one growth step back");
+        ImGui::SameLine();
+        if (ImGui::ArrowButton("##step-on", ImGuiDir_Right)) step(+1);
+        if (ImGui::IsItemHovered()) ImGui::SetTooltip("one growth step on");
+        ImGui::SameLine();
+        if (given) ImGui::Text("step %d", *steps);
+        else ImGui::Text("step %d (default)", *steps);
+    }
+}
+
+} // namespace
+
 /// The panel: stages, tools, edits, appearance, file, status. Buttons press the keys the
 /// keyboard has (so the recording holds key events either way); settings are sent as
 /// Setting events when a slider is let go.
@@ -77,44 +121,7 @@ void draw_desktop_panel(DesktopSession& session, const std::string& session_name
         button("undo");
         button("redo");
     }
-    if (ImGui::CollapsingHeader("Grower", ImGuiTreeNodeFlags_DefaultOpen)) {
-        // Every growth model there is; the scene's tree grows with the one chosen.
-        const GrowerChoice& current = scene_grower(doc);
-        if (ImGui::BeginCombo("model", current.name.c_str())) {
-            for (const Grower* g : growers()) {
-                const std::string name(g->name());
-                if (ImGui::Selectable(name.c_str(), name == current.name))
-                    session.setting(static_cast<int>(SettingId::Grower), 0, g->panel_code());
-                if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", std::string(g->title()).c_str());
-            }
-            ImGui::EndCombo();
-        }
-        // A grower that grows in steps: its growth one step back or on (growth/grower.h
-        // steps_param), from its default when the session does not give the steps.
-        // (The default may mean parsing an L-system: once per choice, not once per frame.)
-        static GrowerChoice steps_of; // the default grower, which has no steps
-        static std::optional<int> steps_cached;
-        if (steps_of != current) {
-            steps_of = current;
-            steps_cached = growth_steps(current);
-        }
-        if (const std::optional<int> steps = steps_cached) {
-            const Grower* g = find_grower(current.name);
-            const bool given = current.params.count(std::string(g->steps_param())) != 0;
-            const auto step = [&](int delta) {
-                if (const std::optional<double> v = growth_steps_after(current, delta))
-                    session.setting(static_cast<int>(SettingId::GrowthSteps), 0, *v);
-            };
-            if (ImGui::ArrowButton("##step-back", ImGuiDir_Left)) step(-1);
-            if (ImGui::IsItemHovered()) ImGui::SetTooltip("one growth step back");
-            ImGui::SameLine();
-            if (ImGui::ArrowButton("##step-on", ImGuiDir_Right)) step(+1);
-            if (ImGui::IsItemHovered()) ImGui::SetTooltip("one growth step on");
-            ImGui::SameLine();
-            if (given) ImGui::Text("step %d", *steps);
-            else ImGui::Text("step %d (default)", *steps);
-        }
-    }
+    if (ImGui::CollapsingHeader("Grower", ImGuiTreeNodeFlags_DefaultOpen)) draw_grower_section(session, doc, state);
     if (ImGui::CollapsingHeader("Appearance", ImGuiTreeNodeFlags_DefaultOpen)) {
         std::string target = state.target_lobe == 0 ? "whole tree" : "lobe " + std::to_string(state.target_lobe);
         if (ImGui::BeginCombo("for", target.c_str())) {

@@ -8,7 +8,10 @@
 /// actions as buttons. Controls: docs/desktop.md.
 
 #include <array>
+#include <optional>
 #include <string>
+
+#include "core/grower_choice.h"
 
 namespace lobe {
 
@@ -19,6 +22,10 @@ struct DesktopPanelState {
     int target_lobe = 0; ///< the lobe the appearance settings go to (0: the whole tree)
     std::array<char, 1024> import_path{};
     float import_size_m = 1.5f;
+    /// The growth steps shown for the grower choice `steps_of` (growth_steps; worked out once
+    /// per choice: for an L-system it means parsing it). The default grower has no steps.
+    GrowerChoice steps_of;
+    std::optional<int> steps;
 };
 
 /// Width of the panel in pixels (the sketch is drawn right of it).
