@@ -34,12 +34,15 @@ void add_lobes_command(CLI::App& app, int& exit_code)
     cmd->add_option("--settings", a->settings, "Settings JSON (a settings object or a session document)");
     cmd->add_option("--size", a->size_m, "A mesh input is scaled so its bounding box's largest side is this (metres)")
         ->capture_default_str()
-        ->check(CLI::Range(0.01, 100.0));
+        ->check(finite_range(0.01, 100.0));
     cmd->add_option("--simplify-above", a->simplify_above,
                     "A mesh of more triangles than this is simplified in cubes of a fifth of the spacing before "
                     "repair (0: never)")
         ->capture_default_str();
-    cmd->callback([a, &exit_code] {
+    cmd->callback([a, cmd, &exit_code] {
+        check_input_kind(a->input, "lobes", "a recording, a session document (.json) or a mesh (.obj/.ply/.off)", true,
+                         true);
+        if (cmd->get_option("--size")->count() > 0) warn_mesh_only_option(a->input, "--size");
         const std::string ext = lower_extension(a->input);
         std::error_code ec;
         std::filesystem::create_directories(a->out, ec);

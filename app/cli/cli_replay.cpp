@@ -25,8 +25,10 @@ void add_replay_command(CLI::App& app, int& exit_code)
     cmd->add_option("-o,--out", a->out, "Output folder (created): strokes.json, session.json, lobes/lobe_N.ply, tree.glb")
         ->required();
     cmd->add_option("--settings", a->settings, "Settings JSON (a settings object or a session document)");
-    cmd->add_option("--seed", a->seed, "Seed of every random choice downstream")->capture_default_str();
+    cmd->add_option("--seed", a->seed, "Seed of every random choice downstream")->capture_default_str()->check(seed_check());
     cmd->callback([a, &exit_code] {
+        check_input_kind(a->rec, "replay", "a recording; grow, export, render and lobes take session documents and meshes",
+                         false, false);
         Document doc;
         doc.seed = a->seed;
         if (!a->settings.empty()) doc.settings = load_settings_file(a->settings);

@@ -36,7 +36,7 @@ void add_sketch_command(CLI::App& app, int& exit_code)
     cmd->add_flag("--inline-regrowth", a->inline_regrowth,
                   "Regrow on the frame thread after every change (default: off it, as live)");
     cmd->add_option("--settings", a->settings, "Settings JSON the session starts with");
-    cmd->add_option("--seed", a->seed, "The session's seed")->capture_default_str();
+    cmd->add_option("--seed", a->seed, "The session's seed")->capture_default_str()->check(seed_check());
     cmd->callback([a, &exit_code] {
         const Recording rec = load_recording_verbose(a->rec);
         Document doc;
