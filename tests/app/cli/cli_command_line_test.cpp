@@ -221,5 +221,16 @@ TEST(CliCommandLine, InputsOfTheWrongKindAreNamedForWhatTheyAre)
     EXPECT_FALSE(fs::exists(dir + "/l"));
 }
 
+TEST(CliCommandLine, ARenderOfAGlbWithoutTheAskedLodNamesTheLodsItHas)
+{
+    const std::string dir = test::temp_dir("cli-grammar-lod");
+    const std::string rec = test::source_path("recordings/table1-1lobe-5strokes.lrec");
+    ASSERT_EQ(test::run_cli("-q grow " + rec + " --out " + dir + "/t.glb --lod 2").code, 0);
+    const CliRun r = test::run_cli("-q render " + dir + "/t.glb --out " + dir + "/t.png --size 32x32");
+    EXPECT_EQ(r.code, 1) << r.out;
+    EXPECT_EQ(r.out, "lobesketch: error: " + dir + "/t.glb: has no LOD0 (it has LOD2; pick one with --lod)\n");
+    EXPECT_FALSE(fs::exists(dir + "/t.png"));
+}
+
 } // namespace
 } // namespace lobe
