@@ -141,6 +141,14 @@ void check_input_kind(const std::string& path, const std::string& command, const
     else if (!takes_session && ext == ".json")
         kind = is_session_file(path) ? "a Lobesketch session document" : "a JSON file";
     else if (!takes_mesh && is_mesh_file(path)) kind = "a mesh";
+    else if (ext == ".obj") {
+        // An OBJ this program exported is a whole tree, not a lobe to grow one in.
+        std::ifstream in{path, std::ios::binary};
+        std::string first;
+        std::getline(in, first);
+        if (first.rfind("# Lobesketch: ", 0) == 0 && first.find("origin at the trunk base") != std::string::npos)
+            kind = "a tree exported by lobesketch (a mesh input is the lobe a tree grows in)";
+    }
     if (kind.empty()) return;
     throw UsageError(path + ": " + kind + " is not an input " + command + " takes (" + takes + ")");
 }

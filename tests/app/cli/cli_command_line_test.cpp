@@ -193,6 +193,11 @@ TEST(CliCommandLine, InputsOfTheWrongKindAreNamedForWhatTheyAre)
     expect_usage_error("grow " + dir + "/leaf.png --out " + dir + "/x.glb", "leaf.png: a picture is not an input grow takes");
     expect_usage_error("lobes " + dir + "/leaf.png --out " + dir + "/l", "a picture is not an input lobes takes");
     expect_usage_error("render " + dir + "/leaf.png --out " + dir + "/x.png", "a picture is not an input render takes");
+    ASSERT_EQ(test::run_cli("-q export " + in.session + " --out " + dir + "/exported.obj").code, 0);
+    expect_usage_error("render " + dir + "/exported.obj --out " + dir + "/x.png",
+                       "exported.obj: a tree exported by lobesketch (a mesh input is the lobe a tree grows in) is not "
+                       "an input render takes");
+    expect_usage_error("grow " + dir + "/exported.obj --out " + dir + "/x.glb", "is not an input grow takes");
     expect_usage_error("replay " + in.session + " --out " + dir + "/o",
                        "a Lobesketch session document is not an input replay takes");
     // Wrong kinds by their content: the work fails in one line naming what the file is.
