@@ -147,7 +147,7 @@ void add_grow_command(CLI::App& app, int& exit_code)
         ->required()
         ->check(tree_file_check());
     add_tree_options(cmd, *a);
-    cmd->add_option("--size", a->in.mesh_size, "A mesh input is scaled so its bounding box's largest side is this (metres)")
+    cmd->add_option("--size,--mesh-size", a->in.mesh_size, "A mesh input is scaled so its bounding box's largest side is this (metres)")
         ->capture_default_str()
         ->check(finite_range(0.01, 100.0));
     cmd->callback([a, cmd, &exit_code] {

@@ -26,7 +26,8 @@ void add_sketch_command(CLI::App& app, int& exit_code)
     };
     auto a = std::make_shared<Args>();
     cmd->add_option("REC", a->rec, "Recording whose hand frames are the tracked hands")->required();
-    cmd->add_option("--session", a->session, "Session file written (atomically) when the recording ends");
+    cmd->add_option("--session,-o,--out", a->session,
+                    "Session file written (atomically) when the recording ends (--out as in the other commands)");
     cmd->add_option("--autosave", a->autosave, "Autosave written after every change of the document");
     cmd->add_option("--record", a->record, "The session's own recording, written as it goes");
     cmd->add_flag("--realtime", a->realtime, "Feed each frame at its time (default: as fast as the session runs)");

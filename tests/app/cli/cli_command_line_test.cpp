@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include "tests/support/cli_run.h"
@@ -235,6 +236,54 @@ TEST(CliCommandLine, ARenderOfAGlbWithoutTheAskedLodNamesTheLodsItHas)
     EXPECT_EQ(r.code, 1) << r.out;
     EXPECT_EQ(r.out, "lobesketch: error: " + dir + "/t.glb: has no LOD0 (it has LOD2; pick one with --lod)\n");
     EXPECT_FALSE(fs::exists(dir + "/t.png"));
+}
+
+TEST(CliCommandLine, AFolderUsedBeforeKeepsNoLobeMeshOfTheEarlierRun)
+{
+    const std::string dir = test::temp_dir("cli-grammar-stale");
+    const std::string three = test::source_path("recordings/table1-3lobes-16strokes.lrec");
+    const std::string one = test::source_path("recordings/table1-1lobe-5strokes.lrec");
+    ASSERT_EQ(test::run_cli("-q replay " + three + " --out " + dir + "/r").code, 0);
+    ASSERT_TRUE(fs::exists(dir + "/r/lobes/lobe_3.ply"));
+    std::ofstream(dir + "/r/lobes/notes.txt") << "mine\n";
+    CliRun r = test::run_cli("-q replay " + one + " --out " + dir + "/r");
+    ASSERT_EQ(r.code, 0) << r.out;
+    EXPECT_NE(r.out.find("warning: " + one + ": removed 2 lobe mesh(es) of an earlier run from " + dir + "/r/lobes"),
+              std::string::npos)
+        << r.out;
+    std::size_t plys = 0;
+    for (const auto& e : fs::directory_iterator(dir + "/r/lobes")) plys += e.path().extension() == ".ply" ? 1 : 0;
+    EXPECT_EQ(plys, 1u);
+    EXPECT_TRUE(fs::exists(dir + "/r/lobes/notes.txt")); // only lobe meshes are removed
+    // lobes into the same folder: the same.
+    ASSERT_EQ(test::run_cli("-q lobes " + three + " --out " + dir + "/l").code, 0);
+    r = test::run_cli("-q lobes " + one + " --out " + dir + "/l");
+    ASSERT_EQ(r.code, 0) << r.out;
+    EXPECT_FALSE(fs::exists(dir + "/l/lobes/lobe_3.ply"));
+    EXPECT_EQ(count(r.out, "removed 2 lobe mesh(es) of an earlier run"), 1u) << r.out;
+}
+
+TEST(CliCommandLine, TheSameOptionNamesWorkInEveryCommand)
+{
+    const std::string dir = test::temp_dir("cli-grammar-names");
+    const std::string rec = test::source_path("recordings/table1-1lobe-5strokes.lrec");
+    // sketch writes its session with --out too (--session stays).
+    CliRun r = test::run_cli("-q sketch " + rec + " --out " + dir + "/s.json");
+    ASSERT_EQ(r.code, 0) << r.out;
+    EXPECT_TRUE(fs::exists(dir + "/s.json"));
+    // grow and lobes take render's --mesh-size beside --size.
+    ASSERT_EQ(test::run_cli("-q lobes " + rec + " --out " + dir + "/l").code, 0);
+    const std::string mesh = dir + "/l/lobes/lobe_1.ply";
+    ASSERT_EQ(test::run_cli("-q grow " + mesh + " --out " + dir + "/a.glb --size 0.5").code, 0);
+    ASSERT_EQ(test::run_cli("-q grow " + mesh + " --out " + dir + "/b.glb --mesh-size 0.5").code, 0);
+    ASSERT_EQ(test::run_cli("-q grow " + mesh + " --out " + dir + "/c.glb").code, 0);
+    auto bytes = [](const std::string& path) {
+        std::ifstream in(path, std::ios::binary);
+        return std::string(std::istreambuf_iterator<char>(in), {});
+    };
+    EXPECT_EQ(bytes(dir + "/a.glb"), bytes(dir + "/b.glb"));
+    EXPECT_NE(bytes(dir + "/a.glb"), bytes(dir + "/c.glb"));
+    ASSERT_EQ(test::run_cli("-q lobes " + mesh + " --out " + dir + "/m --mesh-size 0.5").code, 0);
 }
 
 } // namespace
