@@ -64,6 +64,20 @@ CLI::Validator finite_range(double lo, double hi)
         "", "finite range");
 }
 
+CLI::Validator species_check()
+{
+    return CLI::Validator(
+        [](std::string& text) {
+            if (lower_extension(text) == ".json") return std::string(); // a preset file: read later
+            const std::vector<std::string> known = species_names();
+            if (std::find(known.begin(), known.end(), text) != known.end()) return std::string();
+            std::string list;
+            for (const std::string& n : known) list += n + ", ";
+            return "unknown species '" + text + "' (known: " + list + "or a preset .json file)";
+        },
+        "", "species");
+}
+
 CLI::Validator seed_check()
 {
     return CLI::Validator(
@@ -254,16 +268,7 @@ void add_tree_input_options(CLI::App* cmd, TreeInputOptions& o)
     cmd->add_option("--species", o.species,
                     "Species preset: broadleaf, conifer, willow, birch, or a preset .json file (with the "
                     "self-organizing grower also its growth preset)")
-        ->check(CLI::Validator(
-            [](std::string& text) {
-                if (lower_extension(text) == ".json") return std::string(); // a preset file: read later
-                const std::vector<std::string> known = species_names();
-                if (std::find(known.begin(), known.end(), text) != known.end()) return std::string();
-                std::string list;
-                for (const std::string& n : known) list += n + ", ";
-                return "unknown species '" + text + "' (known: " + list + "or a preset .json file)";
-            },
-            "", "species"));
+        ->check(species_check());
     std::vector<std::string> names;
     for (const Grower* g : growers()) names.emplace_back(g->name());
     cmd->add_option("--grower", o.grower, "Growth model: " + grower_names() + " (default: the session's, else " +

@@ -36,6 +36,8 @@ public:
 
 /// A CLI11 check of a number: finite and in [lo, hi] (CLI::Range lets "nan" through).
 CLI::Validator finite_range(double lo, double hi);
+/// A CLI11 check of --species: a shipped preset's name, or a .json file (read later).
+CLI::Validator species_check();
 /// A CLI11 check of a seed: a whole number 0 to 2^64-1 ("-1" would wrap to 2^64-1).
 CLI::Validator seed_check();
 /// A CLI11 check of an output file's extension: one of `extensions` (lower case, with the

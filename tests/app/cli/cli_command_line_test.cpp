@@ -286,5 +286,24 @@ TEST(CliCommandLine, TheSameOptionNamesWorkInEveryCommand)
     ASSERT_EQ(test::run_cli("-q lobes " + mesh + " --out " + dir + "/m --mesh-size 0.5").code, 0);
 }
 
+TEST(CliCommandLine, ReplayTakesSpeciesAndHeightAsGrowDoes)
+{
+    const std::string dir = test::temp_dir("cli-grammar-replay-species");
+    const std::string rec = test::source_path("recordings/table1-1lobe-5strokes.lrec");
+    ASSERT_EQ(test::run_cli("-q replay " + rec + " --out " + dir + "/plain").code, 0);
+    CliRun r = test::run_cli("-q replay " + rec + " --out " + dir + "/conifer --species conifer --height 8");
+    ASSERT_EQ(r.code, 0) << r.out;
+    ASSERT_EQ(test::run_cli("-q grow " + rec + " --out " + dir + "/grown.glb --species conifer --height 8").code, 0);
+    auto bytes = [](const std::string& path) {
+        std::ifstream in(path, std::ios::binary);
+        return std::string(std::istreambuf_iterator<char>(in), {});
+    };
+    EXPECT_EQ(bytes(dir + "/conifer/tree.glb"), bytes(dir + "/grown.glb"));
+    EXPECT_NE(bytes(dir + "/conifer/tree.glb"), bytes(dir + "/plain/tree.glb"));
+    EXPECT_NE(bytes(dir + "/conifer/session.json").find("\"species\": \"conifer\""), std::string::npos);
+    expect_usage_error("replay " + rec + " --out " + dir + "/x --species oak", "unknown species 'oak'");
+    expect_usage_error("replay " + rec + " --out " + dir + "/x --height nan", "--height: expected a number");
+}
+
 } // namespace
 } // namespace lobe
