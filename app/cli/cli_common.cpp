@@ -427,7 +427,8 @@ void apply_document_options(Document& doc, const TreeInputOptions& o)
     if (!o.grower.empty() || choice != scene_grower(doc)) set_scene_grower(doc, std::move(choice));
 }
 
-GrownInput grow_input_tree(const std::string& input, const TreeInputOptions& o)
+GrownInput grow_input_tree(const std::string& input, const TreeInputOptions& o,
+                           const std::function<void(const Document&)>& before_growing)
 {
     GrownInput out;
     Document& doc = out.doc;
@@ -439,6 +440,7 @@ GrownInput grow_input_tree(const std::string& input, const TreeInputOptions& o)
     }
     apply_tree_input_options(doc.settings, o);
     apply_document_options(doc, o);
+    if (before_growing && (ext == ".json" || is_mesh_file(input))) before_growing(doc);
     if (is_mesh_file(input)) {
         const BuiltLobe lobe = model_lobe(input, doc.settings, o.mesh_size);
         LobeRecord rec;

@@ -3,6 +3,7 @@
 /// Shared helpers of the CLI subcommands: messages, settings files, recording input.
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -145,9 +146,12 @@ struct GrownInput {
 
 /// Grows the tree of `input`: a session document (.json), a mesh (.obj/.ply/.off, one lobe
 /// of `mesh_size`) or a recording (run through the input pipeline and the session builder,
-/// warnings printed naming the file), with the options applied.
+/// warnings printed naming the file), with the options applied. `before_growing` (when given)
+/// sees the document of a session or mesh input once its settings are final, before the
+/// tree is grown (a recording's events may still change them as it is replayed).
 /// \throw FileError, InvalidInput
-GrownInput grow_input_tree(const std::string& input, const TreeInputOptions& o);
+GrownInput grow_input_tree(const std::string& input, const TreeInputOptions& o,
+                           const std::function<void(const Document&)>& before_growing = {});
 
 /// The lsystem grower's choice for the L-system file `path`: its text as `source`, the path
 /// as `source_name`, the view file beside it (NAME.v) as `view` when there is one.

@@ -155,7 +155,10 @@ void add_grow_command(CLI::App& app, int& exit_code)
                          true);
         if (cmd->get_option("--size")->count() > 0) warn_mesh_only_option(a->input, "--size");
         require_outputs_folders(*a);
-        const GrownInput grown = grow_input_tree(a->input, a->in);
+        // The LODs asked for exist: known before growing for a session or a mesh.
+        const GrownInput grown = grow_input_tree(a->input, a->in, [a](const Document& doc) {
+            parse_lod_list(a->lod, doc.settings.branches.lod_count);
+        });
         report_and_write(*a, grown.doc, grown.tree, a->input, exit_code);
     });
 }
@@ -183,6 +186,7 @@ void add_export_command(CLI::App& app, int& exit_code)
         if (!a->in.settings.empty()) doc.settings = load_settings_file(a->in.settings);
         apply_tree_input_options(doc.settings, a->in);
         apply_document_options(doc, a->in);
+        parse_lod_list(a->lod, doc.settings.branches.lod_count); // the LODs asked for exist, before growing
         report_and_write(*a, doc, build_document_tree(doc), a->input, exit_code);
     });
 }

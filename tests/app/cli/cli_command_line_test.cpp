@@ -209,6 +209,19 @@ TEST(CliCommandLine, InputsOfTheWrongKindAreNamedForWhatTheyAre)
     EXPECT_EQ(r.code, 1) << r.out;
     EXPECT_NE(r.out.find("renamed.autosave: a Lobesketch session document, not a recording"), std::string::npos) << r.out;
     EXPECT_EQ(r.out.find("import-leap"), std::string::npos) << r.out;
+    // An LOD the settings do not make, said before anything is grown (no "grew" line).
+    r = test::run_cli("export " + in.session + " --out " + dir + "/x.glb --set branches.lod_count=2 --lod 2");
+    EXPECT_EQ(r.code, 1) << r.out;
+    EXPECT_EQ(r.out, "lobesketch: error: --lod: LOD 2 does not exist (the tree has LOD0 to LOD1; "
+                     "settings.branches.lod_count)\n");
+    // A session with nothing to grow: growing it first would warn and say so instead.
+    std::ofstream(dir + "/empty.json") << R"({"format": "lobesketch-session", "version": 1})";
+    for (const char* command : {"grow", "export"}) {
+        r = test::run_cli(std::string(command) + " " + dir + "/empty.json --out " + dir + "/x.glb --lod 3");
+        EXPECT_EQ(r.code, 1) << r.out;
+        EXPECT_EQ(r.out, "lobesketch: error: --lod: LOD 3 does not exist (the tree has LOD0 to LOD2; "
+                         "settings.branches.lod_count)\n");
+    }
     // A folder that does not exist, said before anything is grown.
     r = test::run_cli("grow " + in.rec + " --out " + dir + "/missing/dir/x.glb");
     EXPECT_EQ(r.code, 1) << r.out;
