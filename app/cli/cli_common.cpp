@@ -397,10 +397,10 @@ void apply_document_options(Document& doc, const TreeInputOptions& o)
     const std::string selforg(self_organizing_grower().name());
     if (!o.lsystem.empty()) {
         if (!o.grower.empty() && o.grower != lsystem::kGrowerName)
-            throw InvalidInput("--lsystem: an L-system file grows with --grower " + std::string(lsystem::kGrowerName) +
+            throw UsageError("--lsystem: an L-system file grows with --grower " + std::string(lsystem::kGrowerName) +
                                ", not " + o.grower);
         if (only_selforg)
-            throw InvalidInput(std::string(only_selforg) + " is only valid with --grower " + selforg + " (the grower is " +
+            throw UsageError(std::string(only_selforg) + " is only valid with --grower " + selforg + " (the grower is " +
                                std::string(lsystem::kGrowerName) + ")");
         GrowerChoice choice = lsystem_file_choice(o.lsystem);
         if (o.height) choice.params["height_m"] = *o.height;
@@ -415,7 +415,7 @@ void apply_document_options(Document& doc, const TreeInputOptions& o)
         choice = scene_grower(doc);
     }
     if (only_selforg && choice.name != selforg)
-        throw InvalidInput(std::string(only_selforg) + " is only valid with --grower " + selforg + " (the grower is " +
+        throw UsageError(std::string(only_selforg) + " is only valid with --grower " + selforg + " (the grower is " +
                            choice.name + ")");
     if (choice.name == selforg) {
         if (o.environment) choice.params["environment"] = *o.environment;

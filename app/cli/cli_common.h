@@ -29,10 +29,11 @@ void progress(const std::string& line); ///< a progress line on stderr (suppress
 void set_quiet(bool quiet);
 
 /// A bad command line found after CLI11 has parsed it (an input of a kind the command does
-/// not take), before any work: printed as one line, exit 2 (kExitUsage).
-class UsageError : public Error {
+/// not take, options that cannot go together), before any work: printed as one line, exit 2
+/// (kExitUsage). An InvalidInput, so code that checks options without the CLI still catches it.
+class UsageError : public InvalidInput {
 public:
-    using Error::Error;
+    using InvalidInput::InvalidInput;
 };
 
 /// A CLI11 check of a number: finite and in [lo, hi] (CLI::Range lets "nan" through).
@@ -117,9 +118,9 @@ void apply_tree_input_options(Settings& s, const TreeInputOptions& o);
 /// --environment, --bud-fate, --iterations and --species give the self-organizing grower;
 /// without --grower they change the session's self-organizing grower); --lsystem FILE.l
 /// makes it the lsystem grower with that file (lsystem_file_choice).
-/// \throw FileError for an unreadable --lsystem file; InvalidInput when --grower names
-/// another grower than lsystem beside --lsystem, or (one line) for a self-organizing option
-/// with another grower.
+/// \throw FileError for an unreadable --lsystem file; UsageError (a bad command line) when
+/// --grower names another grower than lsystem beside --lsystem, or (one line) for a
+/// self-organizing option with another grower.
 void apply_document_options(Document& doc, const TreeInputOptions& o);
 
 /// The local time as "YYYYMMDD-HHMMSS", for default file names.

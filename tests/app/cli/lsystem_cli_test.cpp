@@ -155,7 +155,7 @@ TEST(LSystemCli, GrowsInTheLobesOfASessionAndWithGrow)
     ASSERT_TRUE(test::validate_gltf(dir + "/g.glb", report));
     EXPECT_EQ(report["issues"]["numErrors"], 0) << test::describe_gltf_issues(report);
     r = run("grow " + recording + " --grower subtrees --lsystem " + dir + "/topiary.l --out " + dir + "/h.glb");
-    EXPECT_EQ(r.code, 1) << r.out;
+    EXPECT_EQ(r.code, 2) << r.out;
     EXPECT_NE(r.out.find("--lsystem"), std::string::npos) << r.out;
 }
 
