@@ -99,6 +99,17 @@ TEST(CliCommandLine, BadOptionValuesExitTwoInOneLineBeforeAnyWork)
     EXPECT_EQ(test::run_cli("-q grow " + in.rec + glb + " --seed 18446744073709551615").code, 0);
 }
 
+TEST(CliCommandLine, EverySubcommandRefusesABadCommandLineInOneLineAndTakesQuietAfterIt)
+{
+    for (const char* sub : {"info", "replay", "import-leap", "import-webxr", "synth", "lobes", "grow", "export", "render",
+                            "lsystem", "desktop", "vr", "recover", "sketch", "settings"}) {
+        // CLI11 names the first thing wrong: the unknown option, or a required --out missing.
+        expect_usage_error(std::string(sub) + " x --no-such-option", "(see 'lobesketch " + std::string(sub) + " --help')");
+        const CliRun help = test::run_cli(std::string(sub) + " --help -q");
+        EXPECT_EQ(help.code, 0) << sub << ": " << help.out;
+    }
+}
+
 TEST(CliCommandLine, AnUnknownCommandIsNamedWithTheCommandsAndTheNearestOne)
 {
     const CliRun r = test::run_cli("grwo recordings/demo.lrec --out t.glb");
