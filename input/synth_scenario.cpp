@@ -3,6 +3,7 @@
 // limits: docs/scenario-format.md.
 #include "input/synth_scenario.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -523,15 +524,30 @@ Scenario load_scenario(const std::string& path)
     json j;
     try {
         j = json::parse(text);
-    } catch (const json::exception& e) {
-        throw FileError(path, "not valid JSON: " + one_line(e.what()));
+    } catch (const json::parse_error& e) {
+        // Where it went wrong, in the file's terms; not the JSON library's text.
+        std::size_t line = 1, column = 1;
+        const std::size_t end = std::min<std::size_t>(e.byte > 0 ? e.byte - 1 : 0, text.size());
+        for (std::size_t i = 0; i < end; ++i) {
+            if (text[i] == '\n') {
+                ++line;
+                column = 1;
+            } else {
+                ++column;
+            }
+        }
+        throw FileError(path, "not a scenario: not valid JSON (line " + std::to_string(line) + ", column " +
+                                  std::to_string(column) + "); a scenario is a JSON document (docs/scenario-format.md)");
     }
     try {
         return scenario_from_json(j);
     } catch (const InvalidInput& e) {
         throw FileError(path, one_line(e.what()));
     } catch (const json::exception& e) {
-        throw FileError(path, one_line(e.what()));
+        // "[json.exception.type_error.302] type must be …": the library's tag dropped.
+        std::string why = one_line(e.what());
+        if (why.rfind("[json.exception.", 0) == 0 && why.find("] ") != std::string::npos) why.erase(0, why.find("] ") + 2);
+        throw FileError(path, "not a scenario: " + why + " (docs/scenario-format.md)");
     }
 }
 

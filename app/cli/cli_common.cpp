@@ -3,10 +3,12 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <sstream>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -23,6 +25,7 @@
 #include "growth/selforg/selforg_grower.h"
 #include "growth/species.h"
 #include "input/pipeline.h"
+#include "input/recording_format.h"
 #include "app/session/stage_options.h"
 #include "meshing/mesh_io.h"
 
@@ -38,6 +41,136 @@ void error(const std::string& line) { std::cerr << "lobesketch: error: " << line
 void progress(const std::string& line)
 {
     if (!g_quiet) std::cerr << line << '\n';
+}
+
+CLI::Validator finite_range(double lo, double hi)
+{
+    return CLI::Validator(
+        [lo, hi](std::string& text) {
+            double v = 0.0;
+            std::size_t used = 0;
+            try {
+                v = std::stod(text, &used);
+            } catch (const std::exception&) {
+                used = 0;
+            }
+            if (used != text.size() || !std::isfinite(v) || v < lo || v > hi) {
+                std::ostringstream range;
+                range << lo << " to " << hi;
+                return "expected a number from " + range.str() + " (got '" + text + "')";
+            }
+            return std::string();
+        },
+        "", "finite range");
+}
+
+CLI::Validator species_check()
+{
+    return CLI::Validator(
+        [](std::string& text) {
+            if (lower_extension(text) == ".json") return std::string(); // a preset file: read later
+            const std::vector<std::string> known = species_names();
+            if (std::find(known.begin(), known.end(), text) != known.end()) return std::string();
+            std::string list;
+            for (const std::string& n : known) list += n + ", ";
+            return "unknown species '" + text + "' (known: " + list + "or a preset .json file)";
+        },
+        "", "species");
+}
+
+CLI::Validator seed_check()
+{
+    return CLI::Validator(
+        [](std::string& text) {
+            const bool digits = !text.empty() && text.size() <= 20 &&
+                                std::all_of(text.begin(), text.end(), [](unsigned char c) { return std::isdigit(c); });
+            if (!digits || (text.size() == 20 && text > "18446744073709551615"))
+                return "a seed is a whole number from 0 to 18446744073709551615 (got '" + text + "')";
+            return std::string();
+        },
+        "", "seed");
+}
+
+CLI::Validator output_extension(std::vector<std::string> extensions, std::string what)
+{
+    return CLI::Validator(
+        [extensions, what](std::string& text) {
+            const std::string ext = lower_extension(text);
+            if (std::find(extensions.begin(), extensions.end(), ext) != extensions.end()) return std::string();
+            return text + ": " + what;
+        },
+        "", "output extension");
+}
+
+void require_output_folder(const std::string& path)
+{
+    const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+    if (folder.empty()) return;
+    std::error_code ec;
+    if (std::filesystem::is_directory(folder, ec)) return;
+    if (std::filesystem::exists(folder, ec))
+        throw FileError(path, "'" + folder.string() + "' is not a folder");
+    throw FileError(path, "the folder '" + folder.string() + "' does not exist");
+}
+
+bool is_session_file(const std::string& path)
+{
+    std::ifstream in{path, std::ios::binary};
+    char c = 0;
+    while (in.get(c) && std::isspace(static_cast<unsigned char>(c))) {
+    }
+    if (!in || c != '{') return false;
+    try {
+        const nlohmann::json j = nlohmann::json::parse(read_file_limited(path, 256u << 20), nullptr, false);
+        return j.is_object() && j.contains("format") && j["format"] == "lobesketch-session";
+    } catch (const std::exception&) {
+        return false;
+    }
+}
+
+bool is_recording_file(const std::string& path)
+{
+    std::ifstream in{path, std::ios::binary};
+    std::string head(64, '\0');
+    in.read(head.data(), static_cast<std::streamsize>(head.size()));
+    head.resize(static_cast<std::size_t>(in.gcount()));
+    if (head.rfind("\xEF\xBB\xBF", 0) == 0) head.erase(0, 3); // a UTF-8 BOM before the text form
+    namespace rf = recording_format;
+    const std::string binary(reinterpret_cast<const char*>(rf::kMagic.data()), rf::kMagic.size());
+    return head.rfind(binary, 0) == 0 || head.rfind(std::string(rf::kTextMagic), 0) == 0;
+}
+
+void check_input_kind(const std::string& path, const std::string& command, const std::string& takes,
+                      bool takes_session, bool takes_mesh)
+{
+    const std::string ext = lower_extension(path);
+    std::string kind;
+    if (ext == ".glb" || ext == ".gltf") kind = "a glTF file (an exported tree)";
+    else if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" || ext == ".tga" || ext == ".webp")
+        kind = "a picture";
+    else if (ext == ".mtl") kind = "an OBJ material file";
+    else if (ext == ".fbx" || ext == ".stl" || ext == ".dae" || ext == ".3ds" || ext == ".blend")
+        kind = "a model in a format lobesketch does not read";
+    else if (ext == ".l" || ext == ".v") kind = "an L-system file (grow it with 'lobesketch lsystem FILE.l')";
+    else if (!takes_session && ext == ".json")
+        kind = is_session_file(path) ? "a Lobesketch session document" : "a JSON file";
+    else if (!takes_mesh && is_mesh_file(path)) kind = "a mesh";
+    else if (ext == ".obj") {
+        // An OBJ this program exported is a whole tree, not a lobe to grow one in.
+        std::ifstream in{path, std::ios::binary};
+        std::string first;
+        std::getline(in, first);
+        if (first.rfind("# Lobesketch: ", 0) == 0 && first.find("origin at the trunk base") != std::string::npos)
+            kind = "a tree exported by lobesketch (a mesh input is the lobe a tree grows in)";
+    }
+    if (kind.empty()) return;
+    throw UsageError(path + ": " + kind + " is not an input " + command + " takes (" + takes + ")");
+}
+
+void warn_mesh_only_option(const std::string& input, const std::string& option)
+{
+    if (is_mesh_file(input)) return;
+    warn(option + " applies only to a mesh input (.obj/.ply/.off); ignored for " + input);
 }
 
 void print_report(const std::string& path, const ReadReport& report)
@@ -63,6 +196,13 @@ Recording load_recording_verbose(const std::string& path)
             head.resize(static_cast<std::size_t>(in.gcount()));
         }
         const std::string what = e.what();
+        if (head.rfind("{", 0) == 0 && what.find("magic") != std::string::npos && is_session_file(path))
+            throw Error(path + ": a Lobesketch session document, not a recording (grow, export, render and lobes "
+                               "take sessions; 'lobesketch info' shows one)");
+        if (head.rfind("glTF", 0) == 0 && what.find("magic") != std::string::npos)
+            throw Error(path + ": a glTF binary (an exported tree), not a recording");
+        if (head.rfind("\x89PNG", 0) == 0 && what.find("magic") != std::string::npos)
+            throw Error(path + ": a PNG picture, not a recording");
         if (head.rfind("{", 0) == 0 && what.find("magic") != std::string::npos)
             throw Error(what + " (a Leap Motion JSON capture? convert it with 'lobesketch import-leap')");
         if (head.rfind("var ", 0) == 0 && what.find("magic") != std::string::npos)
@@ -127,7 +267,8 @@ void add_tree_input_options(CLI::App* cmd, TreeInputOptions& o)
     cmd->add_option("--settings", o.settings, "Settings JSON (a settings object or a session document)");
     cmd->add_option("--species", o.species,
                     "Species preset: broadleaf, conifer, willow, birch, or a preset .json file (with the "
-                    "self-organizing grower also its growth preset)");
+                    "self-organizing grower also its growth preset)")
+        ->check(species_check());
     std::vector<std::string> names;
     for (const Grower* g : growers()) names.emplace_back(g->name());
     cmd->add_option("--grower", o.grower, "Growth model: " + grower_names() + " (default: the session's, else " +
@@ -152,7 +293,7 @@ void add_tree_input_options(CLI::App* cmd, TreeInputOptions& o)
                 }
             },
             "", "setting assignment"));
-    cmd->add_option("--seed", o.seed, "Seed of every random choice of growth (default: the session's)");
+    cmd->add_option("--seed", o.seed, "Seed of every random choice of growth (default: the session's)")->check(seed_check());
     cmd->add_option("--environment", o.environment,
                     "Self-organizing grower: what buds perceive, markers (space colonization) or shadow")
         ->check(CLI::IsMember({"markers", "shadow"}));
@@ -173,7 +314,23 @@ SettingsOverlay setting_assignments(const std::vector<std::string>& assignments)
 
 void apply_tree_input_options(Settings& s, const TreeInputOptions& o)
 {
-    if (!o.species.empty()) apply_species(s, load_species(o.species));
+    if (!o.species.empty()) {
+        const Settings before = s;
+        apply_species(s, load_species(o.species));
+        if (!o.settings.empty()) {
+            // The species is applied after the settings file: say which of the file's values it replaced.
+            std::vector<std::string> changed;
+            for (const SettingInfo& info : settings_table())
+                if (setting_text(before, info) != setting_text(s, info)) changed.push_back(info.key);
+            if (!changed.empty()) {
+                std::string keys;
+                for (std::size_t i = 0; i < changed.size() && i < 5; ++i) keys += (i ? ", " : "") + changed[i];
+                if (changed.size() > 5) keys += ", …";
+                warn("--species " + o.species + " replaces " + std::to_string(changed.size()) + " setting(s) of --settings " +
+                     o.settings + " (" + keys + "): the species wins; --set applies after both");
+            }
+        }
+    }
     setting_assignments(o.set).apply_to(s);
     if (o.split_angle) s.growth.split_angle_deg = *o.split_angle;
     if (o.spacing) s.lobes.edge_length_m = *o.spacing;
@@ -240,10 +397,10 @@ void apply_document_options(Document& doc, const TreeInputOptions& o)
     const std::string selforg(self_organizing_grower().name());
     if (!o.lsystem.empty()) {
         if (!o.grower.empty() && o.grower != lsystem::kGrowerName)
-            throw InvalidInput("--lsystem: an L-system file grows with --grower " + std::string(lsystem::kGrowerName) +
+            throw UsageError("--lsystem: an L-system file grows with --grower " + std::string(lsystem::kGrowerName) +
                                ", not " + o.grower);
         if (only_selforg)
-            throw InvalidInput(std::string(only_selforg) + " is only valid with --grower " + selforg + " (the grower is " +
+            throw UsageError(std::string(only_selforg) + " is only valid with --grower " + selforg + " (the grower is " +
                                std::string(lsystem::kGrowerName) + ")");
         GrowerChoice choice = lsystem_file_choice(o.lsystem);
         if (o.height) choice.params["height_m"] = *o.height;
@@ -258,7 +415,7 @@ void apply_document_options(Document& doc, const TreeInputOptions& o)
         choice = scene_grower(doc);
     }
     if (only_selforg && choice.name != selforg)
-        throw InvalidInput(std::string(only_selforg) + " is only valid with --grower " + selforg + " (the grower is " +
+        throw UsageError(std::string(only_selforg) + " is only valid with --grower " + selforg + " (the grower is " +
                            choice.name + ")");
     if (choice.name == selforg) {
         if (o.environment) choice.params["environment"] = *o.environment;
@@ -270,7 +427,8 @@ void apply_document_options(Document& doc, const TreeInputOptions& o)
     if (!o.grower.empty() || choice != scene_grower(doc)) set_scene_grower(doc, std::move(choice));
 }
 
-GrownInput grow_input_tree(const std::string& input, const TreeInputOptions& o)
+GrownInput grow_input_tree(const std::string& input, const TreeInputOptions& o,
+                           const std::function<void(const Document&)>& before_growing)
 {
     GrownInput out;
     Document& doc = out.doc;
@@ -282,6 +440,7 @@ GrownInput grow_input_tree(const std::string& input, const TreeInputOptions& o)
     }
     apply_tree_input_options(doc.settings, o);
     apply_document_options(doc, o);
+    if (before_growing && (ext == ".json" || is_mesh_file(input))) before_growing(doc);
     if (is_mesh_file(input)) {
         const BuiltLobe lobe = model_lobe(input, doc.settings, o.mesh_size);
         LobeRecord rec;

@@ -3,12 +3,14 @@
 /// Shared helpers of the CLI subcommands: messages, settings files, recording input.
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "app/session/tree_pipeline.h"
 #include "core/document.h"
+#include "core/errors.h"
 #include "core/settings.h"
 #include "core/settings_json.h" // the commands that write settings as JSON (settings_json)
 #include "core/settings_table.h"
@@ -16,6 +18,7 @@
 
 namespace CLI {
 class App;
+class Validator;
 }
 
 namespace lobe::cli {
@@ -24,6 +27,46 @@ void warn(const std::string& line);  ///< "lobesketch: warning: …" on stderr
 void error(const std::string& line); ///< "lobesketch: error: …" on stderr
 void progress(const std::string& line); ///< a progress line on stderr (suppressed by --quiet)
 void set_quiet(bool quiet);
+
+/// A bad command line found after CLI11 has parsed it (an input of a kind the command does
+/// not take, options that cannot go together), before any work: printed as one line, exit 2
+/// (kExitUsage). An InvalidInput, so code that checks options without the CLI still catches it.
+class UsageError : public InvalidInput {
+public:
+    using InvalidInput::InvalidInput;
+};
+
+/// A CLI11 check of a number: finite and in [lo, hi] (CLI::Range lets "nan" through).
+CLI::Validator finite_range(double lo, double hi);
+/// A CLI11 check of --species: a shipped preset's name, or a .json file (read later).
+CLI::Validator species_check();
+/// A CLI11 check of a seed: a whole number 0 to 2^64-1 ("-1" would wrap to 2^64-1).
+CLI::Validator seed_check();
+/// A CLI11 check of an output file's extension: one of `extensions` (lower case, with the
+/// dot); `what` says what is written ("the tree is written as .glb or .obj").
+CLI::Validator output_extension(std::vector<std::string> extensions, std::string what);
+
+/// \throw FileError when the folder `path` would be written in does not exist (checked before
+/// the work, so a typo in --out does not cost a whole growth).
+void require_output_folder(const std::string& path);
+
+/// Refuses, as a bad command line, an input whose extension says it is not one `command`
+/// takes (a .glb, a picture, an L-system file, a session where a recording is wanted, …),
+/// naming what it takes. `takes` lists them ("a recording, a session document (.json) or a
+/// mesh (.obj/.ply/.off)"). Recordings may have any extension, so unknown ones pass.
+/// \throw UsageError
+void check_input_kind(const std::string& path, const std::string& command, const std::string& takes,
+                      bool takes_session, bool takes_mesh);
+
+/// True when `path` holds a Lobesketch session document (a JSON object whose "format" is
+/// "lobesketch-session"), whatever its extension.
+bool is_session_file(const std::string& path);
+/// True when `path` starts as a Lobesketch recording does (binary or text form).
+bool is_recording_file(const std::string& path);
+
+/// Warns (one line) when an option that applies only to a mesh input was given for another
+/// input: `option` ("--size") was set on the command line, `input` is not a mesh.
+void warn_mesh_only_option(const std::string& input, const std::string& option);
 
 /// Prints the reader's report as warnings, one line each, naming the file.
 void print_report(const std::string& path, const ReadReport& report);
@@ -75,9 +118,9 @@ void apply_tree_input_options(Settings& s, const TreeInputOptions& o);
 /// --environment, --bud-fate, --iterations and --species give the self-organizing grower;
 /// without --grower they change the session's self-organizing grower); --lsystem FILE.l
 /// makes it the lsystem grower with that file (lsystem_file_choice).
-/// \throw FileError for an unreadable --lsystem file; InvalidInput when --grower names
-/// another grower than lsystem beside --lsystem, or (one line) for a self-organizing option
-/// with another grower.
+/// \throw FileError for an unreadable --lsystem file; UsageError (a bad command line) when
+/// --grower names another grower than lsystem beside --lsystem, or (one line) for a
+/// self-organizing option with another grower.
 void apply_document_options(Document& doc, const TreeInputOptions& o);
 
 /// The local time as "YYYYMMDD-HHMMSS", for default file names.
@@ -104,9 +147,12 @@ struct GrownInput {
 
 /// Grows the tree of `input`: a session document (.json), a mesh (.obj/.ply/.off, one lobe
 /// of `mesh_size`) or a recording (run through the input pipeline and the session builder,
-/// warnings printed naming the file), with the options applied.
+/// warnings printed naming the file), with the options applied. `before_growing` (when given)
+/// sees the document of a session or mesh input once its settings are final, before the
+/// tree is grown (a recording's events may still change them as it is replayed).
 /// \throw FileError, InvalidInput
-GrownInput grow_input_tree(const std::string& input, const TreeInputOptions& o);
+GrownInput grow_input_tree(const std::string& input, const TreeInputOptions& o,
+                           const std::function<void(const Document&)>& before_growing = {});
 
 /// The lsystem grower's choice for the L-system file `path`: its text as `source`, the path
 /// as `source_name`, the view file beside it (NAME.v) as `view` when there is one.

@@ -31,9 +31,23 @@ struct TreeArgs {
 void add_tree_options(CLI::App* cmd, TreeArgs& a)
 {
     add_tree_input_options(cmd, a.in);
-    cmd->add_option("--lod", a.lod, "LODs to write: all, or indices such as 0 or 0,2")->capture_default_str();
+    cmd->add_option("--lod", a.lod, "LODs to write: all, or indices such as 0 or 0,2")
+        ->capture_default_str()
+        ->check(CLI::Validator(
+            [](std::string& text) {
+                // The form here; whether each LOD exists is known once the settings are.
+                try {
+                    parse_lod_list(text, 100);
+                    return std::string();
+                } catch (const InvalidInput& e) {
+                    std::string why = e.what();
+                    if (why.rfind("--lod: ", 0) == 0) why.erase(0, 7); // CLI11 names the option itself
+                    return why;
+                }
+            },
+            "LIST", "LOD list"));
     cmd->add_option("--height", a.height, "Scale the exported tree to this height in metres (0 keeps the sketch's)")
-        ->check(CLI::Range(0.0, 1000.0));
+        ->check(finite_range(0.0, 1000.0));
     cmd->add_flag("--lobes", a.lobes, "Also write the lobes as extra nodes");
     cmd->add_flag("--strokes", a.strokes, "Also write the strokes as extra nodes");
     cmd->add_option("--report", a.report,
@@ -107,6 +121,20 @@ void report_and_write(const TreeArgs& a, const Document& doc, const BuiltTree& t
     exit_code = kExitOk;
 }
 
+/// --out's extension, checked when the command line is parsed.
+CLI::Validator tree_file_check()
+{
+    return output_extension({".glb", ".obj"}, "the tree is written as .glb (glTF binary) or .obj (with .mtl and a PNG)");
+}
+
+/// Every file the command writes goes into a folder that exists (before the tree is grown).
+void require_outputs_folders(const TreeArgs& a)
+{
+    require_output_folder(a.out);
+    if (!a.report.empty()) require_output_folder(a.report);
+    if (!a.skeleton_out.empty()) require_output_folder(a.skeleton_out);
+}
+
 } // namespace
 
 void add_grow_command(CLI::App& app, int& exit_code)
@@ -116,13 +144,21 @@ void add_grow_command(CLI::App& app, int& exit_code)
     auto a = std::make_shared<TreeArgs>();
     cmd->add_option("INPUT", a->input, "Recording, session document or mesh")->required();
     cmd->add_option("-o,--out", a->out, "Output file: tree.glb (glTF binary) or tree.obj (with .mtl and PNG)")
-        ->required();
+        ->required()
+        ->check(tree_file_check());
     add_tree_options(cmd, *a);
-    cmd->add_option("--size", a->in.mesh_size, "A mesh input is scaled so its bounding box's largest side is this (metres)")
+    cmd->add_option("--size,--mesh-size", a->in.mesh_size, "A mesh input is scaled so its bounding box's largest side is this (metres)")
         ->capture_default_str()
-        ->check(CLI::Range(0.01, 100.0));
-    cmd->callback([a, &exit_code] {
-        const GrownInput grown = grow_input_tree(a->input, a->in);
+        ->check(finite_range(0.01, 100.0));
+    cmd->callback([a, cmd, &exit_code] {
+        check_input_kind(a->input, "grow", "a recording, a session document (.json) or a mesh (.obj/.ply/.off)", true,
+                         true);
+        if (cmd->get_option("--size")->count() > 0) warn_mesh_only_option(a->input, "--size");
+        require_outputs_folders(*a);
+        // The LODs asked for exist: known before growing for a session or a mesh.
+        const GrownInput grown = grow_input_tree(a->input, a->in, [a](const Document& doc) {
+            parse_lod_list(a->lod, doc.settings.branches.lod_count);
+        });
         report_and_write(*a, grown.doc, grown.tree, a->input, exit_code);
     });
 }
@@ -133,13 +169,24 @@ void add_export_command(CLI::App& app, int& exit_code)
     auto a = std::make_shared<TreeArgs>();
     cmd->add_option("SESSION", a->input, "Session document (.json)")->required();
     cmd->add_option("-o,--out", a->out, "Output file: tree.glb (glTF binary) or tree.obj (with .mtl and PNG)")
-        ->required();
+        ->required()
+        ->check(tree_file_check());
     add_tree_options(cmd, *a);
     cmd->callback([a, &exit_code] {
+        if (lower_extension(a->input) != ".json" && !is_session_file(a->input)) {
+            std::string kind = "this file";
+            if (is_mesh_file(a->input)) kind = "a mesh";
+            else if (is_recording_file(a->input)) kind = "a recording";
+            throw UsageError(a->input + ": export wants a session document (.json), and " + kind +
+                             " is not one; grow takes recordings, sessions and meshes (lobesketch grow " + a->input +
+                             " --out " + a->out + ")");
+        }
+        require_outputs_folders(*a);
         Document doc = load_session(a->input);
         if (!a->in.settings.empty()) doc.settings = load_settings_file(a->in.settings);
         apply_tree_input_options(doc.settings, a->in);
         apply_document_options(doc, a->in);
+        parse_lod_list(a->lod, doc.settings.branches.lod_count); // the LODs asked for exist, before growing
         report_and_write(*a, doc, build_document_tree(doc), a->input, exit_code);
     });
 }

@@ -93,7 +93,8 @@ void add_info_command(CLI::App& app, int& exit_code)
     cmd->add_option("REC", *path, "Recording (binary or text form), or session document (.json)")->required();
     cmd->add_flag("--json", *as_json, "Print the summary as JSON");
     cmd->callback([path, as_json, &exit_code] {
-        if (lower_extension(*path) == ".json") {
+        // A session document by its content too (an autosave, a renamed session), not only by .json.
+        if (lower_extension(*path) == ".json" || is_session_file(*path)) {
             session_info(*path, *as_json);
             exit_code = kExitOk;
             return;

@@ -32,14 +32,17 @@ void add_lobes_command(CLI::App& app, int& exit_code)
     cmd->add_option("INPUT", a->input, "Recording, session document or mesh")->required();
     cmd->add_option("-o,--out", a->out, "Output folder (created): lobes/lobe_N.ply and session.json")->required();
     cmd->add_option("--settings", a->settings, "Settings JSON (a settings object or a session document)");
-    cmd->add_option("--size", a->size_m, "A mesh input is scaled so its bounding box's largest side is this (metres)")
+    cmd->add_option("--size,--mesh-size", a->size_m, "A mesh input is scaled so its bounding box's largest side is this (metres)")
         ->capture_default_str()
-        ->check(CLI::Range(0.01, 100.0));
+        ->check(finite_range(0.01, 100.0));
     cmd->add_option("--simplify-above", a->simplify_above,
                     "A mesh of more triangles than this is simplified in cubes of a fifth of the spacing before "
                     "repair (0: never)")
         ->capture_default_str();
-    cmd->callback([a, &exit_code] {
+    cmd->callback([a, cmd, &exit_code] {
+        check_input_kind(a->input, "lobes", "a recording, a session document (.json) or a mesh (.obj/.ply/.off)", true,
+                         true);
+        if (cmd->get_option("--size")->count() > 0) warn_mesh_only_option(a->input, "--size");
         const std::string ext = lower_extension(a->input);
         std::error_code ec;
         std::filesystem::create_directories(a->out, ec);
@@ -61,6 +64,9 @@ void add_lobes_command(CLI::App& app, int& exit_code)
             std::filesystem::create_directories(a->out + "/lobes", ec);
             if (ec) throw FileError(a->out + "/lobes", "cannot create folder: " + ec.message());
             write_ply(a->out + "/lobes/lobe_1.ply", mesh);
+            if (const std::size_t removed = remove_stale_lobe_files(a->out + "/lobes", {"lobe_1.ply"}); removed > 0)
+                warn(a->input + ": removed " + std::to_string(removed) + " lobe mesh(es) of an earlier run from " + a->out +
+                     "/lobes");
             // The session holds the lobe itself, so it opens, regrows and exports without the file.
             LobeRecord rec = LobeRecord::of_strokes(1, {}, "lobes/lobe_1.ply");
             rec.model = std::make_shared<const LobeModel>(

@@ -93,21 +93,23 @@ void add_lsystem_command(CLI::App& app, int& exit_code)
     };
     auto a = std::make_shared<Args>();
     cmd->add_option("FILE", a->file, "L-system file (.l; NAME.v beside it is its view file), or a shipped preset's name (docs/lsystems.md)")->required();
-    cmd->add_option("-o,--out", a->out, "Output file: tree.glb (glTF binary) or tree.obj (with .mtl and PNG)")->required();
+    cmd->add_option("-o,--out", a->out, "Output file: tree.glb (glTF binary) or tree.obj (with .mtl and PNG)")
+        ->required()
+        ->check(output_extension({".glb", ".obj"},
+                                 "the tree is written as .glb (glTF binary) or .obj (with .mtl and a PNG)"));
     cmd->add_option("--steps", a->steps, "Derivation steps (default: the file's derivation length)")
         ->check(CLI::Range(0, lsystem::kMaxDerivationLength));
-    cmd->add_option("--seed", a->in.seed, "Seed of the stochastic productions and ran() (default 1)");
+    cmd->add_option("--seed", a->in.seed, "Seed of the stochastic productions and ran() (default 1)")->check(seed_check());
     cmd->add_option("--lobes", a->lobes,
                     "Grow in the lobes of this session document (.json): from its trunk base, with its settings");
     cmd->add_option("--string-out", a->string_out, "Also write the derived word, one line");
     cmd->add_option("--skeleton-out", a->skeleton_out, "Also write the tree graph as JSON (docs/growth.md)");
     cmd->add_option("--height", a->in.height, "A tree grown without lobes is scaled to this height in metres (default 3)")
-        ->check(CLI::Range(0.01, 100.0));
+        ->check(finite_range(0.01, 100.0));
     cmd->add_option("--settings", a->in.settings, "Settings JSON (a settings object or a session document)");
     cmd->callback([a, &exit_code] {
-        const std::string ext = lower_extension(a->out);
-        if (ext != ".glb" && ext != ".obj")
-            throw InvalidInput(a->out + ": the tree is written as .glb (glTF binary) or .obj (with .mtl and a PNG)");
+        for (const std::string* path : {&a->out, &a->string_out, &a->skeleton_out})
+            if (!path->empty()) require_output_folder(*path);
         const LSystemGrown g = grow_lsystem_file(a->file, a->lobes, a->steps, a->in);
         const BuiltTree& tree = g.grown.tree;
         progress("derived " + std::to_string(g.modules) + " modules and drew " + std::to_string(tree.growth.tree.size()) +

@@ -1,5 +1,7 @@
 #include "app/cli/outputs.h"
 
+#include <algorithm>
+#include <cctype>
 #include <filesystem>
 
 #include <nlohmann/json.hpp>
@@ -45,6 +47,7 @@ std::size_t write_document_lobes(Document& doc, const std::string& out_dir, std:
     std::filesystem::create_directories(dir, ec);
     if (ec) throw FileError(dir, "cannot create folder: " + ec.message());
     std::size_t written = 0;
+    std::vector<std::string> names;
     for (LobeRecord& rec : doc.lobes) {
         rec.mesh_file.clear();
         for (const BuiltLobe& b : lobes) {
@@ -52,11 +55,32 @@ std::size_t write_document_lobes(Document& doc, const std::string& out_dir, std:
             const std::string name = "lobes/lobe_" + std::to_string(rec.id) + ".ply";
             write_ply(out_dir + "/" + name, b.mesh);
             rec.mesh_file = name;
+            names.push_back(std::filesystem::path(name).filename().string());
             ++written;
         }
     }
+    if (const std::size_t removed = remove_stale_lobe_files(dir, names); removed > 0)
+        warnings.push_back("removed " + std::to_string(removed) + " lobe mesh(es) of an earlier run from " + dir);
     if (built) *built = std::move(lobes);
     return written;
+}
+
+std::size_t remove_stale_lobe_files(const std::string& lobes_dir, const std::vector<std::string>& kept)
+{
+    std::error_code ec;
+    std::vector<std::filesystem::path> stale;
+    for (std::filesystem::directory_iterator it(lobes_dir, ec), end; !ec && it != end; it.increment(ec)) {
+        const std::string name = it->path().filename().string();
+        if (name.size() <= 9 || name.rfind("lobe_", 0) != 0 || !name.ends_with(".ply")) continue;
+        const std::string digits = name.substr(5, name.size() - 9);
+        if (!std::all_of(digits.begin(), digits.end(), [](unsigned char c) { return std::isdigit(c); })) continue;
+        if (std::find(kept.begin(), kept.end(), name) == kept.end()) stale.push_back(it->path());
+    }
+    for (const std::filesystem::path& p : stale) {
+        std::filesystem::remove(p, ec);
+        if (ec) throw FileError(p.string(), "cannot remove this lobe mesh of an earlier run: " + ec.message());
+    }
+    return stale.size();
 }
 
 } // namespace lobe

@@ -58,7 +58,9 @@ void add_render_command(CLI::App& app, int& exit_code)
     cmd->add_option("INPUT", a->input,
                     "Recording, session document (.json), mesh (.obj/.ply/.off), L-system (.l) or a .glb made by lobesketch")
         ->required();
-    cmd->add_option("-o,--out", a->out, "Picture (.png); with --view orbit, OUT_000.png, OUT_001.png, …")->required();
+    cmd->add_option("-o,--out", a->out, "Picture (.png); with --view orbit, OUT_000.png, OUT_001.png, …")
+        ->required()
+        ->check(output_extension({".png"}, "pictures are written as .png"));
     cmd->add_option("--view", a->view, "front (looks along -Z), side (along -X), top (down -Y) or orbit (a turntable)")
         ->capture_default_str()
         ->check(CLI::IsMember({"front", "side", "top", "orbit"}));
@@ -89,14 +91,23 @@ void add_render_command(CLI::App& app, int& exit_code)
     add_tree_input_options(cmd, a->in);
     cmd->add_option("--mesh-size", a->in.mesh_size, "A mesh input is scaled so its bounding box's largest side is this (metres)")
         ->capture_default_str()
-        ->check(CLI::Range(0.01, 100.0));
+        ->check(finite_range(0.01, 100.0));
     cmd->add_flag("--software", a->software, "Render on the CPU (lavapipe) even when a GPU is present");
-    cmd->callback([a, &exit_code] {
+    cmd->callback([a, cmd, &exit_code] {
         int width = 0, height = 0;
         parse_size(a->size, width, height);
         RenderContent content = parse_show_list(a->show);
         content.lod = a->lod;
-        if (lower_extension(a->out) != ".png") throw InvalidInput(a->out + ": pictures are written as .png");
+        const std::string input_ext = lower_extension(a->input);
+        if (input_ext != ".glb" && input_ext != ".l")
+            check_input_kind(a->input, "render",
+                             "a recording, a session document (.json), a mesh (.obj/.ply/.off), an L-system file (.l) "
+                             "or a .glb made by lobesketch",
+                             true, true);
+        if (cmd->get_option("--frames")->count() > 0 && a->view != "orbit")
+            warn("--frames applies only to --view orbit; one picture is drawn for --view " + a->view);
+        if (cmd->get_option("--mesh-size")->count() > 0 && input_ext != ".glb" && input_ext != ".l")
+            warn_mesh_only_option(a->input, "--mesh-size");
 
         RenderScene scene;
         if (lower_extension(a->input) == ".glb") {

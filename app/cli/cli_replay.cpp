@@ -17,19 +17,34 @@ void add_replay_command(CLI::App& app, int& exit_code)
 {
     auto* cmd = app.add_subcommand("replay", "Replay a recording through the pipeline and write its results");
     struct Args {
-        std::string rec, out, settings;
+        std::string rec, out, settings, species;
         std::uint64_t seed = 1;
+        double height = 0.0;
     };
     auto a = std::make_shared<Args>();
     cmd->add_option("REC", a->rec, "Recording (binary or text form)")->required();
     cmd->add_option("-o,--out", a->out, "Output folder (created): strokes.json, session.json, lobes/lobe_N.ply, tree.glb")
         ->required();
     cmd->add_option("--settings", a->settings, "Settings JSON (a settings object or a session document)");
-    cmd->add_option("--seed", a->seed, "Seed of every random choice downstream")->capture_default_str();
+    cmd->add_option("--seed", a->seed, "Seed of every random choice downstream")->capture_default_str()->check(seed_check());
+    cmd->add_option("--species", a->species,
+                    "Species preset applied after --settings, as in grow: broadleaf, conifer, willow, birch, or a preset "
+                    ".json file")
+        ->check(species_check());
+    cmd->add_option("--height", a->height, "Scale tree.glb to this height in metres, as grow does (0 keeps the sketch's)")
+        ->check(finite_range(0.0, 1000.0));
     cmd->callback([a, &exit_code] {
+        check_input_kind(a->rec, "replay", "a recording; grow, export, render and lobes take session documents and meshes",
+                         false, false);
         Document doc;
         doc.seed = a->seed;
         if (!a->settings.empty()) doc.settings = load_settings_file(a->settings);
+        if (!a->species.empty()) {
+            TreeInputOptions species;
+            species.settings = a->settings;
+            species.species = a->species;
+            apply_tree_input_options(doc.settings, species);
+        }
         std::size_t drags = 0;
         Document out_doc = replay_into_document(a->rec, std::move(doc), &drags);
 
@@ -51,7 +66,9 @@ void add_replay_command(CLI::App& app, int& exit_code)
             const BuiltTree tree = grow_document_tree(out_doc, std::move(lobes));
             for (const std::string& w : tree.warnings) warn(a->rec + ": " + w);
             const TreeGeometry geometry = document_tree_geometry(out_doc, tree);
-            write_tree_file(a->out + "/tree.glb", out_doc, tree, geometry, ExportOptions{});
+            ExportOptions options;
+            options.target_height_m = a->height;
+            write_tree_file(a->out + "/tree.glb", out_doc, tree, geometry, options);
             tree_written = true;
             progress("grew a tree of " + std::to_string(tree.growth.tree.size()) + " nodes (triangles " +
                      lod_triangle_summary(geometry) + ")");

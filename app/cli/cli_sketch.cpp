@@ -26,7 +26,8 @@ void add_sketch_command(CLI::App& app, int& exit_code)
     };
     auto a = std::make_shared<Args>();
     cmd->add_option("REC", a->rec, "Recording whose hand frames are the tracked hands")->required();
-    cmd->add_option("--session", a->session, "Session file written (atomically) when the recording ends");
+    cmd->add_option("--session,-o,--out", a->session,
+                    "Session file written (atomically) when the recording ends (--out as in the other commands)");
     cmd->add_option("--autosave", a->autosave, "Autosave written after every change of the document");
     cmd->add_option("--record", a->record, "The session's own recording, written as it goes");
     cmd->add_flag("--realtime", a->realtime, "Feed each frame at its time (default: as fast as the session runs)");
@@ -36,7 +37,7 @@ void add_sketch_command(CLI::App& app, int& exit_code)
     cmd->add_flag("--inline-regrowth", a->inline_regrowth,
                   "Regrow on the frame thread after every change (default: off it, as live)");
     cmd->add_option("--settings", a->settings, "Settings JSON the session starts with");
-    cmd->add_option("--seed", a->seed, "The session's seed")->capture_default_str();
+    cmd->add_option("--seed", a->seed, "The session's seed")->capture_default_str()->check(seed_check());
     cmd->callback([a, &exit_code] {
         const Recording rec = load_recording_verbose(a->rec);
         Document doc;

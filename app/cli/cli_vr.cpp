@@ -92,7 +92,7 @@ void add_vr_command(CLI::App& app, int& exit_code)
         ->check(CLI::Range(0, 16384));
     cmd->add_option("--reconnect-seconds", a->reconnect_seconds,
                     "After the headset goes away, how long to wait for it to come back (0: end at once)")
-        ->check(CLI::Range(0.0, 3600.0))
+        ->check(finite_range(0.0, 3600.0))
         ->capture_default_str();
     cmd->add_option("--samples", a->samples, "Multisampling: 1, 2, 4 or 8 samples per pixel")
         ->check(CLI::IsMember({1, 2, 4, 8}))

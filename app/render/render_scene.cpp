@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <set>
 #include <sstream>
 
 #include <glm/geometric.hpp>
@@ -366,7 +367,7 @@ RenderScene glb_render_scene(const std::string& path, const RenderContent& conte
     scene.ground_y = 0.0f; // the export's origin is the trunk base
     const std::string lod = "_LOD" + std::to_string(content.lod);
     bool found_lod = false;
-    int max_lod = -1;
+    std::set<int> lods_found; // the LODs the file has, to name them when the asked one is missing
     for (const tinygltf::Node& node : m.nodes) {
         if (node.mesh < 0 || std::size_t(node.mesh) >= m.meshes.size()) continue;
         const tinygltf::Mesh& mesh = m.meshes[std::size_t(node.mesh)];
@@ -376,7 +377,7 @@ RenderScene glb_render_scene(const std::string& path, const RenderContent& conte
         if (branches || leaves) {
             const std::string digits = name.substr(name.rfind("_LOD") + 4);
             if (!digits.empty() && digits.size() < 3 && std::all_of(digits.begin(), digits.end(), ::isdigit))
-                max_lod = std::max(max_lod, std::stoi(digits));
+                lods_found.insert(std::stoi(digits));
         }
         if (branches && name == "tree_branches" + lod) {
             found_lod = true;
@@ -400,10 +401,13 @@ RenderScene glb_render_scene(const std::string& path, const RenderContent& conte
                      polyline_tube(glb_line(m, mesh, path)));
         }
     }
-    if ((content.tree || content.leaves) && !found_lod)
-        throw FileError(path, max_lod < 0 ? std::string("has no tree_branches_LOD<k> meshes (not a tree exported by Lobesketch?)")
-                                          : "has no LOD" + std::to_string(content.lod) + " (it has LOD0 to LOD" +
-                                                std::to_string(max_lod) + ")");
+    if ((content.tree || content.leaves) && !found_lod) {
+        if (lods_found.empty())
+            throw FileError(path, "has no tree_branches_LOD<k> meshes (not a tree exported by Lobesketch?)");
+        std::string has;
+        for (const int k : lods_found) has += (has.empty() ? "LOD" : ", LOD") + std::to_string(k);
+        throw FileError(path, "has no LOD" + std::to_string(content.lod) + " (it has " + has + "; pick one with --lod)");
+    }
     return scene;
 }
 

@@ -64,7 +64,7 @@ TEST(SelfOrganizingCli, TheOptionsBecomeTheGrowersParametersAndASpeciesPresetNam
     EXPECT_EQ(std::get<std::int64_t>(scene_grower(doc).params.at("iterations")), 30);
     EXPECT_EQ(std::get<std::string>(scene_grower(doc).params.at("species")), "birch");
     Document other;
-    EXPECT_THROW(cli::apply_document_options(other, later), InvalidInput);
+    EXPECT_THROW(cli::apply_document_options(other, later), cli::UsageError);
 }
 
 TEST(SelfOrganizingCli, ItsOptionsWithAnotherGrowerOrBadValuesAreRefusedInOneLine)
@@ -73,7 +73,8 @@ TEST(SelfOrganizingCli, ItsOptionsWithAnotherGrowerOrBadValuesAreRefusedInOneLin
     const std::string rec = test::source_path("recordings/table1-1lobe-5strokes.lrec");
     for (const char* opt : {"--environment shadow", "--bud-fate priority", "--iterations 5"}) {
         const test::CliRun r = test::run_cli("grow " + rec + " " + opt + " --out " + out + "/a.glb");
-        EXPECT_EQ(r.code, 1) << r.out;
+        EXPECT_EQ(r.code, 2) << r.out;
+        EXPECT_EQ(r.out.find("replaying"), std::string::npos) << "refused before the recording is replayed: " << r.out;
         const std::string flag = std::string(opt).substr(0, std::string(opt).find(' '));
         EXPECT_NE(r.out.find(flag + " is only valid with --grower self-organizing"), std::string::npos) << r.out;
     }

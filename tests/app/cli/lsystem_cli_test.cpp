@@ -155,7 +155,7 @@ TEST(LSystemCli, GrowsInTheLobesOfASessionAndWithGrow)
     ASSERT_TRUE(test::validate_gltf(dir + "/g.glb", report));
     EXPECT_EQ(report["issues"]["numErrors"], 0) << test::describe_gltf_issues(report);
     r = run("grow " + recording + " --grower subtrees --lsystem " + dir + "/topiary.l --out " + dir + "/h.glb");
-    EXPECT_EQ(r.code, 1) << r.out;
+    EXPECT_EQ(r.code, 2) << r.out;
     EXPECT_NE(r.out.find("--lsystem"), std::string::npos) << r.out;
 }
 
@@ -196,7 +196,7 @@ TEST(LSystemCli, BadInputFailsWithOneLine)
     write(dir + "/bad.l", "Lsystem: 1\nAxiom: F[F\nendlsystem\n");
     expect_one_error_line(run("lsystem " + dir + "/bad.l --out " + dir + "/t.glb"), 1, "bad.l:2:");
     write(dir + "/ok.l", "Lsystem: 1\nAxiom: F\nendlsystem\n");
-    expect_one_error_line(run("lsystem " + dir + "/ok.l --out " + dir + "/t.stl"), 1, ".glb");
+    expect_one_error_line(run("lsystem " + dir + "/ok.l --out " + dir + "/t.stl"), 2, ".glb");
     write(dir + "/badview.l", "Lsystem: 1\nAxiom: F\nendlsystem\n");
     write(dir + "/badview.v", "angle increment: many\n");
     expect_one_error_line(run("lsystem " + dir + "/badview.l --out " + dir + "/t.glb"), 1, "badview.v:1:");

@@ -158,10 +158,10 @@ TEST(TreeCli, BadGrowOptionsGiveOneLineAndExitCodes)
         int code;
     };
     const Case cases[] = {
-        {"grow " + r + " --out " + out + "/x.glb --species baobab", "unknown species 'baobab'", 1},
+        {"grow " + r + " --out " + out + "/x.glb --species baobab", "unknown species 'baobab'", 2},
         {"grow " + r + " --out " + out + "/x.glb --lod 5", "--lod: LOD 5 does not exist", 1},
-        {"grow " + r + " --out " + out + "/x.glb --lod 0,0", "given twice", 1},
-        {"grow " + r + " --out " + out + "/x.fbx", "is written as .glb", 1},
+        {"grow " + r + " --out " + out + "/x.glb --lod 0,0", "given twice", 2},
+        {"grow " + r + " --out " + out + "/x.fbx", "is written as .glb", 2},
         {"grow " + r + " --out " + out + "/x.glb --split-angle 2", "split-angle", 2},
         {"grow " + out + "/missing.json --out " + out + "/x.glb", "missing.json", 1},
     };

@@ -1049,7 +1049,7 @@ TEST(RenderCli, BadOptionsGiveOneLineAndExitCodes)
         {"render " + r + " --out " + out + "/x.png --size 9000x100", "expected WxH", 2},
         {"render " + r + " --out " + out + "/x.png --show tree,bark", "unknown item 'bark'", 2},
         {"render " + r + " --out " + out + "/x.png --view diagonal", "--view", 2},
-        {"render " + r + " --out " + out + "/x.jpg", "written as .png", 1},
+        {"render " + r + " --out " + out + "/x.jpg", "written as .png", 2},
         {"render " + out + "/missing.glb --out " + out + "/x.png", "missing.glb", 1},
         {"render " + r + " --out " + out + "/x.png --lod 7", "--lod: LOD 7 does not exist", 1},
     };
