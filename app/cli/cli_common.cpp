@@ -455,4 +455,13 @@ GrownInput grow_input_tree(const std::string& input, const TreeInputOptions& o,
     return out;
 }
 
+nlohmann::json wood_json(const WoodEstimate& e)
+{
+    return nlohmann::json{{"wood_volume_m3", e.wood_volume_m3},
+                          {"dry_biomass_kg", e.dry_biomass_kg},
+                          {"carbon_kg", e.carbon_kg},
+                          {"co2_kg", e.co2_kg},
+                          {"density_kg_m3", e.density_kg_m3}};
+}
+
 } // namespace lobe::cli

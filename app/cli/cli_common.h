@@ -14,6 +14,7 @@
 #include "core/settings.h"
 #include "core/settings_json.h" // the commands that write settings as JSON (settings_json)
 #include "core/settings_table.h"
+#include "growth/wood.h"
 #include "input/recording.h"
 
 namespace CLI {
@@ -125,6 +126,10 @@ void apply_document_options(Document& doc, const TreeInputOptions& o);
 
 /// The local time as "YYYYMMDD-HHMMSS", for default file names.
 std::string timestamp();
+/// A wood estimate as the report and `info --json` write it (docs/wood-and-co2.md):
+/// wood_volume_m3, dry_biomass_kg, carbon_kg, co2_kg, density_kg_m3.
+nlohmann::json wood_json(const WoodEstimate& e);
+
 /// "tree.json" → "tree<suffix>" beside it.
 std::string beside(const std::string& session, const std::string& suffix);
 

@@ -60,19 +60,12 @@ void add_tree_options(CLI::App* cmd, TreeArgs& a)
 std::string wood_report(const TreeArgs& a, const Document& doc, const BuiltTree& tree, const TreeGeometry& geometry)
 {
     const double density = basic_wood_density(doc.settings.growth.species);
-    auto fields = [](const WoodEstimate& e) {
-        return nlohmann::json{{"wood_volume_m3", e.wood_volume_m3},
-                              {"dry_biomass_kg", e.dry_biomass_kg},
-                              {"carbon_kg", e.carbon_kg},
-                              {"co2_kg", e.co2_kg},
-                              {"density_kg_m3", e.density_kg_m3}};
-    };
-    nlohmann::json j = fields(estimate_wood(tree.growth.tree, density));
+    nlohmann::json j = wood_json(estimate_wood(tree.growth.tree, density));
     j["species"] = doc.settings.growth.species;
     if (a.height > 0.0) {
         const double height = tree_height(geometry, tree.growth.tree.nodes[0].position);
         if (!(height > 1e-9)) throw InvalidInput("--report: the tree has no height above its base to scale");
-        nlohmann::json at = fields(estimate_wood(tree.growth.tree, density, a.height / height));
+        nlohmann::json at = wood_json(estimate_wood(tree.growth.tree, density, a.height / height));
         at["height_m"] = a.height;
         j["at_height"] = std::move(at);
     }

@@ -67,12 +67,7 @@ void session_info(const std::string& path, bool as_json)
                                   {"lobes", tree.lobes.size()},
                                   {"nodes", tree.growth.tree.size()},
                                   {"species", doc.settings.growth.species},
-                                  {"wood",
-                                   {{"wood_volume_m3", e.wood_volume_m3},
-                                    {"dry_biomass_kg", e.dry_biomass_kg},
-                                    {"carbon_kg", e.carbon_kg},
-                                    {"co2_kg", e.co2_kg},
-                                    {"density_kg_m3", e.density_kg_m3}}}};
+                                  {"wood", wood_json(e)}};
         std::cout << j.dump(2) << "\n";
         return;
     }

@@ -33,9 +33,7 @@ GrowerChoice lsystem_file_choice(const std::string& path)
             choice.params["preset"] = path;
             return choice;
         }
-        std::string names;
-        for (const std::string& n : lsystem::preset_names()) names += (names.empty() ? "" : ", ") + n;
-        throw FileError(path, "no such file, nor a shipped L-system preset (" + names + ")");
+        throw FileError(path, "no such file, nor a shipped L-system preset (" + lsystem::preset_names_text() + ")");
     }
     choice.params["source"] = read_file_limited(path, lsystem::kMaxFileBytes);
     choice.params["source_name"] = path;

@@ -450,9 +450,9 @@ void VrSession::Impl::update_status()
     if (live.grown()) label += s.regrowing ? "  GROWING..." : "  TREE";
     if (live.grown() && live.built() && live.built()->wood.co2_kg > 0.0) {
         // The tree's CO2 as grown (docs/wood-and-co2.md), to a tenth of a kilogram.
-        const double kg = std::round(live.built()->wood.co2_kg * 10.0) / 10.0;
-        const std::string text = std::to_string(kg);
-        label += "  CO2 " + text.substr(0, text.find('.') + 2) + " KG";
+        char co2[48];
+        std::snprintf(co2, sizeof co2, "  CO2 %.1f KG", live.built()->wood.co2_kg);
+        label += co2;
     }
     s.label = label;
 }

@@ -139,11 +139,8 @@ void LSystemGrower::check_params(const GrowerChoice& choice, const std::string& 
                 throw InvalidInput(at + ": longer than " + std::to_string(kMaxFileBytes) + " bytes");
             if (key == "preset") {
                 const std::vector<std::string> names = preset_names();
-                if (std::find(names.begin(), names.end(), *text) == names.end()) {
-                    std::string known;
-                    for (const std::string& n : names) known += (known.empty() ? "" : ", ") + n;
-                    throw InvalidInput(at + ": no L-system preset \"" + *text + "\" (known: " + known + ")");
-                }
+                if (std::find(names.begin(), names.end(), *text) == names.end())
+                    throw InvalidInput(at + ": no L-system preset \"" + *text + "\" (known: " + preset_names_text() + ")");
             }
         } else if (key == "steps") {
             const auto* n = std::get_if<std::int64_t>(&value);
@@ -206,14 +203,17 @@ std::vector<std::string> preset_names()
     return names;
 }
 
+std::string preset_names_text()
+{
+    std::string list;
+    for (const std::string& n : preset_names()) list += (list.empty() ? "" : ", ") + n;
+    return list;
+}
+
 LSystemSource preset_source(const std::string& name)
 {
     const Preset* p = find_preset(name);
-    if (!p) {
-        std::string list;
-        for (const std::string& n : preset_names()) list += (list.empty() ? "" : ", ") + n;
-        throw InvalidInput("no L-system preset \"" + name + "\" (presets: " + list + ")");
-    }
+    if (!p) throw InvalidInput("no L-system preset \"" + name + "\" (presets: " + preset_names_text() + ")");
     LSystemSource src;
     src.name = std::string(kPresetFolder) + name + ".l";
     src.view_name = std::string(kPresetFolder) + name + ".v";
@@ -282,12 +282,13 @@ void grow_crowns_on_skeleton(const GrowerInput& in, const LSystem& system, const
     g.leaves.emplace(); // the model's own leaves only (none without surfaces)
     if (g.tree.empty()) return;
     for (std::size_t i = 0; i < in.lobes.size(); ++i) {
-        const int entry = crown_entry(skeleton, LobeEnvironment({in.lobes[i]}, glm::dvec3(0.0)), in.lobes[i]);
+        LobeEnvironment lobe_env({in.lobes[i]}, glm::dvec3(0.0));
+        const int entry = crown_entry(skeleton, lobe_env, in.lobes[i]);
         const TreeNode& at = g.tree.nodes[static_cast<std::size_t>(entry)];
         const glm::dvec3 origin(at.position);
         glm::dvec3 heading(0.0, 1.0, 0.0);
         if (at.parent >= 0) heading = origin - glm::dvec3(g.tree.nodes[static_cast<std::size_t>(at.parent)].position);
-        const LobeEnvironment lobe_env({in.lobes[i]}, origin);
+        lobe_env.set_origin(origin);
         // Each lobe draws its own numbers: its seed, else the tree's keyed by the lobe's id.
         derive_options.seed = in.lobes[i].seed.value_or(splitmix64(in.seed ^ splitmix64(static_cast<std::uint64_t>(in.lobes[i].id))));
         derive_options.environment = &lobe_env;

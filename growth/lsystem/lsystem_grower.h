@@ -55,6 +55,8 @@ class LobeEnvironment final : public Environment {
 public:
     LobeEnvironment(const std::vector<GrowthLobe>& lobes, const glm::dvec3& origin);
     bool inside(const glm::dvec3& p) const override;
+    /// Moves the model's origin (what inside() adds to its points); lobe_at is unchanged.
+    void set_origin(const glm::dvec3& origin) { origin_ = origin; }
     /// The index of the first lobe holding stage point `p` (metres), or -1.
     int lobe_at(const glm::vec3& p) const;
 
@@ -75,6 +77,8 @@ struct LSystemSource {
 
 /// Names of the presets: "default" and every shipped growth/data/lsystems/NAME.l, sorted.
 std::vector<std::string> preset_names();
+/// preset_names() as "default, abop-monopodial, …" (for messages).
+std::string preset_names_text();
 /// The preset's `.l` (and `.v` when shipped). \throw InvalidInput for an unknown name.
 LSystemSource preset_source(const std::string& name);
 
