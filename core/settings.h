@@ -95,6 +95,23 @@ struct GrowthSettings {
     /// Relative weights of the library subtrees (growth/data/subtrees.json) by name; missing
     /// names weigh 0. Empty: all subtrees weigh the same.
     std::map<std::string, double> subtree_weights;
+    /// Form of the species (growth/species_form.h). With no trunk strokes, 1 continues the
+    /// default trunk as a leader up through the crown (an excurrent tree: a conifer); 0 ends it
+    /// below the crown, where the limbs fork (a decurrent tree).
+    int leader = 0;
+    /// Spacing of the leader's nodes as a fraction of the crown's height: the laterals grow
+    /// from them in tiers (whorls). 0: the leader's nodes are skeleton_spacing_m apart.
+    double whorl_spacing = 0.0;
+    /// Share by which a lateral's outer end turns from its grown direction towards straight
+    /// down, growing along the lateral from its base (gravity bending a branch): 0 none.
+    double droop = 0.0;
+    /// Share by which the outer part of every lateral turns to hang straight down (a weeping
+    /// tree's twigs): 0 none, 1 the outer two thirds hang plumb.
+    double hang = 0.0;
+    /// Height of the exported tree in metres (real scale, docs/export.md): the tree's structure
+    /// is scaled about its base so its highest branch node lies this high, while leaves, leaf
+    /// spacing and twig radii keep their sizes in metres. 0: the size it was sketched at.
+    double height_m = 0.0;
 };
 
 /// Branch radii (pipe model) and generalised-cylinder geometry.
@@ -106,6 +123,10 @@ struct BranchSettings {
     int smoothing_iterations = 2; ///< Laplacian smoothing passes of branch curves
     double bark_color[3] = {0.36, 0.25, 0.17}; ///< linear RGB
     int lod_count = 3;            ///< levels of detail written (LOD0 … LOD{n−1})
+    /// At real scale (GrowthSettings::height_m > 0): the trunk's diameter at breast height as
+    /// a share of the tree's height; > 0 fits the pipe exponent to it (tips keep tip_radius_m,
+    /// growth/real_scale.h), 0 uses pipe_exponent. docs/growth.md gives each species' figure.
+    double dbh_ratio = 0.03;
 };
 
 /// Leaves: alpha-tested textured quads at tip nodes.
@@ -116,6 +137,11 @@ struct LeafSettings {
     double deviation_deg = 35.0; ///< random deviation from the branch direction
     double color[3] = {0.20, 0.42, 0.12}; ///< linear RGB
     std::string shape = "ovate"; ///< leaf texture: "ovate", "round" or "needle"
+    /// Distance between leaves along a shoot (the segment from a tip to its parent): a shoot
+    /// longer than per_node × spacing_m carries one leaf per spacing_m along it (at most 64)
+    /// instead of per_node at its tip; 0: every leaf at the tip. Keeps the leaf density of a
+    /// tree scaled to real height (growth.height_m) at the species' value.
+    double spacing_m = 0.02;
 };
 
 /// All settings of a session.

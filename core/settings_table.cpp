@@ -133,6 +133,20 @@ const std::vector<Field<GrowthSettings>>& growth_fields()
         {"subtree_weights", &GrowthSettings::subtree_weights,
          "relative weights of the library subtrees (growth/data/subtrees.json) by name; names left out weigh 0; none: "
          "all weigh the same"},
+        {"leader", &GrowthSettings::leader, "[0, 1]",
+         "1: with no trunk strokes the default trunk continues as a leader up through the crown (excurrent, a "
+         "conifer); 0: it ends below the crown"},
+        {"whorl_spacing", &GrowthSettings::whorl_spacing, "[0, 0.5]",
+         "spacing of the leader's nodes as a fraction of the crown height, so laterals grow in whorls; 0: "
+         "skeleton_spacing_m"},
+        {"droop", &GrowthSettings::droop, "[0, 1]",
+         "share by which a lateral turns from its grown direction towards straight down, growing from its base "
+         "to its end"},
+        {"hang", &GrowthSettings::hang, "[0, 1]",
+         "share by which the outer part of every lateral turns to hang straight down (weeping twigs)"},
+        {"height_m", &GrowthSettings::height_m, "[0, 1000]",
+         "height of the exported tree: the structure is scaled about its base to this height, leaves and twig "
+         "radii keep their size (real scale); 0: as sketched"},
     };
     return f;
 }
@@ -149,6 +163,9 @@ const std::vector<Field<BranchSettings>>& branch_fields()
          "Laplacian smoothing passes of branch curves"},
         {"bark_color", &BranchSettings::bark_color, "bark colour, linear RGB"},
         {"lod_count", &BranchSettings::lod_count, "[1, 6]", "levels of detail written (LOD0 … LOD{n−1})"},
+        {"dbh_ratio", &BranchSettings::dbh_ratio, "[0, 0.2]",
+         "at real scale (growth.height_m > 0): trunk diameter at breast height over tree height; > 0 fits the pipe "
+         "exponent to it, 0 uses pipe_exponent"},
     };
     return f;
 }
@@ -162,6 +179,9 @@ const std::vector<Field<LeafSettings>>& leaf_fields()
         {"deviation_deg", &LeafSettings::deviation_deg, "[0, 180]", "random deviation of a leaf from its branch direction"},
         {"color", &LeafSettings::color, "leaf colour, linear RGB"},
         {"shape", &LeafSettings::shape, std::vector<std::string>{"ovate", "round", "needle"}, "leaf texture"},
+        {"spacing_m", &LeafSettings::spacing_m, "[0, 0.5]",
+         "distance between leaves along a shoot: a shoot longer than per_node × this carries one leaf per spacing "
+         "(at most 64); 0: all at the tip"},
     };
     return f;
 }

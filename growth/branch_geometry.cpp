@@ -13,6 +13,7 @@
 #include "core/errors.h"
 #include "growth/bark_texture.h"
 #include "growth/leaves.h"
+#include "growth/real_scale.h"
 
 namespace lobe {
 namespace {
@@ -836,8 +837,7 @@ void build_tree_geometry_into(TreeGeometry& geo, const TreeGraph& graph, const B
         int most = std::max(0, leaves.per_node);
         for (const LobeLeafOverride& o : lobe_leaves) most = std::max(most, o.per_node.value_or(0));
         const double leaf_count = placed_leaves ? static_cast<double>(placed_leaves->size())
-                                  : most > 0    ? static_cast<double>(leaf_tip_nodes(graph).size()) * most
-                                                : 0.0;
+                                  : spread_leaf_count(graph, leaves, most);
         double triangles = 2.0 * leaf_count;
         for (const RingRange& r : ranges)
             if (r.count >= 2) triangles += 2.0 * lod0.radial_segments * (r.count - 1.0) + 2.0 * lod0.radial_segments;
@@ -846,8 +846,9 @@ void build_tree_geometry_into(TreeGeometry& geo, const TreeGraph& graph, const B
                                " triangles, more than the " + std::to_string(kMaxTreeTriangles) +
                                " allowed (lower max_nodes, radial_segments or leaves per node)");
     }
-    const LeafCloud cloud =
+    LeafCloud cloud =
         placed_leaves ? make_placed_leaf_cloud(*placed_leaves, seed) : make_leaf_cloud(graph, leaves, seed, lobe_leaves);
+    if (!placed_leaves) spread_leaves_along_shoots(cloud, graph, leaves); // leaf density along long shoots
 
     // Nothing can throw past this point: `geo` is only changed when the whole build succeeds.
     geo.species = species;

@@ -13,6 +13,7 @@
 #include "core/errors.h"
 #include "core/random.h"
 #include "growth/mesh_raycast.h"
+#include "growth/species_form.h"
 
 namespace lobe {
 
@@ -505,6 +506,8 @@ GrowthResult grow_tree(const std::vector<std::vector<glm::vec3>>& trunk_strokes,
     for (const GrowthLobe& l : lobes) rays.emplace_back(l.mesh);
     SkeletonOptions so;
     so.spacing_m = settings.skeleton_spacing_m;
+    so.leader = settings.leader != 0;
+    so.whorl_spacing = settings.whorl_spacing;
     Skeleton skeleton = build_skeleton(trunk_strokes, meshes, so, &rays);
     result.messages = skeleton.messages;
     result.tree = skeleton.graph;
@@ -542,6 +545,7 @@ GrowthResult grow_tree(const std::vector<std::vector<glm::vec3>>& trunk_strokes,
                                       std::to_string(settings.max_iterations) + " reached with attractors left");
         result.lobes.push_back(stats);
     }
+    apply_species_form(result.tree, result.skeleton_nodes, settings); // droop and hang
     return result;
 }
 

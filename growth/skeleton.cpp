@@ -8,6 +8,7 @@
 #include <glm/geometric.hpp>
 
 #include "growth/mesh_raycast.h"
+#include "growth/species_form.h"
 
 namespace lobe {
 
@@ -228,6 +229,21 @@ Skeleton build_skeleton(const std::vector<std::vector<glm::vec3>>& trunk_strokes
         b.limb(root, fork, -1, false);
     } else {
         return s;
+    }
+
+    if (options.leader && !lobes.empty()) {
+        // An excurrent tree: the trunk goes on from its highest point up through the crown.
+        glm::vec3 lo(std::numeric_limits<float>::max()), hi = -lo;
+        for (std::size_t i = 0; i < lobes.size(); ++i) {
+            if (lobes[i].positions.empty()) continue;
+            lo = glm::min(lo, boxes[i].lo);
+            hi = glm::max(hi, boxes[i].hi);
+        }
+        std::size_t top = 0;
+        for (std::size_t i = 0; i < s.graph.nodes.size(); ++i)
+            if (s.owner[i] == -1 && s.graph.nodes[i].position.y > s.graph.nodes[top].position.y) top = i;
+        if (lo.y <= hi.y)
+            b.chain(static_cast<int>(top), default_leader_points(s.graph.nodes[top].position, lo.y, hi.y, options.whorl_spacing, options.spacing_m), -1);
     }
 
     // Every lobe must be reached: a lobe that no skeleton node enters gets a limb to its centre.

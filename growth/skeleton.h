@@ -26,6 +26,11 @@ struct SkeletonOptions {
     /// The default trunk's base lies this fraction of the lobes' total height below the
     /// lowest lobe (and never below the stage floor y = 0 when the lobes are above it).
     double default_trunk_fraction = 0.6;
+    /// The trunk (default or sketched) continues from its highest point as a leader up
+    /// through the crown (growth/species_form.h, GrowthSettings::leader), its nodes
+    /// whorl_spacing × the crown's height apart (0: spacing_m).
+    bool leader = false;
+    double whorl_spacing = 0.0;
 };
 
 /// Most trunk strokes used, and most skeleton nodes (the spacing grows to stay below it).

@@ -260,6 +260,8 @@ void add_assignment(SettingsOverlay& overlay, const std::string& assignment)
 
 } // namespace
 
+void add_radius_options(CLI::App* cmd, TreeInputOptions& o);
+
 void add_tree_input_options(CLI::App* cmd, TreeInputOptions& o)
 {
     const SettingInfo& split = *find_setting("growth.split_angle_deg");
@@ -303,6 +305,15 @@ void add_tree_input_options(CLI::App* cmd, TreeInputOptions& o)
         ->check(CLI::Range(std::int64_t{1}, std::int64_t{500}));
     cmd->add_option("--split-angle", o.split_angle, setting_help(split))->check(setting_value_check(split));
     cmd->add_option("--attractor-spacing", o.spacing, setting_help(spacing))->check(setting_value_check(spacing));
+    add_radius_options(cmd, o);
+}
+
+void add_radius_options(CLI::App* cmd, TreeInputOptions& o)
+{
+    const SettingInfo& exponent = *find_setting("branches.pipe_exponent");
+    const SettingInfo& tip = *find_setting("branches.tip_radius_m");
+    cmd->add_option("--pipe-exponent", o.pipe_exponent, setting_help(exponent) + "; given, it is used at real scale too (branches.dbh_ratio=0)")->check(setting_value_check(exponent));
+    cmd->add_option("--tip-radius", o.tip_radius, setting_help(tip) + " (metres)")->check(setting_value_check(tip));
 }
 
 SettingsOverlay setting_assignments(const std::vector<std::string>& assignments)
@@ -334,6 +345,12 @@ void apply_tree_input_options(Settings& s, const TreeInputOptions& o)
     setting_assignments(o.set).apply_to(s);
     if (o.split_angle) s.growth.split_angle_deg = *o.split_angle;
     if (o.spacing) s.lobes.edge_length_m = *o.spacing;
+    if (o.pipe_exponent) {
+        s.branches.pipe_exponent = *o.pipe_exponent;
+        s.branches.dbh_ratio = 0.0; // the exponent given, not one fitted to the trunk
+    }
+    if (o.tip_radius) s.branches.tip_radius_m = *o.tip_radius;
+    if (o.height && *o.height > 0.0) s.growth.height_m = *o.height;
     validate_settings(s);
 }
 
@@ -448,10 +465,12 @@ GrownInput grow_input_tree(const std::string& input, const TreeInputOptions& o,
         rec.model = std::make_shared<const LobeModel>(LobeModel{input, lobe.mesh});
         doc.lobes.push_back(std::move(rec));
         out.tree = grow_document_tree(doc, {lobe});
+        apply_real_scale(doc, out.tree);
         return out;
     }
     if (ext != ".json") doc = replay_into_document(input, std::move(doc));
     out.tree = build_document_tree(doc);
+    apply_real_scale(doc, out.tree);
     return out;
 }
 

@@ -89,7 +89,10 @@ struct TreeInputOptions {
     std::optional<double> split_angle, spacing;
     double mesh_size = 1.5; ///< a mesh input's largest side (metres)
     std::string lsystem;    ///< `--lsystem FILE.l`: the lsystem grower with that file (empty: none)
-    std::optional<double> height; ///< an L-system tree grown without lobes is this tall (metres)
+    /// The tree's height in metres: settings.growth.height_m (real scale, apply_real_scale),
+    /// and an L-system tree grown without lobes is this tall.
+    std::optional<double> height;
+    std::optional<double> pipe_exponent, tip_radius; ///< settings.branches.pipe_exponent, tip_radius_m
     /// The self-organizing grower's parameters (growth/selforg/selforg_grower.h); only with
     /// that grower. `--species` also sets its `species` when it names one of its presets.
     std::optional<std::string> environment, bud_fate;
@@ -97,11 +100,14 @@ struct TreeInputOptions {
 };
 
 /// Registers --settings, --species, --grower, --lsystem, --set, --seed, --split-angle,
-/// --attractor-spacing, and the self-organizing grower's --environment, --bud-fate and
+/// --attractor-spacing, --pipe-exponent, --tip-radius, and the self-organizing grower's --environment, --bud-fate and
 /// --iterations. The help and range checks of --set, --split-angle and
 /// --attractor-spacing come from the settings table: a bad value is a bad command line (exit
 /// 2) naming the setting.
 void add_tree_input_options(CLI::App* cmd, TreeInputOptions& o);
+/// Registers --pipe-exponent and --tip-radius alone (replay, which takes no other tree
+/// input options).
+void add_radius_options(CLI::App* cmd, TreeInputOptions& o);
 
 /// `--set` assignments ("growth.split_angle_deg=25"), in order, as an overlay.
 /// \throw InvalidInput naming the key (unknown, a value of the wrong form or out of range).
@@ -109,7 +115,8 @@ SettingsOverlay setting_assignments(const std::vector<std::string>& assignments)
 
 /// Applies the options to `s` in this order, which is a contract (docs/settings.md): the
 /// settings file is the caller's (it replaces the settings first), then the species preset,
-/// then each `--set` in the order given, then --split-angle and --attractor-spacing; then the
+/// then each `--set` in the order given, then --split-angle, --attractor-spacing,
+/// --pipe-exponent, --tip-radius and --height (growth.height_m, when > 0); then the
 /// result is validated (settings that contradict each other are refused here). --seed sets
 /// the document's seed, not a setting. \throw InvalidInput
 void apply_tree_input_options(Settings& s, const TreeInputOptions& o);

@@ -24,7 +24,6 @@ namespace {
 struct TreeArgs {
     TreeInputOptions in;
     std::string input, out, lod = "all", report, skeleton_out;
-    double height = 0.0;
     bool lobes = false, strokes = false;
 };
 
@@ -46,7 +45,9 @@ void add_tree_options(CLI::App* cmd, TreeArgs& a)
                 }
             },
             "LIST", "LOD list"));
-    cmd->add_option("--height", a.height, "Scale the exported tree to this height in metres (0 keeps the sketch's)")
+    cmd->add_option("--height", a.in.height,
+                    "Real scale: the tree's structure is scaled to this height in metres, its leaves and twigs keep "
+                    "the species' sizes (settings.growth.height_m; 0 or none: the session's, else as sketched)")
         ->check(finite_range(0.0, 1000.0));
     cmd->add_flag("--lobes", a.lobes, "Also write the lobes as extra nodes");
     cmd->add_flag("--strokes", a.strokes, "Also write the strokes as extra nodes");
@@ -62,11 +63,14 @@ std::string wood_report(const TreeArgs& a, const Document& doc, const BuiltTree&
     const double density = basic_wood_density(doc.settings.growth.species);
     nlohmann::json j = wood_json(estimate_wood(tree.growth.tree, density));
     j["species"] = doc.settings.growth.species;
-    if (a.height > 0.0) {
-        const double height = tree_height(geometry, tree.growth.tree.nodes[0].position);
-        if (!(height > 1e-9)) throw InvalidInput("--report: the tree has no height above its base to scale");
-        nlohmann::json at = wood_json(estimate_wood(tree.growth.tree, density, a.height / height));
-        at["height_m"] = a.height;
+    (void)a;
+    (void)geometry;
+    if (tree.scale != 1.0) {
+        // The tree is at real scale (apply_real_scale): the figures above are of the tree as
+        // written, repeated under at_height with its height and the scale applied.
+        nlohmann::json at = wood_json(estimate_wood(tree.growth.tree, density));
+        at["height_m"] = doc.settings.growth.height_m;
+        at["scale"] = tree.scale;
         j["at_height"] = std::move(at);
     }
     return j.dump(2) + "\n";
@@ -85,7 +89,6 @@ void report_and_write(const TreeArgs& a, const Document& doc, const BuiltTree& t
     const TreeGeometry geometry = document_tree_geometry(doc, tree);
     const double geometry_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     ExportOptions options;
-    options.target_height_m = a.height;
     options.lods = parse_lod_list(a.lod, static_cast<int>(geometry.lods.size()));
     options.include_lobes = a.lobes;
     options.include_strokes = a.strokes;
@@ -180,7 +183,9 @@ void add_export_command(CLI::App& app, int& exit_code)
         apply_tree_input_options(doc.settings, a->in);
         apply_document_options(doc, a->in);
         parse_lod_list(a->lod, doc.settings.branches.lod_count); // the LODs asked for exist, before growing
-        report_and_write(*a, doc, build_document_tree(doc), a->input, exit_code);
+        BuiltTree tree = build_document_tree(doc);
+        apply_real_scale(doc, tree);
+        report_and_write(*a, doc, tree, a->input, exit_code);
     });
 }
 

@@ -89,6 +89,10 @@ void add_render_command(CLI::App& app, int& exit_code)
             "LIST"));
     cmd->add_option("--lod", a->lod, "Level of detail of the tree (0: finest)")->capture_default_str()->check(CLI::Range(0, 9));
     add_tree_input_options(cmd, a->in);
+    cmd->add_option("--height", a->in.height,
+                    "Real scale: the tree's structure at this height in metres, leaves and twigs at the species' sizes "
+                    "(settings.growth.height_m)")
+        ->check(finite_range(0.0, 1000.0));
     cmd->add_option("--mesh-size", a->in.mesh_size, "A mesh input is scaled so its bounding box's largest side is this (metres)")
         ->capture_default_str()
         ->check(finite_range(0.01, 100.0));

@@ -20,6 +20,7 @@ void add_replay_command(CLI::App& app, int& exit_code)
         std::string rec, out, settings, species;
         std::uint64_t seed = 1;
         double height = 0.0;
+        TreeInputOptions radii;
     };
     auto a = std::make_shared<Args>();
     cmd->add_option("REC", a->rec, "Recording (binary or text form)")->required();
@@ -31,8 +32,11 @@ void add_replay_command(CLI::App& app, int& exit_code)
                     "Species preset applied after --settings, as in grow: broadleaf, conifer, willow, birch, or a preset "
                     ".json file")
         ->check(species_check());
-    cmd->add_option("--height", a->height, "Scale tree.glb to this height in metres, as grow does (0 keeps the sketch's)")
+    cmd->add_option("--height", a->height,
+                    "Real scale for tree.glb, as grow does: the structure at this height in metres, leaves and twigs at "
+                    "the species' sizes (stored in session.json as settings.growth.height_m; 0: as sketched)")
         ->check(finite_range(0.0, 1000.0));
+    add_radius_options(cmd, a->radii);
     cmd->callback([a, &exit_code] {
         check_input_kind(a->rec, "replay", "a recording; grow, export, render and lobes take session documents and meshes",
                          false, false);
@@ -45,6 +49,12 @@ void add_replay_command(CLI::App& app, int& exit_code)
             species.species = a->species;
             apply_tree_input_options(doc.settings, species);
         }
+        if (a->radii.pipe_exponent) {
+            doc.settings.branches.pipe_exponent = *a->radii.pipe_exponent;
+            doc.settings.branches.dbh_ratio = 0.0;
+        }
+        if (a->radii.tip_radius) doc.settings.branches.tip_radius_m = *a->radii.tip_radius;
+        if (a->height > 0.0) doc.settings.growth.height_m = a->height;
         std::size_t drags = 0;
         Document out_doc = replay_into_document(a->rec, std::move(doc), &drags);
 
@@ -63,12 +73,11 @@ void add_replay_command(CLI::App& app, int& exit_code)
         // Then the tree grown in those lobes (docs/growth.md, docs/export.md).
         bool tree_written = false;
         if (!lobes.empty()) {
-            const BuiltTree tree = grow_document_tree(out_doc, std::move(lobes));
+            BuiltTree tree = grow_document_tree(out_doc, std::move(lobes));
+            apply_real_scale(out_doc, tree);
             for (const std::string& w : tree.warnings) warn(a->rec + ": " + w);
             const TreeGeometry geometry = document_tree_geometry(out_doc, tree);
-            ExportOptions options;
-            options.target_height_m = a->height;
-            write_tree_file(a->out + "/tree.glb", out_doc, tree, geometry, options);
+            write_tree_file(a->out + "/tree.glb", out_doc, tree, geometry, ExportOptions{});
             tree_written = true;
             progress("grew a tree of " + std::to_string(tree.growth.tree.size()) + " nodes (triangles " +
                      lod_triangle_summary(geometry) + ")");

@@ -56,7 +56,13 @@ void write_tree_file(const std::string& path, const Document& doc, const BuiltTr
     if (!tree.growth.tree.empty()) scene.base = tree.growth.tree.nodes[0].position;
     if (options.include_lobes)
         for (const BuiltLobe& l : tree.lobes) scene.lobes.push_back(l.mesh);
-    if (options.include_strokes) scene.strokes = effective_strokes(doc);
+    if (options.include_strokes) {
+        scene.strokes = effective_strokes(doc);
+        if (tree.scale != 1.0) // the strokes as the tree was scaled (apply_real_scale)
+            for (Stroke& s : scene.strokes)
+                for (StrokePoint& p : s.points)
+                    p.position = glm::vec3(glm::dvec3(scene.base) + (glm::dvec3(p.position) - glm::dvec3(scene.base)) * tree.scale);
+    }
     if (ext == ".glb")
         write_glb(path, scene, options);
     else if (ext == ".obj")

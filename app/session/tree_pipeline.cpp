@@ -5,6 +5,7 @@
 
 #include "growth/grower.h"
 #include "growth/radii.h"
+#include "growth/real_scale.h"
 #include "growth/species.h"
 #include "app/session/edit_ops.h"
 #include "app/session/stage_options.h"
@@ -67,6 +68,37 @@ void finish_grown_tree(const Document& doc, BuiltTree& tree)
         assign_pipe_radii(tree.growth.tree, radii.exponent, radii.tip_radius_m);
     }
     for (const std::string& m : tree.growth.messages) tree.warnings.push_back("growth: " + m);
+}
+
+void apply_real_scale(const Document& doc, BuiltTree& tree)
+{
+    const double target = doc.settings.growth.height_m;
+    const double height = graph_height(tree.growth.tree);
+    if (!(target > 0.0) || !(height > 1e-9)) return;
+    const double factor = target / height;
+    TreeGraph& graph = tree.growth.tree;
+    const glm::dvec3 root(graph.nodes[0].position);
+    scale_tree_structure(graph, factor);
+    const auto scaled = [&](const glm::vec3& p) { return glm::vec3(root + (glm::dvec3(p) - root) * factor); };
+    for (BuiltLobe& l : tree.lobes)
+        for (glm::vec3& p : l.mesh.positions) p = scaled(p);
+    if (tree.growth.radii_set) {
+        // The grower's own proportions: its radii and leaves grow with it.
+        for (TreeNode& n : graph.nodes) n.radius = static_cast<float>(n.radius * factor);
+        if (tree.growth.leaves)
+            for (PlacedLeaf& leaf : *tree.growth.leaves) {
+                leaf.base = scaled(leaf.base);
+                leaf.length_m = static_cast<float>(leaf.length_m * factor);
+                leaf.width_m = static_cast<float>(leaf.width_m * factor);
+            }
+    } else {
+        const PipeRadiiOptions radii = pipe_radii_options(doc.settings);
+        if (doc.settings.branches.dbh_ratio > 0.0)
+            fit_pipe_exponent(graph, radii.tip_radius_m, doc.settings.branches.dbh_ratio);
+        else
+            assign_pipe_radii(graph, radii.exponent, radii.tip_radius_m);
+    }
+    tree.scale *= factor;
 }
 
 BuiltTree grow_document_tree(const Document& doc, std::vector<BuiltLobe> lobes)

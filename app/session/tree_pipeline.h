@@ -20,6 +20,9 @@ struct BuiltTree {
     std::vector<BuiltLobe> lobes;      ///< as grown in, stage space
     GrowthResult growth;               ///< tree graph with radii assigned
     std::vector<std::string> warnings; ///< one line each: lobe and growth messages
+    /// How much apply_real_scale scaled the tree's structure (and its lobes) about its root:
+    /// 1 when it is the size it was sketched at.
+    double scale = 1.0;
 };
 
 /// The growth inputs of built lobes: each lobe's mesh, its id, and its effective split angle
@@ -35,6 +38,13 @@ GrowerInput document_grower_input(const Document& doc, const std::vector<BuiltLo
 /// After the grower: pipe-model radii (growth/radii.h) unless the grower set its own
 /// (GrowthResult::radii_set), and the growth messages as warnings ("growth: …").
 void finish_grown_tree(const Document& doc, BuiltTree& tree);
+
+/// Real scale (docs/export.md, "Size"): when settings.growth.height_m > 0, scales the tree's
+/// nodes and its lobes about the root so the highest node lies height_m above it, and sets
+/// the radii again (the pipe model's twigs keep tip_radius_m). A grower that set its own radii
+/// and leaves (an L-system) has them scaled with it. Sets BuiltTree::scale; no-op for 0 or a
+/// tree with no height.
+void apply_real_scale(const Document& doc, BuiltTree& tree);
 
 /// Grows the document's tree in `lobes` (already built) from its trunk strokes, with its
 /// grower: document_grower_input, the grower, finish_grown_tree. \throw InvalidInput when the document names a grower or parameters no grower
