@@ -3,6 +3,7 @@
 // forms byte by byte and line by line: docs/recording-format.md.
 #include "input/recording.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <string_view>
@@ -81,8 +82,28 @@ const char* setting_name(SettingId id)
     case SettingId::Seed: return "seed";
     case SettingId::Grower: return "grower";
     case SettingId::GrowthSteps: return "growth-steps";
+    case SettingId::LeafWidth: return "leaf-width";
+    case SettingId::LeafColor: return "leaf-color";
+    case SettingId::BarkColor: return "bark-color";
+    case SettingId::PipeExponent: return "pipe-exponent";
+    case SettingId::TipRadius: return "tip-radius";
     }
     return nullptr;
+}
+
+int pack_color(const double (&rgb)[3])
+{
+    int packed = 0;
+    for (double c : rgb) packed = packed * 256 + static_cast<int>(std::lround(std::clamp(c, 0.0, 1.0) * 255.0));
+    return packed;
+}
+
+void unpack_color(int packed, double (&rgb)[3])
+{
+    for (int i = 2; i >= 0; --i) {
+        rgb[i] = double(packed & 255) / 255.0;
+        packed >>= 8;
+    }
 }
 
 } // namespace lobe

@@ -79,12 +79,23 @@ enum class SettingId : std::int32_t {
     Grower = 7,           ///< a grower's panel code (growth/grower.h); tree-wide only (trees[0].grower)
     GrowthSteps = 8,      ///< an integer ≥ 0: the scene grower's growth steps (Grower::steps_param), 0 for
                           ///< its default; tree-wide only
+    // Appearance (ids from 20: a block of their own).
+    LeafWidth = 20,    ///< metres (settings.leaves.width_m); tree-wide only
+    LeafColor = 21,    ///< settings.leaves.color packed as 0xRRGGBB, each byte round(255 × linear component); tree-wide only
+    BarkColor = 22,    ///< settings.branches.bark_color, packed as LeafColor; tree-wide only
+    PipeExponent = 23, ///< settings.branches.pipe_exponent; tree-wide only
+    TipRadius = 24,    ///< metres (settings.branches.tip_radius_m); tree-wide only
 };
 
 /// "split-angle", "attractor-spacing", "leaf-length", "leaves-per-node", "species", "seed",
-/// "grower", "growth-steps"; nullptr for an id this build does not know.
+/// "grower", "growth-steps", "leaf-width", "leaf-color", "bark-color", "pipe-exponent",
+/// "tip-radius"; nullptr for an id this build does not know.
 const char* setting_name(SettingId id);
-inline bool known_setting_id(std::int32_t id) { return id >= 1 && id <= 8; }
+inline bool known_setting_id(std::int32_t id) { return (id >= 1 && id <= 8) || (id >= 20 && id <= 24); }
+
+/// A linear RGB colour (each component in [0, 1]) as a LeafColor/BarkColor value, and back.
+int pack_color(const double (&rgb)[3]);
+void unpack_color(int packed, double (&rgb)[3]);
 
 /// The species a Setting event of id Species chooses from, by index (x = 0 … 3).
 inline constexpr const char* kSettingSpecies[] = {"broadleaf", "conifer", "willow", "birch"};

@@ -1,6 +1,7 @@
 #include "app/desktop/desktop_panel.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -57,6 +58,36 @@ void draw_grower_section(DesktopSession& session, const Document& doc, DesktopPa
         if (given) ImGui::Text("step %d", *steps);
         else ImGui::Text("step %d (default)", *steps);
     }
+}
+
+/// The whole tree's leaf width and colours and its radii (pipe model); `send` sends one
+/// Setting event. Labels and ranges: the panel controls; lengths in cm and mm.
+template <class Send> void draw_tree_appearance(const Document& doc, const Send& send)
+{
+    const auto control = [](SettingId id) -> const PanelControl& { return *find_panel_control(id); };
+    const PanelControl& width_c = control(SettingId::LeafWidth);
+    float width = float(doc.settings.leaves.width_m * 100.0);
+    ImGui::SliderFloat(width_c.label, &width, float(width_c.lo * 100.0), float(width_c.hi * 100.0), "%.1f cm");
+    if (ImGui::IsItemDeactivatedAfterEdit()) send(SettingId::LeafWidth, width / 100.0);
+    // Colours: linear RGB, sent packed (pack_color) when the picker is let go.
+    const auto colour = [&](SettingId id, const double (&rgb)[3]) {
+        float c[3] = {float(rgb[0]), float(rgb[1]), float(rgb[2])};
+        ImGui::ColorEdit3(control(id).label, c, ImGuiColorEditFlags_Float);
+        if (ImGui::IsItemDeactivatedAfterEdit()) {
+            const double picked[3] = {c[0], c[1], c[2]};
+            send(id, pack_color(picked));
+        }
+    };
+    colour(SettingId::LeafColor, doc.settings.leaves.color);
+    colour(SettingId::BarkColor, doc.settings.branches.bark_color);
+    const PanelControl& pipe_c = control(SettingId::PipeExponent);
+    float pipe = float(doc.settings.branches.pipe_exponent);
+    ImGui::SliderFloat(pipe_c.label, &pipe, float(pipe_c.lo), float(pipe_c.hi), "%.1f");
+    if (ImGui::IsItemDeactivatedAfterEdit()) send(SettingId::PipeExponent, std::round(pipe * 10.0) / 10.0);
+    const PanelControl& tip_c = control(SettingId::TipRadius);
+    float tip = float(doc.settings.branches.tip_radius_m * 1000.0);
+    ImGui::SliderFloat(tip_c.label, &tip, float(tip_c.lo * 1000.0), float(tip_c.hi * 1000.0), "%.1f mm");
+    if (ImGui::IsItemDeactivatedAfterEdit()) send(SettingId::TipRadius, std::round(double(tip) * 10.0) / 10000.0);
 }
 
 } // namespace
@@ -165,6 +196,7 @@ void draw_desktop_panel(DesktopSession& session, const std::string& session_name
         const PanelControl& leaves_c = control(SettingId::LeavesPerNode);
         ImGui::SliderInt(leaves_c.label, &leaves, int(leaves_c.lo), int(leaves_c.hi));
         if (ImGui::IsItemDeactivatedAfterEdit()) send(SettingId::LeavesPerNode, leaves);
+        if (state.target_lobe == 0) draw_tree_appearance(doc, send);
         const PanelControl& seed_c = control(SettingId::Seed);
         int seed = int(std::min<std::uint64_t>(lobe && lobe->seed ? *lobe->seed : doc.seed, std::uint64_t(seed_c.hi)));
         if (ImGui::InputInt(seed_c.label, &seed, int(seed_c.step), 10) && seed >= seed_c.lo && seed <= seed_c.hi)

@@ -36,6 +36,14 @@ const std::vector<PanelControl>& panel_controls()
         // check_params says what it takes.
         {SettingId::GrowthSteps, "growth-steps", "step", 0.0, 100000.0, 1.0,
          "the scene's tree grows with one grower"},
+        // Appearance of the whole tree: leaf width and colours, and the radii (pipe model).
+        {SettingId::LeafWidth, "leaves.width_m", "leaf width", 0.002, 0.10, 0.001, "one leaf shape for the tree"},
+        {SettingId::LeafColor, "leaves.color", "leaf colour", 0.0, 16777215.0, 1.0, "one leaf colour for the tree"},
+        {SettingId::BarkColor, "branches.bark_color", "bark colour", 0.0, 16777215.0, 1.0, "one bark for the tree"},
+        {SettingId::PipeExponent, "branches.pipe_exponent", "pipe exponent", 1.5, 3.5, 0.1,
+         "one radius model for the tree"},
+        {SettingId::TipRadius, "branches.tip_radius_m", "twig radius", 0.0003, 0.005, 0.0001,
+         "one radius model for the tree"},
     };
     return controls;
 }

@@ -32,7 +32,8 @@ struct PanelControl {
     /// The settings-table row it sets; nullptr for the seed.
     const SettingInfo* setting() const;
     /// What a Setting event's value must lie in: the setting's range in the table, or for
-    /// Species, Seed, Grower and GrowthSteps, [lo, hi] (whole numbers).
+    /// Species, Seed, Grower, GrowthSteps, LeafColor and BarkColor, [lo, hi] (whole numbers;
+    /// a colour packed as pack_color, input/recording.h).
     SettingRange accepts() const;
 };
 

@@ -821,6 +821,24 @@ bool SessionBuilder::apply_setting(const InputAction& a)
             if (choice != now) grower_after = std::move(choice);
             break;
         }
+        case SettingId::LeafWidth:
+        case SettingId::PipeExponent:
+        case SettingId::TipRadius: {
+            Settings probe = s;
+            set_setting(probe, *setting, v);
+            validate_settings(probe);
+            s = std::move(probe);
+            break;
+        }
+        case SettingId::LeafColor:
+        case SettingId::BarkColor: {
+            if (!whole(accepts.lo, accepts.hi))
+                return refuse("a colour must be a whole number from 0 to 16777215 (0xRRGGBB)");
+            double rgb[3];
+            unpack_color(static_cast<int>(v), rgb);
+            set_setting(s, *setting, std::array<double, 3>{rgb[0], rgb[1], rgb[2]});
+            break;
+        }
         case SettingId::Seed:
             if (!whole(accepts.lo, accepts.hi))
                 return refuse("the seed must be a whole number from " + number_text(accepts.lo) + " to " +

@@ -47,8 +47,24 @@ constexpr std::array<float, 4> kDragInkColor{0.25f, 0.65f, 1.0f, 1.0f};
 /// Setting buttons: what they change and by how much (multiplicative steps for sizes).
 enum SettingButton : int {
     kAngleDown = 1, kAngleUp, kLeafDown, kLeafUp, kLeavesDown, kLeavesUp, kNextSpecies, kNextSeed, kNextGrower,
-    kStepBack, kStepOn,
+    kStepBack, kStepOn, kWidthDown, kWidthUp, kNextLeafColor, kNextBarkColor, kTwigDown, kTwigUp, kPipeDown, kPipeUp,
 };
+
+/// What the colour buttons step through (linear RGB): the species' colours, then others.
+constexpr double kLeafPalette[][3] = {{0.2, 0.42, 0.12}, {0.07, 0.22, 0.1},  {0.45, 0.58, 0.2},
+                                      {0.36, 0.6, 0.16}, {0.62, 0.42, 0.08}, {0.55, 0.12, 0.06}};
+constexpr double kBarkPalette[][3] = {{0.36, 0.25, 0.17}, {0.3, 0.24, 0.2}, {0.42, 0.35, 0.24},
+                                      {0.78, 0.76, 0.7},  {0.2, 0.17, 0.15}};
+
+/// The packed colour after `now` in `palette` (its first when `now` is not in it).
+template <std::size_t N> double next_color(const double (&now)[3], const double (&palette)[N][3])
+{
+    const int packed = pack_color(now);
+    std::size_t at = N - 1;
+    for (std::size_t i = 0; i < N; ++i)
+        if (pack_color(palette[i]) == packed) at = i;
+    return double(pack_color(palette[(at + 1) % N]));
+}
 
 /// The button a key or setting button is made from (positions come from the layout).
 VrButton key_button(const char* text, int key) { return VrButton{text, key, 0, 0.0, {}, 0.0f, 0.0f}; }
@@ -131,6 +147,10 @@ VrPanel vr_panel_layout(const Pose& head)
         {setting_button("SPECIES", kNextSpecies), setting_button("SEED", kNextSeed),
          key_button("DEL STROKE", keys::kDeleteStroke), setting_button("GROWER", kNextGrower),
          setting_button("STEP -", kStepBack), setting_button("STEP +", kStepOn)},
+        {setting_button("WIDTH -", kWidthDown), setting_button("WIDTH +", kWidthUp),
+         setting_button("LEAF COLOUR", kNextLeafColor), setting_button("BARK COLOUR", kNextBarkColor),
+         setting_button("TWIG -", kTwigDown), setting_button("TWIG +", kTwigUp)},
+        {setting_button("PIPE -", kPipeDown), setting_button("PIPE +", kPipeUp)},
     };
     const float pitch_x = kButtonW + kButtonGap, pitch_y = kButtonH + kButtonGap;
     const float top = 0.5f * float(rows.size() - 1) * pitch_y;
@@ -374,6 +394,39 @@ void VrSession::Impl::press(const VrButton& b, int index)
         e.code = static_cast<int>(SettingId::GrowthSteps);
         const std::optional<double> after = growth_steps_after(scene_grower(doc), b.setting == kStepOn ? 1 : -1);
         v = after ? *after : 1.0;
+        break;
+    }
+    case kWidthDown:
+    case kWidthUp: {
+        // As the leaf length: a quarter per press, rounded to the millimetre.
+        const PanelControl& c = *find_panel_control(SettingId::LeafWidth);
+        e.code = static_cast<int>(c.id);
+        v = std::clamp(doc.settings.leaves.width_m * (b.setting == kWidthUp ? 1.25 : 0.8), c.lo, c.hi);
+        v = std::round(v * 1000.0) / 1000.0;
+        break;
+    }
+    case kNextLeafColor:
+        e.code = static_cast<int>(SettingId::LeafColor);
+        v = next_color(doc.settings.leaves.color, kLeafPalette);
+        break;
+    case kNextBarkColor:
+        e.code = static_cast<int>(SettingId::BarkColor);
+        v = next_color(doc.settings.branches.bark_color, kBarkPalette);
+        break;
+    case kTwigDown:
+    case kTwigUp: {
+        const PanelControl& c = *find_panel_control(SettingId::TipRadius);
+        e.code = static_cast<int>(c.id);
+        v = std::clamp(doc.settings.branches.tip_radius_m + (b.setting == kTwigUp ? c.step : -c.step), c.lo, c.hi);
+        v = std::round(v * 10000.0) / 10000.0;
+        break;
+    }
+    case kPipeDown:
+    case kPipeUp: {
+        const PanelControl& c = *find_panel_control(SettingId::PipeExponent);
+        e.code = static_cast<int>(c.id);
+        v = std::clamp(doc.settings.branches.pipe_exponent + (b.setting == kPipeUp ? c.step : -c.step), c.lo, c.hi);
+        v = std::round(v * 10.0) / 10.0;
         break;
     }
     case kNextSeed:

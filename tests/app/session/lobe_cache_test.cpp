@@ -20,7 +20,7 @@ Settings changed(const SettingInfo& info)
     Settings s;
     const SettingValue v = get_setting(s, info);
     if (const double* d = std::get_if<double>(&v)) {
-        set_setting(s, info, *d * 1.001);
+        set_setting(s, info, *d == 0.0 ? 0.01 : *d * 1.001);
     } else if (const int* i = std::get_if<int>(&v)) {
         set_setting(s, info, *i + 1);
     } else if (const std::string* n = std::get_if<std::string>(&v)) {

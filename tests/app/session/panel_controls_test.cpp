@@ -35,11 +35,12 @@ TEST(PanelControls, EverySettingEventIdHasAControlNamingATableSetting)
         }
         EXPECT_TRUE(accepts.contains(c.lo)) << accepts.text();
         EXPECT_TRUE(accepts.contains(c.hi)) << accepts.text();
-        if (c.setting() && c.setting()->type != SettingType::Name) {
+        // A number's range is the table's; a colour's is its packed 0xRRGGBB values.
+        if (c.setting() && (c.setting()->type == SettingType::Number || c.setting()->type == SettingType::Integer)) {
             EXPECT_EQ(accepts.text(), c.setting()->range.text());
         }
     }
-    for (std::int32_t id = 1; known_setting_id(id); ++id) EXPECT_EQ(ids.count(id), 1u) << id;
+    for (std::int32_t id = 1; id < 100; ++id) EXPECT_EQ(ids.count(id), known_setting_id(id) ? 1u : 0u) << id;
     EXPECT_EQ(find_panel_control(static_cast<SettingId>(99)), nullptr);
     EXPECT_STREQ(find_panel_control(SettingId::Species)->setting()->key.c_str(), "growth.species");
     EXPECT_EQ(find_panel_control(SettingId::Species)->hi, kSettingSpeciesCount - 1.0);
@@ -74,4 +75,46 @@ TEST(PanelControls, TheSessionBuilderAcceptsWhatTheControlsSay)
     EXPECT_FALSE(b.apply(setting(SettingId::AttractorSpacing, 0.03, 4)));
     EXPECT_NE(b.messages().back().find(find_panel_control(SettingId::AttractorSpacing)->tree_wide_only),
               std::string::npos);
+}
+
+TEST(PanelControls, TheAppearanceControlsSetLeafWidthColoursAndRadiiOfTheWholeTree)
+{
+    SessionBuilder b;
+    auto setting = [](SettingId id, double v, std::int64_t lobe = 0) {
+        InputAction a;
+        a.type = InputAction::Type::SettingChanged;
+        a.time = 1.0;
+        a.setting.id = id;
+        a.setting.value = v;
+        a.setting.lobe = lobe;
+        return a;
+    };
+    const double length = b.document().settings.leaves.length_m;
+    EXPECT_TRUE(b.apply(setting(SettingId::LeafWidth, 0.021)));
+    EXPECT_EQ(b.document().settings.leaves.width_m, 0.021);
+    EXPECT_EQ(b.document().settings.leaves.length_m, length); // the width alone
+    EXPECT_TRUE(b.apply(setting(SettingId::LeafColor, 0x336619)));
+    EXPECT_EQ(b.document().settings.leaves.color[0], 0x33 / 255.0);
+    EXPECT_EQ(b.document().settings.leaves.color[1], 0x66 / 255.0);
+    EXPECT_EQ(b.document().settings.leaves.color[2], 0x19 / 255.0);
+    EXPECT_TRUE(b.apply(setting(SettingId::BarkColor, 0xC8C2B4)));
+    EXPECT_EQ(pack_color(b.document().settings.branches.bark_color), 0xC8C2B4);
+    EXPECT_TRUE(b.apply(setting(SettingId::PipeExponent, 2.5)));
+    EXPECT_EQ(b.document().settings.branches.pipe_exponent, 2.5);
+    EXPECT_TRUE(b.apply(setting(SettingId::TipRadius, 0.002)));
+    EXPECT_EQ(b.document().settings.branches.tip_radius_m, 0.002);
+    // Whole numbers only for a colour; every one of them tree-wide only.
+    EXPECT_FALSE(b.apply(setting(SettingId::LeafColor, 0.5)));
+    EXPECT_NE(b.messages().back().find("0xRRGGBB"), std::string::npos) << b.messages().back();
+    EXPECT_FALSE(b.apply(setting(SettingId::LeafWidth, 2.0)));
+    EXPECT_NE(b.messages().back().find("leaves.width_m"), std::string::npos) << b.messages().back();
+    for (SettingId id : {SettingId::LeafWidth, SettingId::LeafColor, SettingId::BarkColor, SettingId::PipeExponent,
+                         SettingId::TipRadius})
+        EXPECT_NE(find_panel_control(id)->tree_wide_only, nullptr) << setting_name(id);
+    // A packed colour reads back as itself.
+    for (int packed : {0, 0x336619, 0xFFFFFF, 0x5C402B}) {
+        double rgb[3];
+        unpack_color(packed, rgb);
+        EXPECT_EQ(pack_color(rgb), packed);
+    }
 }
