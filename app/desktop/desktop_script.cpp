@@ -94,6 +94,11 @@ const std::vector<PanelSetting>& panel_settings()
         {"seed", static_cast<int>(SettingId::Seed)},
         {"grower", static_cast<int>(SettingId::Grower)},
         {"growth-steps", static_cast<int>(SettingId::GrowthSteps)},
+        {"leaf-width", static_cast<int>(SettingId::LeafWidth)},
+        {"leaf-color", static_cast<int>(SettingId::LeafColor)},
+        {"bark-color", static_cast<int>(SettingId::BarkColor)},
+        {"pipe-exponent", static_cast<int>(SettingId::PipeExponent)},
+        {"tip-radius", static_cast<int>(SettingId::TipRadius)},
     };
     return settings;
 }
