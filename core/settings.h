@@ -95,9 +95,10 @@ struct GrowthSettings {
     /// Relative weights of the library subtrees (growth/data/subtrees.json) by name; missing
     /// names weigh 0. Empty: all subtrees weigh the same.
     std::map<std::string, double> subtree_weights;
-    /// Form of the species (growth/species_form.h). With no trunk strokes, 1 continues the
-    /// default trunk as a leader up through the crown (an excurrent tree: a conifer); 0 ends it
-    /// below the crown, where the limbs fork (a decurrent tree).
+    /// Form of the species (growth/species_form.h). 1 continues the trunk (the default one or
+    /// the sketched one) from its highest point as a leader up through the crown (an
+    /// excurrent tree: a conifer); 0 ends it where it ends (the default trunk below the crown,
+    /// where the limbs fork: a decurrent tree).
     int leader = 0;
     /// Spacing of the leader's nodes as a fraction of the crown's height: the laterals grow
     /// from them in tiers (whorls). 0: the leader's nodes are skeleton_spacing_m apart.

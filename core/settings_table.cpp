@@ -134,8 +134,8 @@ const std::vector<Field<GrowthSettings>>& growth_fields()
          "relative weights of the library subtrees (growth/data/subtrees.json) by name; names left out weigh 0; none: "
          "all weigh the same"},
         {"leader", &GrowthSettings::leader, "[0, 1]",
-         "1: with no trunk strokes the default trunk continues as a leader up through the crown (excurrent, a "
-         "conifer); 0: it ends below the crown"},
+         "1: the trunk (default or sketched) continues from its highest point as a leader up through the crown "
+         "(excurrent, a conifer); 0: it ends where it ends (decurrent)"},
         {"whorl_spacing", &GrowthSettings::whorl_spacing, "[0, 0.5]",
          "spacing of the leader's nodes as a fraction of the crown height, so laterals grow in whorls; 0: "
          "skeleton_spacing_m"},

@@ -312,7 +312,8 @@ void add_radius_options(CLI::App* cmd, TreeInputOptions& o)
 {
     const SettingInfo& exponent = *find_setting("branches.pipe_exponent");
     const SettingInfo& tip = *find_setting("branches.tip_radius_m");
-    cmd->add_option("--pipe-exponent", o.pipe_exponent, setting_help(exponent) + "; given, it is used at real scale too (branches.dbh_ratio=0)")->check(setting_value_check(exponent));
+    cmd->add_option("--pipe-exponent", o.pipe_exponent,
+                    setting_help(exponent) + "; given, it is used at real scale too (branches.dbh_ratio=0)")->check(setting_value_check(exponent));
     cmd->add_option("--tip-radius", o.tip_radius, setting_help(tip) + " (metres)")->check(setting_value_check(tip));
 }
 

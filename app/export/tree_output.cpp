@@ -58,10 +58,10 @@ void write_tree_file(const std::string& path, const Document& doc, const BuiltTr
         for (const BuiltLobe& l : tree.lobes) scene.lobes.push_back(l.mesh);
     if (options.include_strokes) {
         scene.strokes = effective_strokes(doc);
+        const glm::dvec3 base(scene.base);
         if (tree.scale != 1.0) // the strokes as the tree was scaled (apply_real_scale)
             for (Stroke& s : scene.strokes)
-                for (StrokePoint& p : s.points)
-                    p.position = glm::vec3(glm::dvec3(scene.base) + (glm::dvec3(p.position) - glm::dvec3(scene.base)) * tree.scale);
+                for (StrokePoint& p : s.points) p.position = glm::vec3(base + (glm::dvec3(p.position) - base) * tree.scale);
     }
     if (ext == ".glb")
         write_glb(path, scene, options);

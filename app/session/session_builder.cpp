@@ -705,6 +705,31 @@ bool SessionBuilder::copy_at_tip(const InputAction& a)
     return true;
 }
 
+namespace {
+
+/// A whole-tree appearance setting (leaf width, leaf and bark colour, pipe exponent, tip
+/// radius) into `s`: a colour packed as pack_color (input/recording.h), a number checked
+/// against the settings table. Returns why it is refused, or "".
+/// \throw InvalidInput from the table's checks.
+std::string apply_tree_appearance(Settings& s, const SettingInfo& setting, double v, const SettingRange& accepts)
+{
+    if (setting.type == SettingType::Color) {
+        if (!(v >= accepts.lo && v <= accepts.hi && v == std::floor(v)))
+            return "a colour must be a whole number from 0 to 16777215 (0xRRGGBB)";
+        double rgb[3];
+        unpack_color(static_cast<int>(v), rgb);
+        set_setting(s, setting, std::array<double, 3>{rgb[0], rgb[1], rgb[2]});
+        return "";
+    }
+    Settings probe = s;
+    set_setting(probe, setting, v);
+    validate_settings(probe);
+    s = std::move(probe);
+    return "";
+}
+
+} // namespace
+
 bool SessionBuilder::apply_setting(const InputAction& a)
 {
     const SettingChange& c = a.setting;
@@ -823,22 +848,11 @@ bool SessionBuilder::apply_setting(const InputAction& a)
         }
         case SettingId::LeafWidth:
         case SettingId::PipeExponent:
-        case SettingId::TipRadius: {
-            Settings probe = s;
-            set_setting(probe, *setting, v);
-            validate_settings(probe);
-            s = std::move(probe);
-            break;
-        }
+        case SettingId::TipRadius:
         case SettingId::LeafColor:
-        case SettingId::BarkColor: {
-            if (!whole(accepts.lo, accepts.hi))
-                return refuse("a colour must be a whole number from 0 to 16777215 (0xRRGGBB)");
-            double rgb[3];
-            unpack_color(static_cast<int>(v), rgb);
-            set_setting(s, *setting, std::array<double, 3>{rgb[0], rgb[1], rgb[2]});
+        case SettingId::BarkColor:
+            if (const std::string why = apply_tree_appearance(s, *setting, v, accepts); !why.empty()) return refuse(why);
             break;
-        }
         case SettingId::Seed:
             if (!whole(accepts.lo, accepts.hi))
                 return refuse("the seed must be a whole number from " + number_text(accepts.lo) + " to " +
