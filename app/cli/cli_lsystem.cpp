@@ -91,13 +91,7 @@ GrowerChoice sketch_choice(const std::string& path, double growth, const std::st
     lsystem::SketchRulesOptions ro;
     ro.growth = growth;
     rules = lsystem::sketch_rules(sketch, ro);
-    GrowerChoice choice;
-    choice.name = lsystem::kGrowerName;
-    choice.version = lsystem_grower().version();
-    choice.params["source"] = rules.lsystem;
-    choice.params["source_name"] = rules_name;
-    choice.params["view"] = rules.view;
-    return choice;
+    return lsystem::sketch_grower_choice(rules, rules_name);
 }
 
 std::string view_path_of(const std::string& rules_path)

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/errors.h"
+#include "growth/lsystem/lsystem_grower.h"
 
 namespace lobe::lsystem {
 
@@ -394,6 +395,31 @@ SketchRules sketch_rules(const Sketch& s, const SketchRulesOptions& o)
              "angle increment: 137.5\n"
              "metres per unit: 1\n";
     return r;
+}
+
+GrowerChoice sketch_grower_choice(const SketchRules& rules, const std::string& name)
+{
+    GrowerChoice choice;
+    choice.name = kGrowerName;
+    choice.version = lsystem_grower().version();
+    choice.params["source"] = rules.lsystem;
+    choice.params["source_name"] = name;
+    choice.params["view"] = rules.view;
+    return choice;
+}
+
+SketchGrown grow_sketch(const Sketch& sketch, const SketchRulesOptions& options, std::uint64_t seed, std::size_t max_tree_nodes)
+{
+    SketchGrown out;
+    out.rules = sketch_rules(sketch, options);
+    GrowerInput in;
+    in.choice = sketch_grower_choice(out.rules);
+    in.seed = seed;
+    in.max_tree_nodes = max_tree_nodes;
+    LSystemRun run = run_lsystem(in);
+    out.modules = run.word.size();
+    out.growth = std::move(run.growth);
+    return out;
 }
 
 } // namespace lobe::lsystem

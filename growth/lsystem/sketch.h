@@ -21,6 +21,8 @@
 
 #include <glm/vec3.hpp>
 
+#include "growth/grower.h"
+
 namespace lobe::lsystem {
 
 /// Most nodes of the trunk, and of one branch.
@@ -117,5 +119,21 @@ SketchRules sketch_rules(const Sketch& sketch, const SketchRulesOptions& options
 /// half the difference of its neighbours, one-sided at the ends), `steps` per section, the
 /// nodes themselves included: nodes.size() − 1 sections give (size − 1)·steps + 1 points.
 std::vector<glm::dvec3> sketch_curve(const std::vector<glm::dvec3>& nodes, int steps);
+
+/// The `lsystem` grower's choice that grows `rules` (their `.l` as source, named `name` in
+/// messages, and their `.v` as view).
+GrowerChoice sketch_grower_choice(const SketchRules& rules, const std::string& name = "sketch.l");
+
+/// A sketch's tree: the rules derived and grown by the `lsystem` grower (no lobes, model
+/// units metres, the root at the model's origin, so sketched point p lands at p − trunk[0]).
+/// Radii are not set (GrowthResult::radii_set false: the pipe model's, growth/radii.h).
+/// 	hrow InvalidInput as sketch_rules, or a derivation past the engine's limits.
+struct SketchGrown {
+    SketchRules rules;
+    GrowthResult growth;
+    std::size_t modules = 0; ///< of the derived word
+};
+SketchGrown grow_sketch(const Sketch& sketch, const SketchRulesOptions& options = {}, std::uint64_t seed = 1,
+                        std::size_t max_tree_nodes = 2000000);
 
 } // namespace lobe::lsystem
