@@ -274,10 +274,19 @@ void axis_blueprints(std::string& out, char sym, Frame& f, const std::vector<glm
     const std::vector<glm::dvec3> pts = sketch_curve(nodes, steps);
     const std::size_t sections = nodes.size() - 1;
     if (node_frames) node_frames->push_back(f);
+    const std::string head = std::string(1, sym) + "(x,t) : x % " + std::to_string(sections) + " == ";
     for (std::size_t k = 0; k < sections; ++k) {
         const std::string body = blueprint(f, pts, k * static_cast<std::size_t>(steps), (k + 1) * static_cast<std::size_t>(steps),
                                            "min(1,GROWTH-t)");
-        out += std::string(1, sym) + "(x,t) : x % " + std::to_string(sections) + " == " + std::to_string(k) + " --> " + body + "\n";
+        if (k == 0) {
+            // The turn into the first section is where the axis leaves its parent (or the
+            // ground): the axis's first section takes it; a repeat of the blueprints goes on
+            // in the direction the axis has (repeating the turn would curl the axis).
+            out += std::string(1, sym) + "(x,t) : x == 0 --> " + body + "\n";
+            out += head + "0 --> " + body.substr(body.find("F(")) + "\n";
+        } else {
+            out += head + std::to_string(k) + " --> " + body + "\n";
+        }
         if (node_frames) node_frames->push_back(f);
     }
 }
@@ -374,12 +383,13 @@ SketchRules sketch_rules(const Sketch& s, const SketchRulesOptions& o)
 
     std::string& l = r.lsystem;
     l += "/* A tree sketched as " + std::to_string(r.trunk_sections) + " trunk sections and " +
-         std::to_string(r.branches.size()) + " branch types, as a parametric 2L-system (docs/lsystem-sketch.md).\n";
+         std::to_string(r.branches.size()) + (r.branches.size() == 1 ? " branch type" : " branch types") +
+         ", as a parametric 2L-system (docs/lsystem-sketch.md).\n";
     l += "   A(x,t): trunk section x (blueprint x % " + std::to_string(r.trunk_sections) + "), grown at step t; B(b,s): the trunk's tip";
     l += ",\n   b branches so far, s the step.";
     for (const SketchBranchRule& br : r.branches)
         l += "\n   " + std::string(1, br.section) + "(x,t), " + std::string(1, br.apex) + "(c,b,s): branch type from trunk node " +
-             std::to_string(br.interval) + ", every " + std::to_string(br.interval) + " sections, growing " +
+             std::to_string(br.interval) + ", every " + std::to_string(br.interval) + " nodes, growing " +
              std::to_string(br.rate_num) + "/" + std::to_string(br.rate_den) + " section per step.";
     l += " */\n";
     l += "#define GROWTH " + num(r.growth - 0.0) + "\n";
