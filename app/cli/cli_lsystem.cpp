@@ -11,6 +11,7 @@
 #include "app/cli/cli.h"
 #include "app/cli/cli_common.h"
 #include "app/export/skeleton_json.h"
+#include "app/live/lsystem_sketch_mode.h"
 #include "app/export/tree_output.h"
 #include "app/session/session_file.h"
 #include "app/session/tree_pipeline.h"
@@ -85,9 +86,26 @@ LSystemGrown grow_lsystem_choice(GrowerChoice choice, const std::string& path, c
 
 /// The lsystem grower's choice for a sketch file: the rules derived from it (sketch.h) at
 /// `growth` (0: the sketch's iterations), named `rules_name` in messages.
-GrowerChoice sketch_choice(const std::string& path, double growth, const std::string& rules_name, lsystem::SketchRules& rules)
+GrowerChoice sketch_choice(const std::string& path, double growth, const std::string& rules_name, const std::string& sketch_out,
+                           lsystem::SketchRules& rules)
 {
-    const lsystem::Sketch sketch = lsystem::parse_sketch(read_file_limited(path, lsystem::kMaxSketchFileBytes), path);
+    lsystem::Sketch sketch;
+    if (is_recording_file(path)) {
+        // A recording of the live L-system sketch mode: the sketch as its replay leaves it,
+        // shown at the growth it was left at.
+        const LSystemSketchMode mode = replay_lsystem_sketch(load_recording_verbose(path));
+        for (const std::string& m : mode.messages()) progress(path + ": " + m);
+        if (mode.sketch().trunk.size() < 2)
+            throw InvalidInput(path + ": the recording sketches no L-system trunk (P turns the L-system sketch mode on)");
+        sketch = mode.sketch();
+        if (growth <= 0.0) growth = mode.growth();
+    } else {
+        sketch = lsystem::parse_sketch(read_file_limited(path, lsystem::kMaxSketchFileBytes), path);
+    }
+    if (!sketch_out.empty()) {
+        write_file_atomic(sketch_out, lsystem::sketch_json(sketch) + "\n");
+        progress("wrote " + sketch_out);
+    }
     lsystem::SketchRulesOptions ro;
     ro.growth = growth;
     rules = lsystem::sketch_rules(sketch, ro);
@@ -115,7 +133,7 @@ void add_lsystem_command(CLI::App& app, int& exit_code)
         "lsystem", "Grow a tree from an L-system file (cpfg's .l, with the .v beside it) and export it as .glb or .obj");
     struct Args {
         TreeInputOptions in;
-        std::string file, out, lobes, string_out, skeleton_out, sketch, rules_out;
+        std::string file, out, lobes, string_out, skeleton_out, sketch, rules_out, sketch_out;
         std::optional<int> steps;
         std::optional<double> growth;
     };
@@ -123,11 +141,14 @@ void add_lsystem_command(CLI::App& app, int& exit_code)
     auto* file_opt = cmd->add_option(
         "FILE", a->file, "L-system file (.l; NAME.v beside it is its view file), or a shipped preset's name (docs/lsystems.md)");
     auto* sketch_opt = cmd->add_option("--sketch", a->sketch,
-                                       "Grow the parametric 2L-system derived from this sketch file instead (docs/lsystem-sketch.md)")
+                                       "Grow the parametric 2L-system derived from this sketch file, or from the L-system sketch "
+                                       "a recording (.lrec) replays to, instead (docs/lsystem-sketch.md)")
                            ->excludes(file_opt);
     cmd->add_option("--rules-out", a->rules_out, "With --sketch: also write the derived rules as RULES.l and its view RULES.v")
         ->needs(sketch_opt)
         ->check(output_extension({".l"}, "the rules are written as a cpfg .l file"));
+    cmd->add_option("--sketch-out", a->sketch_out, "With --sketch: also write the sketch as a sketch file (.json)")
+        ->needs(sketch_opt);
     cmd->add_option("--growth", a->growth,
                     "With --sketch: the growth value in iterations, fractional between two (default: the sketch's iterations)")
         ->needs(sketch_opt)
@@ -151,7 +172,7 @@ void add_lsystem_command(CLI::App& app, int& exit_code)
     cmd->add_option("--settings", a->in.settings, "Settings JSON (a settings object or a session document)");
     cmd->callback([a, &exit_code] {
         if (a->file.empty() && a->sketch.empty()) throw CLI::RequiredError("FILE or --sketch");
-        for (const std::string* path : {&a->out, &a->string_out, &a->skeleton_out, &a->rules_out})
+        for (const std::string* path : {&a->out, &a->string_out, &a->skeleton_out, &a->rules_out, &a->sketch_out})
             if (!path->empty()) require_output_folder(*path);
         LSystemGrown g;
         if (a->sketch.empty()) {
@@ -159,9 +180,9 @@ void add_lsystem_command(CLI::App& app, int& exit_code)
         } else {
             lsystem::SketchRules rules;
             const std::string rules_name = a->rules_out.empty() ? a->sketch + ".l" : a->rules_out;
-            GrowerChoice choice = sketch_choice(a->sketch, a->growth.value_or(0.0), rules_name, rules);
+            GrowerChoice choice = sketch_choice(a->sketch, a->growth.value_or(0.0), rules_name, a->sketch_out, rules);
             progress("derived " + std::to_string(rules.trunk_sections) + " trunk blueprints and " +
-                     std::to_string(rules.branches.size()) + " branch types; growth " + std::to_string(rules.growth));
+                     std::to_string(rules.branches.size()) + " branch type(s); growth " + std::to_string(rules.growth));
             if (!a->rules_out.empty()) {
                 write_file_atomic(a->rules_out, rules.lsystem);
                 write_file_atomic(view_path_of(a->rules_out), rules.view);
