@@ -311,9 +311,20 @@ void LSystemSketchMode::push_frame(const HandFrame& frame)
     left_hand(gs[static_cast<int>(Hand::Left)]);
 }
 
-LSystemSketchMode replay_lsystem_sketch(const Recording& rec, SketchPlatform platform)
+SketchPlatform sketch_platform_for(const std::string& source)
 {
-    LSystemSketchMode mode(platform);
+    SketchPlatform p;
+    if (source.rfind("lobesketch desktop", 0) == 0) {
+        p.position = {0.0, 0.95, 0.0};
+        p.scale = 0.2;
+        p.tree_offset = {0.6, -0.95, 0.0};
+    }
+    return p;
+}
+
+LSystemSketchMode replay_lsystem_sketch(const Recording& rec)
+{
+    LSystemSketchMode mode(sketch_platform_for(rec.header.source));
     std::size_t e = 0;
     for (const HandFrame& f : rec.frames) {
         while (e < rec.events.size() && rec.events[e].time <= f.time) mode.push_event(rec.events[e++]);

@@ -143,8 +143,15 @@ private:
     std::vector<std::string> messages_;
 };
 
+/// Where the platform stands for the app that made a recording (RecordingHeader::source):
+/// for the desktop ("lobesketch desktop…") 1:5 below the camera's first target, on the
+/// plane the mouse's fingertip moves in; else (VR, synthesized) 1:10 at waist height half an
+/// arm in front. The live apps and replay take it from here, so a replay stands it alike.
+SketchPlatform sketch_platform_for(const std::string& recording_source);
+
 /// Replays the raw input of a recording (events at a frame's time before that frame, as the
-/// live apps push them) through a fresh mode: the sketch, platform and tree as they were.
-LSystemSketchMode replay_lsystem_sketch(const Recording& recording, SketchPlatform platform = {});
+/// live apps push them) through a fresh mode with the platform of sketch_platform_for: the
+/// sketch, platform and tree as they were.
+LSystemSketchMode replay_lsystem_sketch(const Recording& recording);
 
 } // namespace lobe

@@ -1,0 +1,97 @@
+#include "app/live/lsystem_sketch_view.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <vector>
+
+#include <glm/gtc/quaternion.hpp>
+
+#include "app/render/render_scene.h"
+#include "app/render/scene_parts.h"
+
+namespace lobe {
+
+namespace {
+
+constexpr std::array<float, 4> kPlatformColor{0.55f, 0.5f, 0.42f, 1.0f};
+constexpr std::array<float, 4> kTrunkColor{0.85f, 0.45f, 0.15f, 1.0f};
+constexpr std::array<float, 4> kBranchColor{0.3f, 0.6f, 0.95f, 1.0f};
+constexpr std::array<float, 4> kPreviewColor{0.95f, 0.95f, 0.6f, 1.0f};
+constexpr std::array<float, 4> kTreeColor{0.36f, 0.25f, 0.17f, 1.0f};
+constexpr float kSectionRadiusM = 0.0025f, kNodeRadiusM = 0.005f, kMinTreeRadiusM = 0.002f;
+
+std::vector<glm::vec3> platform_points(const LSystemSketchMode& mode, const std::vector<glm::dvec3>& nodes)
+{
+    std::vector<glm::vec3> out;
+    for (const glm::dvec3& p : nodes) out.emplace_back(mode.platform_point(p));
+    return out;
+}
+
+} // namespace
+
+void LSystemSketchView::append(const LSystemSketchMode& mode, RenderScene& scene)
+{
+    if (!mode.active()) return;
+    std::uint64_t n = 0;
+    auto add = [&](std::array<float, 4> color, SurfaceGeometry g, std::uint64_t version) {
+        const std::uint64_t key = kKeyBase | n++;
+        if (g.triangles.empty()) return;
+        RenderItem item;
+        item.key = key;
+        item.version = version;
+        item.material = RenderMaterial::Stroke;
+        item.color = color;
+        item.geometry = std::move(g);
+        scene.items.push_back(std::move(item));
+    };
+    ++version_;
+    // The platform: a ring of its grab radius at the root.
+    const SketchPlatform& pf = mode.platform();
+    std::vector<glm::vec3> ring;
+    for (int i = 0; i <= 48; ++i) {
+        const double a = 2.0 * 3.14159265358979 * i / 48.0;
+        ring.emplace_back(pf.position + glm::dvec3(std::cos(a), 0.0, std::sin(a)) * LSystemSketchMode::kGrabRadiusM);
+    }
+    add(kPlatformColor, polyline_tube(ring, 0.004f, 6), version_);
+
+    // The sketch: sections and nodes, the dragged node larger.
+    const lsystem::Sketch& s = mode.sketch();
+    SurfaceGeometry trunk = polyline_tube(platform_points(mode, s.trunk), kSectionRadiusM, 6);
+    for (std::size_t i = 0; i < s.trunk.size(); ++i) {
+        const bool dragged = mode.dragging() && mode.dragging()->first < 0 && mode.dragging()->second == static_cast<int>(i);
+        append_sphere(trunk, glm::vec3(mode.platform_point(s.trunk[i])), dragged ? 2.0f * kNodeRadiusM : kNodeRadiusM);
+    }
+    add(kTrunkColor, std::move(trunk), version_);
+    SurfaceGeometry branches;
+    for (std::size_t b = 0; b < s.branches.size(); ++b) {
+        std::vector<glm::dvec3> nodes{s.trunk[static_cast<std::size_t>(s.branches[b].attach)]};
+        nodes.insert(nodes.end(), s.branches[b].points.begin(), s.branches[b].points.end());
+        append_geometry(branches, polyline_tube(platform_points(mode, nodes), kSectionRadiusM, 6));
+        for (std::size_t i = 1; i < nodes.size(); ++i) {
+            const bool dragged = mode.dragging() && mode.dragging()->first == static_cast<int>(b) &&
+                                 mode.dragging()->second == static_cast<int>(i - 1);
+            append_sphere(branches, glm::vec3(mode.platform_point(nodes[i])), dragged ? 2.0f * kNodeRadiusM : kNodeRadiusM);
+        }
+    }
+    add(kBranchColor, std::move(branches), version_);
+    if (mode.preview())
+        add(kPreviewColor, polyline_tube({glm::vec3(mode.preview()->first), glm::vec3(mode.preview()->second)}, 0.0015f, 5),
+            version_);
+
+    // The full-size tree: a tube per segment, made again only after a regrowth.
+    if (mode.tree_generation() != tree_generation_) {
+        tree_generation_ = mode.tree_generation();
+        tree_mesh_ = SurfaceGeometry{};
+        const TreeGraph& t = mode.tree();
+        for (const TreeNode& node : t.nodes) {
+            if (node.parent < 0) continue;
+            const TreeNode& parent = t.nodes[static_cast<std::size_t>(node.parent)];
+            const float r = std::max(kMinTreeRadiusM, node.radius);
+            append_geometry(tree_mesh_, polyline_tube({parent.position, node.position}, r, 5));
+        }
+    }
+    add(kTreeColor, tree_mesh_, tree_generation_ + 1);
+}
+
+} // namespace lobe

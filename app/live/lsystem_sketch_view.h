@@ -1,0 +1,29 @@
+#pragma once
+/// \file lsystem_sketch_view.h
+/// What the L-system sketch mode (lsystem_sketch_mode.h) shows in the live apps' scene: the
+/// platform as a ring, the sketch's sections as tubes and its nodes as beads (the dragged one
+/// larger), the preview of the next section, and the full-size tree beside the platform as
+/// tubes of its pipe-model radii. The tree's mesh is made again only when the mode regrew.
+
+#include <cstdint>
+
+#include "app/live/lsystem_sketch_mode.h"
+#include "app/render/renderer.h"
+
+namespace lobe {
+
+class LSystemSketchView {
+public:
+    /// Render keys of the mode's items: kKeyBase | n.
+    static constexpr std::uint64_t kKeyBase = std::uint64_t{0x4C53} << 48;
+
+    /// Appends the mode's items to `scene` (nothing while the mode is off).
+    void append(const LSystemSketchMode& mode, RenderScene& scene);
+
+private:
+    std::uint64_t tree_generation_ = ~std::uint64_t{0};
+    std::uint64_t version_ = 0;
+    SurfaceGeometry tree_mesh_;
+};
+
+} // namespace lobe
