@@ -43,6 +43,7 @@ int key_code(const std::string& name_in)
     static const std::pair<const char*, int> named[] = {
         {"escape", 256}, {"enter", 257}, {"tab", 258}, {"backspace", 259}, {"delete", 261},
         {"shift", 340},  {"space", 32},  {"f1", 290},  {"f2", 291},        {"home", 268},
+        {"comma", 44},   {"period", 46}, {"minus", 45}, {"equal", 61},     {"leftbracket", 91}, {"rightbracket", 93},
     };
     for (const auto& [n, code] : named)
         if (name == n) return code;

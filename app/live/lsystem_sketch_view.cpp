@@ -37,6 +37,7 @@ void LSystemSketchView::append(const LSystemSketchMode& mode, RenderScene& scene
     auto add = [&](std::array<float, 4> color, SurfaceGeometry g, std::uint64_t version) {
         const std::uint64_t key = kKeyBase | n++;
         if (g.triangles.empty()) return;
+        if (g.uvs.size() != g.positions.size()) g.uvs.clear(); // tubes and beads together: no texture
         RenderItem item;
         item.key = key;
         item.version = version;
