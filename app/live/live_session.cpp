@@ -85,7 +85,7 @@ void LiveSession::push_event(const InputEvent& e)
 RenderScene& LiveSession::begin_frame_items()
 {
     RenderScene& scene = scene_.begin_frame_items();
-    lsystem_view_.append(lsystem_sketch_, scene);
+    lsystem_view_.append(lsystem_sketch_, scene, pipeline_.scene_transform());
     return scene;
 }
 

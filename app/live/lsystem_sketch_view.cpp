@@ -30,14 +30,22 @@ std::vector<glm::vec3> platform_points(const LSystemSketchMode& mode, const std:
 
 } // namespace
 
-void LSystemSketchView::append(const LSystemSketchMode& mode, RenderScene& scene)
+void LSystemSketchView::append(const LSystemSketchMode& mode, RenderScene& scene, const SceneTransform& t)
 {
     if (!mode.active()) return;
+    const bool moved = t.scale != last_transform_.scale || t.yaw != last_transform_.yaw ||
+                       t.translation != last_transform_.translation;
+    last_transform_ = t;
+    const glm::quat inverse = glm::inverse(t.rotation());
     std::uint64_t n = 0;
     auto add = [&](std::array<float, 4> color, SurfaceGeometry g, std::uint64_t version) {
         const std::uint64_t key = kKeyBase | n++;
         if (g.triangles.empty()) return;
         if (g.uvs.size() != g.positions.size()) g.uvs.clear(); // tubes and beads together: no texture
+        if (!t.identity()) {
+            for (glm::vec3& p : g.positions) p = t.to_document(p);
+            for (glm::vec3& v : g.normals) v = inverse * v;
+        }
         RenderItem item;
         item.key = key;
         item.version = version;
@@ -81,18 +89,20 @@ void LSystemSketchView::append(const LSystemSketchMode& mode, RenderScene& scene
             version_);
 
     // The full-size tree: a tube per segment, made again only after a regrowth.
+    if (moved) ++tree_version_;
     if (mode.tree_generation() != tree_generation_) {
+        ++tree_version_;
         tree_generation_ = mode.tree_generation();
         tree_mesh_ = SurfaceGeometry{};
-        const TreeGraph& t = mode.tree();
-        for (const TreeNode& node : t.nodes) {
+        const TreeGraph& tree = mode.tree();
+        for (const TreeNode& node : tree.nodes) {
             if (node.parent < 0) continue;
-            const TreeNode& parent = t.nodes[static_cast<std::size_t>(node.parent)];
+            const TreeNode& parent = tree.nodes[static_cast<std::size_t>(node.parent)];
             const float r = std::max(kMinTreeRadiusM, node.radius);
             append_geometry(tree_mesh_, polyline_tube({parent.position, node.position}, r, 5));
         }
     }
-    add(kTreeColor, tree_mesh_, tree_generation_ + 1);
+    add(kTreeColor, tree_mesh_, tree_version_);
 }
 
 } // namespace lobe

@@ -9,6 +9,7 @@
 
 #include "app/live/lsystem_sketch_mode.h"
 #include "app/render/renderer.h"
+#include "input/pipeline.h"
 
 namespace lobe {
 
@@ -17,12 +18,15 @@ public:
     /// Render keys of the mode's items: kKeyBase | n.
     static constexpr std::uint64_t kKeyBase = std::uint64_t{0x4C53} << 48;
 
-    /// Appends the mode's items to `scene` (nothing while the mode is off).
-    void append(const LSystemSketchMode& mode, RenderScene& scene);
+    /// Appends the mode's items to `scene` (nothing while the mode is off), taken from stage
+    /// space (where the mode works) into the document's through `scene_transform` (the VR
+    /// app's two-handed grab; the renderer draws the document's space moved by it).
+    void append(const LSystemSketchMode& mode, RenderScene& scene, const SceneTransform& scene_transform = {});
 
 private:
     std::uint64_t tree_generation_ = ~std::uint64_t{0};
-    std::uint64_t version_ = 0;
+    std::uint64_t version_ = 0, tree_version_ = 0;
+    SceneTransform last_transform_;
     SurfaceGeometry tree_mesh_;
 };
 
