@@ -284,7 +284,10 @@ TEST(LSystemSketch, TheSketchFileIsReadStrictly)
     refuses(R"({"trunk": [[0,0,0],[0,1]]})", "three numbers");
     refuses("[1,2]", "JSON object");
     std::string huge = R"({"trunk": [)";
-    for (int i = 0; i < 5000; ++i) huge += (i ? "," : "") + std::string("[0,") + std::to_string(i) + ",0]";
+    for (int i = 0; i < 5000; ++i) {
+        if (i > 0) huge += ',';
+        huge += "[0," + std::to_string(i) + ",0]";
+    }
     refuses(huge + "]}", "more than 1000");
     // In memory too: a NaN from a live sketch is refused the same way.
     Sketch nan = maple();
