@@ -9,6 +9,8 @@
 #include "app/cli/cli_common.h"
 #include "app/cli/outputs.h"
 #include "app/export/tree_output.h"
+#include "app/live/lsystem_sketch_mode.h"
+#include "core/atomic_file.h"
 #include "core/errors.h"
 
 namespace lobe::cli {
@@ -81,7 +83,14 @@ void add_replay_command(CLI::App& app, int& exit_code)
                  std::to_string(drags) + " drag(s)");
         progress("wrote " + a->out + "/strokes.json, " + a->out + "/session.json, " + std::to_string(lobe_files) +
                  " lobe mesh(es) in " + a->out + "/lobes" + (tree_written ? " and " + a->out + "/tree.glb" : ""));
-        if (out_doc.strokes.empty() && drags == 0 && out_doc.lobes.empty()) {
+        // The L-system sketch mode's sketch (docs/lsystem-sketch.md), when the recording made one.
+        const LSystemSketchMode sketch_mode = replay_lsystem_sketch(read_recording(a->rec));
+        const bool sketched = sketch_mode.sketch().trunk.size() >= 2;
+        if (sketched) {
+            write_file_atomic(a->out + "/lsystem-sketch.json", lsystem::sketch_json(sketch_mode.sketch()) + "\n");
+            progress("wrote " + a->out + "/lsystem-sketch.json (the L-system sketch: lobesketch lsystem --sketch grows it)");
+        }
+        if (out_doc.strokes.empty() && drags == 0 && out_doc.lobes.empty() && !sketched) {
             error(a->rec + ": no strokes in this recording");
             exit_code = kExitFailure;
             return;

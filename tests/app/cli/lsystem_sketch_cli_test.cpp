@@ -79,6 +79,28 @@ TEST(LSystemSketchCli, GrowthDrawsATreeBetweenIterations)
     EXPECT_LT(n3, n34);
 }
 
+TEST(LSystemSketchCli, ARecordingOfTheSketchModeGrowsAsItsReplayedSketch)
+{
+    // The maple recording (recordings/lsystem-sketch/): `replay` writes its sketch, and
+    // `lsystem --sketch REC.lrec` grows the same bytes as that sketch file at the growth the
+    // recording left (7).
+    const std::string dir = test::temp_dir("lsystem-sketch-cli-rec");
+    const std::string rec = test::source_path("recordings/lsystem-sketch/maple.lrec");
+    const test::CliRun rp = run("-q replay " + rec + " --out " + dir + "/replayed");
+    ASSERT_EQ(rp.code, 0) << rp.out;
+    ASSERT_TRUE(std::filesystem::exists(dir + "/replayed/lsystem-sketch.json"));
+    const test::CliRun a = run("-q lsystem --sketch " + rec + " --sketch-out " + dir + "/s.json --out " + dir + "/a.glb");
+    ASSERT_EQ(a.code, 0) << a.out;
+    EXPECT_EQ(read(dir + "/s.json"), read(dir + "/replayed/lsystem-sketch.json"));
+    const test::CliRun b = run("-q lsystem --sketch " + dir + "/s.json --growth 7 --out " + dir + "/b.glb");
+    ASSERT_EQ(b.code, 0) << b.out;
+    EXPECT_EQ(read(dir + "/a.glb"), read(dir + "/b.glb"));
+    // A recording without the mode is no sketch.
+    const test::CliRun c = run("lsystem --sketch " + test::source_path("recordings/pinch-edit.lrec") + " --out " + dir + "/c.glb");
+    EXPECT_EQ(c.code, 1) << c.out;
+    EXPECT_NE(c.out.find("sketches no L-system trunk"), std::string::npos) << c.out;
+}
+
 TEST(LSystemSketchCli, BadSketchesAndCommandLinesAreRefusedInOneLine)
 {
     const std::string dir = test::temp_dir("lsystem-sketch-cli-bad");
