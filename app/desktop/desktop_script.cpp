@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "app/desktop/desktop_session.h"
+#include "app/live/lsystem_sketch_mode.h"
 #include "core/errors.h"
 #include "input/tools.h"
 
@@ -73,6 +74,9 @@ const std::vector<PanelAction>& panel_actions()
         {"save", "Save (S)", desktop_keys::kSave},
         {"export", "Export (W)", desktop_keys::kExport},
         {"frame", "Frame (F)", desktop_keys::kFrame},
+        // The L-system sketch mode (docs/lsystem-sketch.md); its other keys act while it is on.
+        {"lsystem", "L-system (P)", keys::kLSystemSketch},
+        {"lsystem-branch", "Branch (B)", lsystem_sketch_keys::kBranch},
     };
     return actions;
 }

@@ -21,10 +21,11 @@ constexpr std::array<float, 4> kPreviewColor{0.95f, 0.95f, 0.6f, 1.0f};
 constexpr std::array<float, 4> kTreeColor{0.36f, 0.25f, 0.17f, 1.0f};
 constexpr float kSectionRadiusM = 0.0025f, kNodeRadiusM = 0.005f, kMinTreeRadiusM = 0.002f;
 
+/// The Bézier curve through `nodes` (as the rules draw the sections), on the platform.
 std::vector<glm::vec3> platform_points(const LSystemSketchMode& mode, const std::vector<glm::dvec3>& nodes)
 {
     std::vector<glm::vec3> out;
-    for (const glm::dvec3& p : nodes) out.emplace_back(mode.platform_point(p));
+    for (const glm::dvec3& p : lsystem::sketch_curve(nodes, lsystem::kDefaultCurveSteps)) out.emplace_back(mode.platform_point(p));
     return out;
 }
 
