@@ -84,6 +84,7 @@ void LiveSession::push_event(const InputEvent& e)
 
 RenderScene& LiveSession::begin_frame_items()
 {
+    lsystem_view_.reclaim(scene_.items_before_frame());
     RenderScene& scene = scene_.begin_frame_items();
     lsystem_view_.append(lsystem_sketch_, scene, pipeline_.scene_transform());
     return scene;
