@@ -130,7 +130,8 @@ LSystemGrown grow_lsystem_file(const std::string& path, const std::string& lobes
 void add_lsystem_command(CLI::App& app, int& exit_code)
 {
     auto* cmd = app.add_subcommand(
-        "lsystem", "Grow a tree from an L-system file (cpfg's .l, with the .v beside it) and export it as .glb or .obj");
+        "lsystem", "Grow a tree from an L-system file (cpfg's .l, with the .v beside it) or from a sketch (--sketch), "
+                   "and export it as .glb or .obj");
     struct Args {
         TreeInputOptions in;
         std::string file, out, lobes, string_out, skeleton_out, sketch, rules_out, sketch_out;

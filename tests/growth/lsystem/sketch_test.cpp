@@ -15,6 +15,7 @@
 
 #include "core/errors.h"
 #include "growth/lsystem/lsystem.h"
+#include "growth/lsystem/lsystem_grower.h"
 #include "growth/lsystem/sketch.h"
 #include "tests/support/expect_throw.h"
 
@@ -293,4 +294,23 @@ TEST(LSystemSketch, TheSketchFileIsReadStrictly)
     Sketch nan = maple();
     nan.trunk[3].y = std::nan("");
     EXPECT_NE(test::expect_one_line_throw<InvalidInput>([&] { sketch_rules(nan); }).find("not a finite number"), std::string::npos);
+}
+
+TEST(LSystemSketch, AViewFileMayFixTheMetresPerUnit)
+{
+    // `metres per unit:` (the rules' view) draws the model at that scale instead of fitting it
+    // to a height; a bad value is refused in one line naming the file and line.
+    EXPECT_EQ(parse_view("metres per unit: 0.5\n", "v.v").metres_per_unit, 0.5);
+    EXPECT_EQ(parse_view("angle increment: 30\n", "v.v").metres_per_unit, 0.0);
+    const std::string what = test::expect_one_line_throw<InvalidInput>([] { parse_view("metres per unit: 0\n", "v.v"); });
+    EXPECT_NE(what.find("v.v:1:"), std::string::npos) << what;
+    SketchRules r = sketch_rules(maple());
+    const SketchGrown g = grow_sketch(maple());
+    r.view = "metres per unit: 0.5\n";
+    GrowerInput in;
+    in.choice = sketch_grower_choice(r);
+    const LSystemRun half = run_lsystem(in);
+    ASSERT_EQ(half.growth.tree.size(), g.growth.tree.size());
+    for (std::size_t i = 0; i < g.growth.tree.size(); ++i)
+        EXPECT_LT(glm::length(half.growth.tree.nodes[i].position * 2.0f - g.growth.tree.nodes[i].position), 1e-5f) << i;
 }
