@@ -97,7 +97,7 @@ GrowerChoice sketch_choice(const std::string& path, double growth, const std::st
         for (const std::string& m : mode.messages()) progress(path + ": " + m);
         if (mode.sketch().trunk.size() < 2)
             throw InvalidInput(path + ": the recording sketches no L-system trunk (P turns the L-system sketch mode on)");
-        sketch = mode.sketch();
+        sketch = mode.sketch_file();
         if (growth <= 0.0) growth = mode.growth();
     } else {
         sketch = lsystem::parse_sketch(read_file_limited(path, lsystem::kMaxSketchFileBytes), path);

@@ -87,7 +87,7 @@ void add_replay_command(CLI::App& app, int& exit_code)
         const LSystemSketchMode sketch_mode = replay_lsystem_sketch(read_recording(a->rec));
         const bool sketched = sketch_mode.sketch().trunk.size() >= 2;
         if (sketched) {
-            write_file_atomic(a->out + "/lsystem-sketch.json", lsystem::sketch_json(sketch_mode.sketch()) + "\n");
+            write_file_atomic(a->out + "/lsystem-sketch.json", lsystem::sketch_json(sketch_mode.sketch_file()) + "\n");
             progress("wrote " + a->out + "/lsystem-sketch.json (the L-system sketch: lobesketch lsystem --sketch grows it)");
         }
         if (out_doc.strokes.empty() && drags == 0 && out_doc.lobes.empty() && !sketched) {

@@ -352,7 +352,7 @@ bool LiveSession::save()
         note("saved " + options_.session_path);
         if (lsystem_sketch_.sketch().trunk.size() >= 2) {
             const std::string path = lsystem_sketch_path(options_.session_path);
-            write_file_atomic(path, lsystem::sketch_json(lsystem_sketch_.sketch()) + "\n");
+            write_file_atomic(path, lsystem::sketch_json(lsystem_sketch_.sketch_file()) + "\n");
             note("saved the L-system sketch to " + path);
         }
         return true;

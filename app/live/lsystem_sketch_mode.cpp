@@ -70,6 +70,14 @@ double LSystemSketchMode::growth() const
     return growth_ ? *growth_ : std::max(1.0, static_cast<double>(sketch_.trunk_sections()));
 }
 
+lsystem::Sketch LSystemSketchMode::sketch_file() const
+{
+    lsystem::Sketch s = sketch_;
+    const double g = growth();
+    if (growth_ && g == std::floor(g) && static_cast<int>(g) != s.trunk_sections()) s.iterations = static_cast<int>(g);
+    return s;
+}
+
 void LSystemSketchMode::note(std::string line)
 {
     messages_.push_back(std::move(line));

@@ -85,6 +85,9 @@ public:
 
     bool active() const { return active_; }
     const lsystem::Sketch& sketch() const { return sketch_; }
+    /// The sketch as a sketch file holds it: with the growth shown as its iterations when that
+    /// is a whole number other than the trunk's section count.
+    lsystem::Sketch sketch_file() const;
     const SketchPlatform& platform() const { return platform_; }
     /// The axis pinches add to: 0 the trunk, else the trunk node the branch being drawn
     /// comes from (its first pinch makes the branch type when there is none on that node).
