@@ -1,5 +1,5 @@
 // Trees grown in the lobes of the shipped recordings (§5), the whole pipeline from hand
-// frames: one connected tree rooted at the trunk base, attractors reached, branches inside
+// frames: one connected tree rooted at the trunk base, tips at the lobe surface, branches inside
 // the lobes, radii from the pipe model, determinism, and lobes independent of each other.
 #include <cmath>
 #include <map>
