@@ -98,14 +98,16 @@ void report_and_write(const TreeArgs& a, const Document& doc, const BuiltTree& t
         write_skeleton_json(a.skeleton_out, tree);
         progress("wrote " + a.skeleton_out);
     }
-    std::size_t attractors = 0, reached = 0;
+    std::size_t attractors = 0, reached = 0, stopped = 0;
     for (const LobeGrowthStats& l : tree.growth.lobes) {
         attractors += l.attractors;
         reached += l.reached;
+        stopped += l.stopped;
     }
     if (attractors > 0)
         progress("grew " + std::to_string(tree.growth.tree.size()) + " nodes in " + std::to_string(tree.lobes.size()) +
-                 " lobe(s), " + std::to_string(reached) + " of " + std::to_string(attractors) + " attractors reached");
+                 " lobe(s); of " + std::to_string(attractors) + " attractors " + std::to_string(stopped) +
+                 " ended by the stop rule, " + std::to_string(reached) + " reached");
     else
         progress("grew " + std::to_string(tree.growth.tree.size()) + " nodes (" + std::to_string(tree.lobes.size()) +
                  " lobe(s))");

@@ -8,6 +8,7 @@
 #include "app/cli/cli.h"
 #include "app/cli/cli_common.h"
 #include "app/cli/outputs.h"
+#include "app/export/skeleton_json.h"
 #include "app/export/tree_output.h"
 #include "app/live/lsystem_sketch_mode.h"
 #include "core/atomic_file.h"
@@ -25,7 +26,8 @@ void add_replay_command(CLI::App& app, int& exit_code)
     };
     auto a = std::make_shared<Args>();
     cmd->add_option("REC", a->rec, "Recording (binary or text form)")->required();
-    cmd->add_option("-o,--out", a->out, "Output folder (created): strokes.json, session.json, lobes/lobe_N.ply, tree.glb")
+    cmd->add_option("-o,--out", a->out,
+                    "Output folder (created): strokes.json, session.json, lobes/lobe_N.ply, tree.glb, tree.json")
         ->required();
     cmd->add_option("--settings", a->settings, "Settings JSON (a settings object or a session document)");
     cmd->add_option("--seed", a->seed, "Seed of every random choice downstream")->capture_default_str()->check(seed_check());
@@ -71,6 +73,7 @@ void add_replay_command(CLI::App& app, int& exit_code)
             ExportOptions options;
             options.target_height_m = a->height;
             write_tree_file(a->out + "/tree.glb", out_doc, tree, geometry, options);
+            write_skeleton_json(a->out + "/tree.json", tree); // the tree graph, as grow --skeleton-out
             tree_written = true;
             progress("grew a tree of " + std::to_string(tree.growth.tree.size()) + " nodes (triangles " +
                      lod_triangle_summary(geometry) + ")");
@@ -82,7 +85,8 @@ void add_replay_command(CLI::App& app, int& exit_code)
                  " lobe group(s), " + std::to_string(out_doc.edits.size()) + " edit(s) from " +
                  std::to_string(drags) + " drag(s)");
         progress("wrote " + a->out + "/strokes.json, " + a->out + "/session.json, " + std::to_string(lobe_files) +
-                 " lobe mesh(es) in " + a->out + "/lobes" + (tree_written ? " and " + a->out + "/tree.glb" : ""));
+                 " lobe mesh(es) in " + a->out + "/lobes" +
+                 (tree_written ? ", " + a->out + "/tree.glb and " + a->out + "/tree.json" : ""));
         // The L-system sketch mode's sketch (docs/lsystem-sketch.md), when the recording made one.
         const LSystemSketchMode sketch_mode = replay_lsystem_sketch(read_recording(a->rec));
         const bool sketched = sketch_mode.sketch().trunk.size() >= 2;

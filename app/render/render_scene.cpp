@@ -17,7 +17,8 @@ namespace lobe {
 namespace {
 
 // Item keys: the part kind in the top byte, an index below.
-constexpr std::uint64_t kBranchesKey = 1ull << 56, kLeavesKey = 2ull << 56, kLobeKey = 3ull << 56, kStrokeKey = 4ull << 56;
+constexpr std::uint64_t kBranchesKey = 1ull << 56, kLeavesKey = 2ull << 56, kLobeKey = 3ull << 56, kStrokeKey = 4ull << 56,
+                        kClusterKey = 5ull << 56;
 
 /// FNV-1a over the mesh's arrays: the version of a mesh is its content.
 std::uint64_t content_hash(const SurfaceGeometry& g)
@@ -81,11 +82,13 @@ RenderContent parse_show_list(const std::string& text)
             c.lobes = true;
         else if (item == "strokes")
             c.strokes = true;
+        else if (item == "clusters")
+            c.clusters = true;
         else
-            throw InvalidInput("--show: unknown item '" + item + "' (expected tree, leaves, lobes, strokes)");
+            throw InvalidInput("--show: unknown item '" + item + "' (expected tree, leaves, lobes, strokes, clusters)");
         any = true;
     }
-    if (!any) throw InvalidInput("--show: expected a list of tree, leaves, lobes, strokes");
+    if (!any) throw InvalidInput("--show: expected a list of tree, leaves, lobes, strokes, clusters");
     return c;
 }
 
@@ -211,6 +214,69 @@ RenderScene tree_render_scene(const TreeGeometry& geometry, const std::vector<Tr
     if (content.strokes)
         for (const Stroke& s : strokes) add_item(scene, stroke_key(s), RenderMaterial::Stroke, kStrokeColor, stroke_tube(s));
     return scene;
+}
+
+namespace {
+
+// Twelve colours far apart (linear RGB): piece k of the tree gets colour k mod 12.
+constexpr std::array<std::array<float, 3>, 12> kPieceColors{{{0.90f, 0.10f, 0.10f}, {0.10f, 0.45f, 0.95f},
+                                                            {0.95f, 0.80f, 0.05f}, {0.55f, 0.10f, 0.85f},
+                                                            {0.05f, 0.80f, 0.30f}, {0.95f, 0.45f, 0.05f},
+                                                            {0.05f, 0.80f, 0.85f}, {0.95f, 0.25f, 0.65f},
+                                                            {0.45f, 0.80f, 0.05f}, {0.25f, 0.15f, 0.60f},
+                                                            {0.70f, 0.45f, 0.25f}, {0.60f, 0.60f, 0.60f}}};
+
+void add_octahedron(SurfaceGeometry& g, const glm::vec3& c, float r)
+{
+    const auto base = static_cast<std::uint32_t>(g.positions.size());
+    const glm::vec3 dirs[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    for (const glm::vec3& d : dirs) {
+        g.positions.push_back(c + r * d);
+        g.normals.push_back(d);
+        g.uvs.emplace_back(0.0f, 0.0f);
+    }
+    const std::uint32_t faces[8][3] = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+    for (const auto& f : faces) g.triangles.push_back({base + f[0], base + f[1], base + f[2]});
+}
+
+void append(SurfaceGeometry& to, const SurfaceGeometry& from)
+{
+    const auto base = static_cast<std::uint32_t>(to.positions.size());
+    to.positions.insert(to.positions.end(), from.positions.begin(), from.positions.end());
+    to.normals.insert(to.normals.end(), from.normals.begin(), from.normals.end());
+    to.uvs.insert(to.uvs.end(), from.uvs.begin(), from.uvs.end());
+    for (const auto& t : from.triangles) to.triangles.push_back({base + t[0], base + t[1], base + t[2]});
+}
+
+} // namespace
+
+void add_cluster_items(RenderScene& scene, const std::vector<ClusteredAttractor>& clusters, const TreeGraph& tree)
+{
+    std::array<SurfaceGeometry, kPieceColors.size()> by_color;
+    // Each piece's attractors, centre and node, in piece order.
+    std::vector<glm::vec3> centre;
+    std::vector<int> count, node;
+    for (const ClusteredAttractor& a : clusters) {
+        if (a.piece < 0 || a.node < 0 || static_cast<std::size_t>(a.node) >= tree.nodes.size()) continue;
+        const auto p = static_cast<std::size_t>(a.piece);
+        if (p >= centre.size()) {
+            centre.resize(p + 1, glm::vec3(0.0f));
+            count.resize(p + 1, 0);
+            node.resize(p + 1, -1);
+        }
+        centre[p] += a.position;
+        ++count[p];
+        node[p] = a.node;
+        add_octahedron(by_color[p % by_color.size()], a.position, 0.006f);
+    }
+    for (std::size_t p = 0; p < centre.size(); ++p) {
+        if (count[p] == 0) continue;
+        const glm::vec3 from = tree.nodes[static_cast<std::size_t>(node[p])].position;
+        append(by_color[p % by_color.size()], polyline_tube({from, centre[p] / static_cast<float>(count[p])}, 0.002f, 5));
+    }
+    for (std::size_t c = 0; c < by_color.size(); ++c)
+        add_item(scene, kClusterKey | c, RenderMaterial::Stroke,
+                 {kPieceColors[c][0], kPieceColors[c][1], kPieceColors[c][2], 1.0f}, std::move(by_color[c]));
 }
 
 namespace {

@@ -64,7 +64,10 @@ void finish_grown_tree(const Document& doc, BuiltTree& tree)
 {
     if (!tree.growth.radii_set) {
         const PipeRadiiOptions radii = pipe_radii_options(doc.settings);
-        assign_pipe_radii(tree.growth.tree, radii.exponent, radii.tip_radius_m);
+        if (tree.growth.leader_radii)
+            assign_leader_radii(tree.growth.tree, radii.exponent, radii.tip_radius_m);
+        else
+            assign_pipe_radii(tree.growth.tree, radii.exponent, radii.tip_radius_m);
     }
     for (const std::string& m : tree.growth.messages) tree.warnings.push_back("growth: " + m);
 }
