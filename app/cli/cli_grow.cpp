@@ -23,7 +23,7 @@ namespace {
 
 struct TreeArgs {
     TreeInputOptions in;
-    std::string input, out, lod = "all", report, skeleton_out;
+    std::string input, out, lod, report, skeleton_out; // lod empty: the format's default
     double height = 0.0;
     bool lobes = false, strokes = false;
 };
@@ -31,8 +31,9 @@ struct TreeArgs {
 void add_tree_options(CLI::App* cmd, TreeArgs& a)
 {
     add_tree_input_options(cmd, a.in);
-    cmd->add_option("--lod", a.lod, "LODs to write: all, or indices such as 0 or 0,2")
-        ->capture_default_str()
+    cmd->add_option("--lod", a.lod,
+                    "LODs to write: all, or indices such as 0 or 0,2 (default: all in a .glb, LOD0 in an .obj; "
+                    "an .obj holds one LOD, the others go to NAME_LODk.obj)")
         ->check(CLI::Validator(
             [](std::string& text) {
                 // The form here; whether each LOD exists is known once the settings are.
@@ -87,9 +88,10 @@ void report_and_write(const TreeArgs& a, const Document& doc, const BuiltTree& t
     ExportOptions options;
     options.target_height_m = a.height;
     options.lods = parse_lod_list(a.lod, static_cast<int>(geometry.lods.size()));
+    if (a.lod.empty() && lower_extension(a.out) == ".obj") options.lods = {0}; // one LOD per OBJ
     options.include_lobes = a.lobes;
     options.include_strokes = a.strokes;
-    write_tree_file(a.out, doc, tree, geometry, options);
+    const std::vector<std::string> written = write_tree_file(a.out, doc, tree, geometry, options);
     if (!a.report.empty()) {
         write_file_atomic(a.report, wood_report(a, doc, tree, geometry));
         progress("wrote " + a.report);
@@ -110,7 +112,7 @@ void report_and_write(const TreeArgs& a, const Document& doc, const BuiltTree& t
         progress("grew " + std::to_string(tree.growth.tree.size()) + " nodes (" + std::to_string(tree.lobes.size()) +
                  " lobe(s))");
     progress("geometry in " + std::to_string(static_cast<int>(geometry_ms)) + " ms, triangles " + lod_triangle_summary(geometry));
-    progress("wrote " + a.out);
+    progress(wrote_line(written));
     exit_code = kExitOk;
 }
 

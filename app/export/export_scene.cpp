@@ -156,10 +156,13 @@ PreparedExport prepare_export(const ExportScene& scene, const ExportOptions& opt
     if (options.include_lobes) {
         for (std::size_t i = 0; i < scene.lobes.size(); ++i) {
             const TriangleMesh& m = scene.lobes[i];
-            const std::string what = "lobe " + std::to_string(i);
+            if (!scene.lobe_ids.empty() && scene.lobe_ids.size() != scene.lobes.size())
+                fail(std::to_string(scene.lobe_ids.size()) + " lobe ids for " + std::to_string(scene.lobes.size()) + " lobes");
+            const std::int64_t id = scene.lobe_ids.empty() ? std::int64_t(i) + 1 : scene.lobe_ids[i];
+            const std::string what = "lobe " + std::to_string(id);
             if (m.triangles.empty()) continue;
             ExportLobe lobe;
-            lobe.name = "lobe_" + std::to_string(i);
+            lobe.name = "lobe_" + std::to_string(id);
             for (std::size_t v = 0; v < m.positions.size(); ++v) {
                 if (!finite(m.positions[v])) fail(what + ": position " + std::to_string(v) + " is not finite");
                 lobe.positions.push_back(to_export(m.positions[v], scene.base, scale));
@@ -192,6 +195,30 @@ PreparedExport prepare_export(const ExportScene& scene, const ExportOptions& opt
             out.strokes.push_back(std::move(line));
         }
     }
+    return out;
+}
+
+double srgb_to_linear(std::uint8_t v)
+{
+    const double c = v / 255.0;
+    return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+}
+
+std::uint8_t linear_to_srgb(double v)
+{
+    const double c = std::clamp(v, 0.0, 1.0);
+    const double s = c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1.0 / 2.4) - 0.055;
+    return static_cast<std::uint8_t>(std::clamp(s * 255.0 + 0.5, 0.0, 255.0));
+}
+
+RgbaImage tinted_texture(const RgbaImage& image, const std::array<float, 3>& rgb)
+{
+    std::array<double, 256> linear{};
+    for (int i = 0; i < 256; ++i) linear[static_cast<std::size_t>(i)] = srgb_to_linear(static_cast<std::uint8_t>(i));
+    RgbaImage out = image;
+    for (std::size_t i = 0; i + 3 < out.pixels.size(); i += 4)
+        for (std::size_t k = 0; k < 3; ++k)
+            out.pixels[i + k] = linear_to_srgb(linear[out.pixels[i + k]] * static_cast<double>(rgb[k]));
     return out;
 }
 

@@ -23,7 +23,8 @@ struct ExportScene {
     std::string name = "tree";          ///< prefix of every node/object name; non-empty, printable
     const TreeGeometry* tree = nullptr; ///< required; not owned
     glm::vec3 base{0.0f};               ///< trunk base on the ground (metres): becomes the origin
-    std::vector<TriangleMesh> lobes;    ///< optional, written as `lobe_<i>` (index in this list)
+    std::vector<TriangleMesh> lobes;    ///< optional, written as `lobe_<id>`
+    std::vector<std::int64_t> lobe_ids; ///< the lobes' ids (LobeRecord::id), one per lobe; empty: ids 1, 2, …
     std::vector<Stroke> strokes;        ///< optional, written as `stroke_<id>` line strips
 };
 
@@ -49,7 +50,7 @@ struct ExportPart {
 
 /// A lobe in export space (positions only: flat shaded).
 struct ExportLobe {
-    std::string name; ///< `lobe_<i>`
+    std::string name; ///< `lobe_<id>`
     std::vector<glm::vec3> positions;
     std::vector<std::array<std::uint32_t, 3>> triangles;
 };
@@ -93,6 +94,15 @@ PreparedExport prepare_export(const ExportScene& scene, const ExportOptions& opt
 /// a side are refused before decoding.
 /// \throw FileError (one line naming the file) when it cannot be read or decoded.
 RgbaImage read_picture_file(const std::string& path, int max_side = 1024);
+
+/// `image` (sRGB-encoded colours) multiplied by the linear colour `rgb`, as a glTF
+/// baseColorFactor multiplies a baseColorTexture: decoded to linear, multiplied, encoded back
+/// to sRGB, rounded; alpha kept. Baked into the OBJ's PNGs, which have no factor.
+RgbaImage tinted_texture(const RgbaImage& image, const std::array<float, 3>& rgb);
+
+/// sRGB-encoded byte to linear, and a linear value in [0, 1] back to an sRGB byte (rounded).
+double srgb_to_linear(std::uint8_t v);
+std::uint8_t linear_to_srgb(double v);
 
 /// PNG encoding of an RGBA8 image (stb_image_write, deterministic: same pixels, same bytes).
 /// \throw InvalidInput for an empty image or a pixel count that does not match.

@@ -45,24 +45,36 @@ std::string lod_triangle_summary(const TreeGeometry& geometry)
     return out;
 }
 
-void write_tree_file(const std::string& path, const Document& doc, const BuiltTree& tree,
+std::vector<std::string> write_tree_file(const std::string& path, const Document& doc, const BuiltTree& tree,
                      const TreeGeometry& geometry, const ExportOptions& options)
 {
     std::string ext = std::filesystem::path(path).extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
     ExportScene scene;
-    scene.name = "tree";
+    scene.name = std::filesystem::path(path).stem().string();
+    if (scene.name.empty()) scene.name = "tree";
     scene.tree = &geometry;
     if (!tree.growth.tree.empty()) scene.base = tree.growth.tree.nodes[0].position;
     if (options.include_lobes)
-        for (const BuiltLobe& l : tree.lobes) scene.lobes.push_back(l.mesh);
+        for (const BuiltLobe& l : tree.lobes) {
+            scene.lobes.push_back(l.mesh);
+            scene.lobe_ids.push_back(l.lobe_id);
+        }
     if (options.include_strokes) scene.strokes = effective_strokes(doc);
-    if (ext == ".glb")
+    if (ext == ".glb") {
         write_glb(path, scene, options);
-    else if (ext == ".obj")
-        write_obj(path, scene, options);
-    else
-        throw InvalidInput(path + ": the tree is written as .glb (glTF binary) or .obj (with .mtl and a PNG)");
+        return {path};
+    }
+    if (ext == ".obj") return write_obj(path, scene, options);
+    throw InvalidInput(path + ": the tree is written as .glb (glTF binary) or .obj (with .mtl and a PNG)");
+}
+
+std::string wrote_line(const std::vector<std::string>& files)
+{
+    if (files.empty()) return "wrote nothing";
+    std::string out = "wrote " + files[0];
+    for (std::size_t i = 1; i < files.size(); ++i) out += (i == 1 ? " (" : ", ") + files[i];
+    return files.size() > 1 ? out + ")" : out;
 }
 
 std::vector<int> parse_lod_list(const std::string& text, int lod_count)

@@ -373,18 +373,21 @@ RenderScene glb_render_scene(const std::string& path, const RenderContent& conte
         const tinygltf::Mesh& mesh = m.meshes[std::size_t(node.mesh)];
         const int material = mesh.primitives.empty() ? -1 : mesh.primitives[0].material;
         const std::string& name = node.name;
-        const bool branches = name.rfind("tree_branches_LOD", 0) == 0, leaves = name.rfind("tree_leaves_LOD", 0) == 0;
-        if (branches || leaves) {
-            const std::string digits = name.substr(name.rfind("_LOD") + 4);
-            if (!digits.empty() && digits.size() < 3 && std::all_of(digits.begin(), digits.end(), ::isdigit))
-                lods_found.insert(std::stoi(digits));
-        }
-        if (branches && name == "tree_branches" + lod) {
+        // `<stem>_branches_LOD<k>` and `<stem>_leaves_LOD<k>`, whatever the file's stem.
+        const std::size_t at = name.rfind("_LOD");
+        const std::string digits = at == std::string::npos ? std::string() : name.substr(at + 4);
+        const bool lod_name = !digits.empty() && digits.size() < 3 && std::all_of(digits.begin(), digits.end(), ::isdigit);
+        auto part_is = [&](const std::string& part) {
+            return lod_name && at >= part.size() && name.compare(at - part.size(), part.size(), part) == 0;
+        };
+        const bool branches = part_is("_branches"), leaves = part_is("_leaves");
+        if (branches || leaves) lods_found.insert(std::stoi(digits));
+        if (branches && name.compare(at, std::string::npos, lod) == 0) {
             found_lod = true;
             if (content.tree)
                 add_item(scene, kBranchesKey | std::uint64_t(content.lod), RenderMaterial::Bark,
                          material_color(m, material, {0.36f, 0.25f, 0.17f, 1.0f}), glb_surface(m, mesh, path));
-        } else if (leaves && name == "tree_leaves" + lod) {
+        } else if (leaves && name.compare(at, std::string::npos, lod) == 0) {
             found_lod = true;
             if (content.leaves) {
                 std::array<float, 4> c = material_color(m, material, {0.20f, 0.42f, 0.12f, 1.0f});
@@ -403,7 +406,7 @@ RenderScene glb_render_scene(const std::string& path, const RenderContent& conte
     }
     if ((content.tree || content.leaves) && !found_lod) {
         if (lods_found.empty())
-            throw FileError(path, "has no tree_branches_LOD<k> meshes (not a tree exported by Lobesketch?)");
+            throw FileError(path, "has no <name>_branches_LOD<k> meshes (not a tree exported by Lobesketch?)");
         std::string has;
         for (const int k : lods_found) has += (has.empty() ? "LOD" : ", LOD") + std::to_string(k);
         throw FileError(path, "has no LOD" + std::to_string(content.lod) + " (it has " + has + "; pick one with --lod)");
