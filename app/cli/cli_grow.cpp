@@ -9,6 +9,7 @@
 #include "app/session/session_file.h"
 #include "app/cli/cli.h"
 #include "app/cli/cli_common.h"
+#include "app/cli/cli_export_options.h"
 #include "app/export/tree_output.h"
 #include "app/export/export_scene.h"
 #include "app/export/skeleton_json.h"
@@ -26,6 +27,7 @@ struct TreeArgs {
     std::string input, out, lod, report, skeleton_out; // lod empty: the format's default
     double height = 0.0;
     bool lobes = false, strokes = false;
+    TreeFileArgs file;
 };
 
 void add_tree_options(CLI::App* cmd, TreeArgs& a)
@@ -49,6 +51,7 @@ void add_tree_options(CLI::App* cmd, TreeArgs& a)
             "LIST", "LOD list"));
     cmd->add_option("--height", a.height, "Scale the exported tree to this height in metres (0 keeps the sketch's)")
         ->check(finite_range(0.0, 1000.0));
+    add_tree_file_options(cmd, a.file);
     cmd->add_flag("--lobes", a.lobes, "Also write the lobes as extra nodes");
     cmd->add_flag("--strokes", a.strokes, "Also write the strokes as extra nodes");
     cmd->add_option("--report", a.report,
@@ -87,8 +90,9 @@ void report_and_write(const TreeArgs& a, const Document& doc, const BuiltTree& t
     const double geometry_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     ExportOptions options;
     options.target_height_m = a.height;
-    options.lods = parse_lod_list(a.lod, static_cast<int>(geometry.lods.size()));
+    options.lods = parse_lod_list(a.lod, static_cast<int>(geometry.lods.size()) + (a.file.billboard > 0 ? 1 : 0));
     if (a.lod.empty() && lower_extension(a.out) == ".obj") options.lods = {0}; // one LOD per OBJ
+    apply_tree_file_options(a.file, options);
     options.include_lobes = a.lobes;
     options.include_strokes = a.strokes;
     const std::vector<std::string> written = write_tree_file(a.out, doc, tree, geometry, options);
@@ -115,6 +119,9 @@ void report_and_write(const TreeArgs& a, const Document& doc, const BuiltTree& t
     progress(wrote_line(written));
     exit_code = kExitOk;
 }
+
+/// The levels a tree of `doc` is written with: its LODs and the billboard.
+int lod_levels(const TreeArgs& a, const Document& doc) { return doc.settings.branches.lod_count + (a.file.billboard > 0 ? 1 : 0); }
 
 /// --out's extension, checked when the command line is parsed.
 CLI::Validator tree_file_check()
@@ -152,7 +159,7 @@ void add_grow_command(CLI::App& app, int& exit_code)
         require_outputs_folders(*a);
         // The LODs asked for exist: known before growing for a session or a mesh.
         const GrownInput grown = grow_input_tree(a->input, a->in, [a](const Document& doc) {
-            parse_lod_list(a->lod, doc.settings.branches.lod_count);
+            parse_lod_list(a->lod, lod_levels(*a, doc));
         });
         report_and_write(*a, grown.doc, grown.tree, a->input, exit_code);
     });
@@ -181,7 +188,7 @@ void add_export_command(CLI::App& app, int& exit_code)
         if (!a->in.settings.empty()) doc.settings = load_settings_file(a->in.settings);
         apply_tree_input_options(doc.settings, a->in);
         apply_document_options(doc, a->in);
-        parse_lod_list(a->lod, doc.settings.branches.lod_count); // the LODs asked for exist, before growing
+        parse_lod_list(a->lod, lod_levels(*a, doc)); // the LODs asked for exist, before growing
         report_and_write(*a, doc, build_document_tree(doc), a->input, exit_code);
     });
 }

@@ -66,6 +66,15 @@ public:
         return push(a);
     }
 
+    int add_vec4(const std::vector<glm::vec4>& v)
+    {
+        std::vector<float> flat;
+        flat.reserve(v.size() * 4);
+        for (const glm::vec4& p : v) flat.insert(flat.end(), {p.x, p.y, p.z, p.w});
+        return push(accessor(add_view(flat.data(), flat.size() * sizeof(float), kArrayBuffer),
+                             TINYGLTF_COMPONENT_TYPE_FLOAT, v.size(), TINYGLTF_TYPE_VEC4));
+    }
+
     int add_vec2(const std::vector<glm::vec2>& v)
     {
         std::vector<float> flat;
@@ -187,6 +196,10 @@ tinygltf::Material bark_material(const PreparedExport& e, GlbBuilder& b)
             embed_texture(b, *e.bark_texture, e.name + "_bark", TINYGLTF_TEXTURE_WRAP_REPEAT);
         m.pbrMetallicRoughness.baseColorTexture.texCoord = 0;
     }
+    if (!e.bark_normal_map.pixels.empty()) {
+        m.normalTexture.index = embed_texture(b, e.bark_normal_map, e.name + "_bark_normal", TINYGLTF_TEXTURE_WRAP_REPEAT);
+        m.normalTexture.texCoord = 0;
+    }
     return m;
 }
 
@@ -207,6 +220,23 @@ tinygltf::Material leaf_material(const PreparedExport& e, GlbBuilder& b)
             embed_texture(b, *e.leaf_texture, e.name + "_leaf", TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE);
         m.pbrMetallicRoughness.baseColorTexture.texCoord = 0;
     }
+    return m;
+}
+
+/// The billboard's material: its baked picture (colour and alpha) with a white factor.
+tinygltf::Material billboard_material(const PreparedExport& e, GlbBuilder& b)
+{
+    tinygltf::Material m;
+    m.name = "billboard";
+    m.pbrMetallicRoughness.baseColorFactor = {1.0, 1.0, 1.0, 1.0};
+    m.pbrMetallicRoughness.metallicFactor = 0.0;
+    m.pbrMetallicRoughness.roughnessFactor = 0.9;
+    m.alphaMode = "MASK";
+    m.alphaCutoff = 0.5;
+    m.doubleSided = true;
+    m.pbrMetallicRoughness.baseColorTexture.index =
+        embed_texture(b, e.billboard_texture, e.name + "_billboard", TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE);
+    m.pbrMetallicRoughness.baseColorTexture.texCoord = 0;
     return m;
 }
 
@@ -245,10 +275,15 @@ tinygltf::Model build_model(const PreparedExport& e)
         extras["species"] = tinygltf::Value(e.species);
         root.extras = tinygltf::Value(extras);
     }
+    int billboard = -1;
     for (const ExportPart& part : e.parts) {
         const bool is_leaves = part.kind == ExportPart::Kind::Leaves;
-        int& material = is_leaves ? leaf : bark;
-        if (material < 0) material = b.add_material(is_leaves ? leaf_material(e, b) : bark_material(e, b));
+        const bool is_billboard = part.kind == ExportPart::Kind::Billboard;
+        int& material = is_billboard ? billboard : is_leaves ? leaf : bark;
+        if (material < 0)
+            material = b.add_material(is_billboard ? billboard_material(e, b)
+                                      : is_leaves  ? leaf_material(e, b)
+                                                   : bark_material(e, b));
         const SurfaceGeometry& g = part.geometry;
         tinygltf::Primitive prim;
         prim.mode = TINYGLTF_MODE_TRIANGLES;
@@ -256,6 +291,7 @@ tinygltf::Model build_model(const PreparedExport& e)
         prim.attributes["POSITION"] = b.add_vec3(g.positions, true);
         prim.attributes["NORMAL"] = b.add_vec3(g.normals, false);
         prim.attributes["TEXCOORD_0"] = b.add_vec2(g.uvs);
+        if (!part.tangents.empty()) prim.attributes["TANGENT"] = b.add_vec4(part.tangents);
         prim.indices = b.add_indices(g.triangles, g.vertex_count());
         root.children.push_back(b.add_mesh_node(part.name, std::move(prim)));
     }

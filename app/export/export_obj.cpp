@@ -50,7 +50,15 @@ void put_rgb(std::string& out, const char* key, const std::array<float, 3>& c)
     out += '\n';
 }
 
-std::string build_mtl(const PreparedExport& e, const std::string& png_name, const std::string& bark_png_name)
+/// "X_bark.png" → "X_bark_normal.png".
+std::string normal_png_name(const std::string& bark_png_name)
+{
+    const std::size_t dot = bark_png_name.rfind('.');
+    return dot == std::string::npos ? bark_png_name + "_normal" : bark_png_name.substr(0, dot) + "_normal" + bark_png_name.substr(dot);
+}
+
+std::string build_mtl(const PreparedExport& e, const std::string& png_name, const std::string& bark_png_name,
+                      const std::string& billboard_png_name)
 {
     std::string m = "# Lobesketch: materials of " + e.name + "\n";
     if (e.has_branches()) {
@@ -61,6 +69,7 @@ std::string build_mtl(const PreparedExport& e, const std::string& png_name, cons
         put_rgb(m, "Ks", {0.0f, 0.0f, 0.0f});
         m += "d 1\nillum 1\n";
         if (e.bark_texture != nullptr) m += "map_Kd " + bark_png_name + "\n";
+        if (!e.bark_normal_map.pixels.empty()) m += "map_Bump " + normal_png_name(bark_png_name) + "\n";
     }
     if (e.has_leaves()) {
         m += "\nnewmtl leaf\n";
@@ -69,6 +78,13 @@ std::string build_mtl(const PreparedExport& e, const std::string& png_name, cons
         put_rgb(m, "Ks", {0.0f, 0.0f, 0.0f});
         m += "d 1\nillum 1\n";
         if (e.leaf_texture != nullptr) m += "map_Kd " + png_name + "\nmap_d " + png_name + "\n";
+    }
+    if (e.has_billboard()) {
+        m += "\nnewmtl billboard\n";
+        put_rgb(m, "Ka", {0.0f, 0.0f, 0.0f});
+        put_rgb(m, "Kd", {1.0f, 1.0f, 1.0f});
+        put_rgb(m, "Ks", {0.0f, 0.0f, 0.0f});
+        m += "d 1\nillum 1\nmap_Kd " + billboard_png_name + "\nmap_d " + billboard_png_name + "\n";
     }
     if (!e.lobes.empty()) {
         m += "\nnewmtl lobe\n";
@@ -104,7 +120,9 @@ std::string build_obj(const PreparedExport& e, const std::string& mtl_name, int 
             o += '\n';
         }
         put_vec3_lines(o, "vn ", g.normals);
-        o += part.kind == ExportPart::Kind::Leaves ? "usemtl leaf\n" : "usemtl bark\n";
+        o += part.kind == ExportPart::Kind::Leaves      ? "usemtl leaf\n"
+             : part.kind == ExportPart::Kind::Billboard ? "usemtl billboard\n"
+                                                        : "usemtl bark\n";
         for (const auto& t : g.triangles) {
             o += 'f';
             for (std::uint32_t i : t) {
@@ -157,7 +175,7 @@ std::string_view bytes_view(const std::vector<std::uint8_t>& b)
 } // namespace
 
 ObjFiles encode_obj(const ExportScene& scene, const ExportOptions& options, const std::string& mtl_name,
-                    const std::string& png_name, const std::string& bark_png_name)
+                    const std::string& png_name, const std::string& bark_png_name, const std::string& billboard_png_name)
 {
     const PreparedExport e = prepare_export(scene, options);
     ObjFiles files;
@@ -168,7 +186,9 @@ ObjFiles encode_obj(const ExportScene& scene, const ExportOptions& options, cons
     if (lods.empty()) lods.push_back(options.lods.empty() ? 0 : *std::min_element(options.lods.begin(), options.lods.end()));
     files.obj = build_obj(e, mtl_name, lods[0], true);
     for (std::size_t i = 1; i < lods.size(); ++i) files.lod_objs.emplace_back(lods[i], build_obj(e, mtl_name, lods[i], false));
-    files.mtl = build_mtl(e, png_name, bark_png_name);
+    files.mtl = build_mtl(e, png_name, bark_png_name, billboard_png_name);
+    if (e.has_billboard()) files.billboard_png = encode_png(e.billboard_texture);
+    if (e.has_branches() && !e.bark_normal_map.pixels.empty()) files.bark_normal_png = encode_png(e.bark_normal_map);
     if (e.has_leaves() && e.leaf_texture != nullptr) files.leaf_png = encode_png(tinted_texture(*e.leaf_texture, e.leaf_color));
     if (e.has_branches() && e.bark_texture != nullptr) files.bark_png = encode_png(tinted_texture(*e.bark_texture, e.bark_color));
     return files;
@@ -181,8 +201,9 @@ std::vector<std::string> write_obj(const std::string& path, const ExportScene& s
     const std::filesystem::path mtl_path = std::filesystem::path(obj_path).replace_extension(".mtl");
     const std::filesystem::path png_path = obj_path.parent_path() / (stem + "_leaf.png");
     const std::filesystem::path bark_path = obj_path.parent_path() / (stem + "_bark.png");
+    const std::filesystem::path billboard_path = obj_path.parent_path() / (stem + "_billboard.png");
     const ObjFiles files = encode_obj(scene, options, mtl_path.filename().string(), png_path.filename().string(),
-                                      bark_path.filename().string());
+                                      bark_path.filename().string(), billboard_path.filename().string());
     std::vector<std::string> written{path, mtl_path.string()};
     if (!files.leaf_png.empty()) {
         write_file_atomic(png_path.string(), bytes_view(files.leaf_png));
@@ -191,6 +212,15 @@ std::vector<std::string> write_obj(const std::string& path, const ExportScene& s
     if (!files.bark_png.empty()) {
         write_file_atomic(bark_path.string(), bytes_view(files.bark_png));
         written.push_back(bark_path.string());
+    }
+    if (!files.bark_normal_png.empty()) {
+        const std::filesystem::path p = obj_path.parent_path() / normal_png_name(bark_path.filename().string());
+        write_file_atomic(p.string(), bytes_view(files.bark_normal_png));
+        written.push_back(p.string());
+    }
+    if (!files.billboard_png.empty()) {
+        write_file_atomic(billboard_path.string(), bytes_view(files.billboard_png));
+        written.push_back(billboard_path.string());
     }
     write_file_atomic(mtl_path.string(), files.mtl);
     for (const auto& [lod, text] : files.lod_objs) {

@@ -27,18 +27,21 @@ struct ObjFiles {
     std::string mtl;
     std::vector<std::uint8_t> leaf_png; ///< empty when the tree has no leaf texture
     std::vector<std::uint8_t> bark_png; ///< empty when the tree has no bark texture (or no branches are written)
+    std::vector<std::uint8_t> bark_normal_png; ///< with ExportOptions::bark_normal_map: X_bark_normal.png (map_Bump)
+    std::vector<std::uint8_t> billboard_png; ///< the billboard's picture; empty without a billboard level
 };
 
 /// Builds the OBJ/MTL/PNG contents; `mtl_name`, `png_name` and `bark_png_name` are the file
 /// names the OBJ and MTL refer to (`mtllib`, `map_Kd`).
 /// \throw InvalidInput as prepare_export.
 ObjFiles encode_obj(const ExportScene& scene, const ExportOptions& options, const std::string& mtl_name,
-                    const std::string& png_name, const std::string& bark_png_name = "bark.png");
+                    const std::string& png_name, const std::string& bark_png_name = "bark.png",
+                    const std::string& billboard_png_name = "billboard.png");
 
 /// Writes `path` (X.obj), X_LODk.obj for every further LOD, X.mtl and the PNGs beside it,
 /// each atomically; the PNGs and MTL are written first so an OBJ never refers to a missing
 /// file. X_leaf.png is written only when the export has leaves and the tree a leaf texture,
-/// X_bark.png likewise for branches. Returns the files written: X.obj, X.mtl, then the PNGs
+/// X_bark.png likewise for branches, X_billboard.png with the billboard level. Returns the files written: X.obj, X.mtl, then the PNGs
 /// and further OBJs.
 /// \throw InvalidInput as prepare_export (nothing is written); FileError(file, …) when a
 /// write fails (files written before it keep their new contents, the failed one its old).

@@ -8,7 +8,9 @@
 #include "app/export/export_gltf.h"
 #include "app/export/export_obj.h"
 #include "core/errors.h"
+#include "growth/bark_texture.h"
 #include "growth/branch_geometry.h"
+#include "growth/leaf_lod.h"
 #include "app/session/edit_ops.h"
 #include "app/session/stage_options.h"
 
@@ -50,10 +52,21 @@ std::vector<std::string> write_tree_file(const std::string& path, const Document
 {
     std::string ext = std::filesystem::path(path).extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    // Textures at another size: the same procedural pictures made again.
+    TreeGeometry resized;
+    const TreeGeometry* drawn = &geometry;
+    if (options.texture_size > 0 && options.texture_size != geometry.bark_texture.width) {
+        if (options.texture_size < 16 || options.texture_size > 2048)
+            throw InvalidInput("export: texture size " + std::to_string(options.texture_size) + " is not in [16, 2048]");
+        resized = geometry;
+        resized.leaf_texture = make_leaf_atlas(make_leaf_texture(doc.settings.leaves.shape, options.texture_size));
+        resized.bark_texture = make_bark_texture(options.texture_size);
+        drawn = &resized;
+    }
     ExportScene scene;
     scene.name = std::filesystem::path(path).stem().string();
     if (scene.name.empty()) scene.name = "tree";
-    scene.tree = &geometry;
+    scene.tree = drawn;
     if (!tree.growth.tree.empty()) scene.base = tree.growth.tree.nodes[0].position;
     if (options.include_lobes)
         for (const BuiltLobe& l : tree.lobes) {

@@ -380,8 +380,8 @@ RenderScene glb_render_scene(const std::string& path, const RenderContent& conte
         auto part_is = [&](const std::string& part) {
             return lod_name && at >= part.size() && name.compare(at - part.size(), part.size(), part) == 0;
         };
-        const bool branches = part_is("_branches"), leaves = part_is("_leaves");
-        if (branches || leaves) lods_found.insert(std::stoi(digits));
+        const bool branches = part_is("_branches"), leaves = part_is("_leaves"), billboard = part_is("_billboard");
+        if (branches || leaves || billboard) lods_found.insert(std::stoi(digits));
         if (branches && name.compare(at, std::string::npos, lod) == 0) {
             found_lod = true;
             if (content.tree)
@@ -393,6 +393,15 @@ RenderScene glb_render_scene(const std::string& path, const RenderContent& conte
                 std::array<float, 4> c = material_color(m, material, {0.20f, 0.42f, 0.12f, 1.0f});
                 c[3] = 1.0f;
                 add_item(scene, kLeavesKey | std::uint64_t(content.lod), RenderMaterial::Leaf, c, glb_surface(m, mesh, path));
+                scene.leaf_texture = material_texture(m, material);
+                scene.leaf_texture_version = image_hash(scene.leaf_texture);
+            }
+        } else if (billboard && name.compare(at, std::string::npos, lod) == 0) {
+            // The billboard level: cards drawn as leaves are, with its baked picture.
+            found_lod = true;
+            if (content.tree || content.leaves) {
+                add_item(scene, kLeavesKey | std::uint64_t(content.lod), RenderMaterial::Leaf, {1.0f, 1.0f, 1.0f, 1.0f},
+                         glb_surface(m, mesh, path));
                 scene.leaf_texture = material_texture(m, material);
                 scene.leaf_texture_version = image_hash(scene.leaf_texture);
             }
