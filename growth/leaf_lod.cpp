@@ -41,8 +41,9 @@ struct SprayLeaf {
 };
 // A fan from the bottom centre, back to front: the upright leaf last, on top.
 constexpr SprayLeaf kSpray[] = {
-    {1.0, 0.62, 0.50, 1.0}, {-1.0, 0.62, 0.50, 1.0}, {0.6, 0.8, 0.49, 1.0}, {-0.6, 0.8, 0.51, 1.0},
-    {0.3, 0.9, 0.49, 1.0},  {-0.3, 0.9, 0.51, 1.0},  {0.0, 0.97, 0.50, 1.0},
+    {1.45, 0.5, 0.50, 1.0},  {-1.45, 0.5, 0.50, 1.0}, {1.15, 0.62, 0.50, 1.0}, {-1.15, 0.62, 0.50, 1.0},
+    {0.85, 0.78, 0.49, 1.0}, {-0.85, 0.78, 0.51, 1.0}, {0.55, 0.9, 0.49, 1.0},  {-0.55, 0.9, 0.51, 1.0},
+    {0.27, 0.98, 0.49, 1.0}, {-0.27, 0.98, 0.51, 1.0}, {0.0, 1.0, 0.50, 1.0},
 };
 
 } // namespace
@@ -128,15 +129,18 @@ void push_quad(SurfaceGeometry& out, const std::array<glm::vec3, 4>& corners, co
 }
 
 /// The card of the leaves `order[begin, end)` (indices into cloud.leaves).
+/// The card of the leaves `order[begin, end)` (indices into cloud.leaves); with `single`, a
+/// lone leaf keeps its own quad on the single-leaf half, else every card shows the spray
+/// (one texture rectangle for all cards, so a renderer can draw them instanced).
 void emit_card(const LeafCloud& cloud, const std::vector<std::pair<std::uint64_t, std::uint32_t>>& order,
-               std::size_t begin, std::size_t end, SurfaceGeometry& out)
+               std::size_t begin, std::size_t end, bool single, SurfaceGeometry& out)
 {
     const LeafCloud::Leaf& first = cloud.leaves[order[begin].second];
-    if (end - begin == 1) { // a lone leaf keeps its own quad
+    if (end - begin == 1) { // a lone leaf keeps its own rectangle
         const glm::vec3 side = static_cast<float>(0.5 * first.width_m) * first.across;
         const glm::vec3 up = static_cast<float>(first.length_m) * first.axis;
         push_quad(out, {first.base - side, first.base + side, first.base + up + side, first.base + up - side},
-                  glm::normalize(glm::cross(first.across, first.axis)), 0.0f, 0.5f);
+                  glm::normalize(glm::cross(first.across, first.axis)), single ? 0.0f : 0.5f, single ? 0.5f : 1.0f);
         return;
     }
     glm::dvec3 axis(0.0), centre(0.0);
@@ -229,7 +233,7 @@ void emit_leaf_cluster_cards(const LeafCloud& cloud, std::size_t max_cards, Surf
         return count;
     };
     if (n <= max_cards) { // every leaf alone
-        for (std::size_t i = 0; i < n; ++i) emit_card(cloud, order, i, i + 1, out);
+        for (std::size_t i = 0; i < n; ++i) emit_card(cloud, order, i, i + 1, true, out);
         return;
     }
     int level = 0;
@@ -251,7 +255,7 @@ void emit_leaf_cluster_cards(const LeafCloud& cloud, std::size_t max_cards, Surf
         if (total + cuts.size() - 1 > max_cards) cuts.resize(1);
         total += cuts.size() - 1;
         cuts.push_back(end);
-        for (std::size_t c = 0; c + 1 < cuts.size(); ++c) emit_card(cloud, order, cuts[c], cuts[c + 1], out);
+        for (std::size_t c = 0; c + 1 < cuts.size(); ++c) emit_card(cloud, order, cuts[c], cuts[c + 1], false, out);
     }
 }
 

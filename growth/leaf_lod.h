@@ -15,8 +15,8 @@
 namespace lobe {
 
 /// The leaf atlas of a tree: 2·n × n pixels for an n × n `leaf` picture (make_leaf_texture):
-/// the leaf itself on the left half, on the right half a spray of seven copies of it fanning
-/// from the bottom centre (turned by up to ±60°, sizes 45 % to 60 % of the cell), composited
+/// the leaf itself on the left half, on the right half a spray of eleven copies of it fanning
+/// from the bottom centre (turned by up to ±83°, sizes 50 % to 100 % of the cell), composited
 /// by alpha. Colours outside the leaves are kept (alpha 0) as in the leaf picture, so
 /// filtering does not darken the edges. Deterministic.
 /// \throw InvalidInput when `leaf` is not square, is empty, or its pixel count is wrong.
@@ -34,8 +34,10 @@ void use_single_leaf_half(SurfaceGeometry& leaves);
 /// normal) over the box of its leaves' corners, in the plane spanned by their mean axis and
 /// the first leaf's base edge, shrunk about its middle until its corners lie in the
 /// axis-aligned box of those leaves' corners (a card never reaches past its leaves); a group
-/// of one leaf is that leaf's own quad with the single-leaf uvs. With max_cards ≥ the number
-/// of leaves this is every leaf as at LOD0. No card when max_cards is 0.
+/// of one leaf gets that leaf's own rectangle. Every card shows the spray (uv u in [0.5, 1]),
+/// so all cards share one texture rectangle and can be drawn instanced. With max_cards ≥ the
+/// number of leaves this is every leaf as at LOD0, on the single-leaf half. No card when
+/// max_cards is 0.
 /// Deterministic (no floating-point sums whose order depends on anything but the cloud).
 void emit_leaf_cluster_cards(const LeafCloud& cloud, std::size_t max_cards, SurfaceGeometry& out);
 

@@ -40,6 +40,9 @@ void add_tree_file_options(CLI::App* cmd, TreeFileArgs& a)
     cmd->add_flag("--bark-normal-map", a.bark_normal_map, "Also write a normal map of the bark (derived from its texture)");
     cmd->add_flag("--optimize", a.optimize,
                   "Reorder each mesh for the vertex cache, overdraw and vertex fetch (meshoptimizer)");
+    cmd->add_flag("--quantize", a.quantize,
+                  "Quantize the .glb's meshes (KHR_mesh_quantization) without compressing them: for importers "
+                  "without EXT_meshopt_compression such as Blender 3.4; implies --optimize");
     cmd->add_flag("--compress", a.compress,
                   "Quantize (KHR_mesh_quantization) and compress (EXT_meshopt_compression) the .glb's meshes; implies "
                   "--optimize. Viewers need both extensions");
@@ -50,8 +53,9 @@ void apply_tree_file_options(const TreeFileArgs& a, ExportOptions& into)
     into.billboard_size = a.billboard;
     into.texture_size = a.texture_size;
     into.bark_normal_map = a.bark_normal_map;
-    into.optimize = a.optimize || a.compress;
+    into.optimize = a.optimize || a.compress || a.quantize;
     into.compress = a.compress;
+    into.quantize = a.quantize && !a.compress;
 }
 
 } // namespace lobe::cli

@@ -11,14 +11,15 @@
 namespace lobe::cli {
 
 struct TreeFileArgs {
-    int billboard = 512;       ///< billboard texture size; 0: no billboard level
+    int billboard = 256;       ///< billboard texture size; 0: no billboard level
     int texture_size = 0;      ///< leaf and bark texture size; 0: the tree's (128)
     bool bark_normal_map = false;
     bool optimize = false;
     bool compress = false;
+    bool quantize = false;
 };
 
-/// Registers --billboard, --texture-size, --bark-normal-map, --optimize and --compress; a bad
+/// Registers --billboard, --texture-size, --bark-normal-map, --optimize, --quantize and --compress; a bad
 /// value (not a power of two in range) is a bad command line (exit 2).
 void add_tree_file_options(CLI::App* cmd, TreeFileArgs& a);
 

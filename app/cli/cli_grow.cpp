@@ -90,7 +90,7 @@ void report_and_write(const TreeArgs& a, const Document& doc, const BuiltTree& t
     const double geometry_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     ExportOptions options;
     options.target_height_m = a.height;
-    options.lods = parse_lod_list(a.lod, static_cast<int>(geometry.lods.size()) + (a.file.billboard > 0 ? 1 : 0));
+    options.lods = parse_lod_list(a.lod, static_cast<int>(geometry.lods.size()), a.file.billboard > 0);
     if (a.lod.empty() && lower_extension(a.out) == ".obj") options.lods = {0}; // one LOD per OBJ
     apply_tree_file_options(a.file, options);
     options.include_lobes = a.lobes;
@@ -119,9 +119,6 @@ void report_and_write(const TreeArgs& a, const Document& doc, const BuiltTree& t
     progress(wrote_line(written));
     exit_code = kExitOk;
 }
-
-/// The levels a tree of `doc` is written with: its LODs and the billboard.
-int lod_levels(const TreeArgs& a, const Document& doc) { return doc.settings.branches.lod_count + (a.file.billboard > 0 ? 1 : 0); }
 
 /// --out's extension, checked when the command line is parsed.
 CLI::Validator tree_file_check()
@@ -159,7 +156,7 @@ void add_grow_command(CLI::App& app, int& exit_code)
         require_outputs_folders(*a);
         // The LODs asked for exist: known before growing for a session or a mesh.
         const GrownInput grown = grow_input_tree(a->input, a->in, [a](const Document& doc) {
-            parse_lod_list(a->lod, lod_levels(*a, doc));
+            parse_lod_list(a->lod, doc.settings.branches.lod_count, a->file.billboard > 0);
         });
         report_and_write(*a, grown.doc, grown.tree, a->input, exit_code);
     });
@@ -188,7 +185,7 @@ void add_export_command(CLI::App& app, int& exit_code)
         if (!a->in.settings.empty()) doc.settings = load_settings_file(a->in.settings);
         apply_tree_input_options(doc.settings, a->in);
         apply_document_options(doc, a->in);
-        parse_lod_list(a->lod, lod_levels(*a, doc)); // the LODs asked for exist, before growing
+        parse_lod_list(a->lod, doc.settings.branches.lod_count, a->file.billboard > 0); // the LODs asked for exist, before growing
         report_and_write(*a, doc, build_document_tree(doc), a->input, exit_code);
     });
 }

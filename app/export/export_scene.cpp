@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #include <glm/geometric.hpp>
+#include <meshoptimizer.h>
 
 #include "app/export/billboard.h"
 #include "core/errors.h"
@@ -137,6 +139,39 @@ std::vector<glm::vec4> bark_tangents(const SurfaceGeometry& g)
 
 } // namespace
 
+namespace {
+
+/// Reorders a part's triangles for the post-transform vertex cache, then for overdraw, then
+/// its vertices for fetch (meshoptimizer): the same triangles, in another order.
+void optimize_part(ExportPart& part)
+{
+    SurfaceGeometry& g = part.geometry;
+    const std::size_t vcount = g.vertex_count(), icount = g.triangles.size() * 3;
+    if (icount == 0) return;
+    std::vector<unsigned int> idx;
+    idx.reserve(icount);
+    for (const auto& t : g.triangles) idx.insert(idx.end(), t.begin(), t.end());
+    meshopt_optimizeVertexCache(idx.data(), idx.data(), icount, vcount);
+    meshopt_optimizeOverdraw(idx.data(), idx.data(), icount, &g.positions[0].x, vcount, sizeof(glm::vec3), 1.05f);
+    std::vector<unsigned int> remap(vcount);
+    const std::size_t unique = meshopt_optimizeVertexFetchRemap(remap.data(), idx.data(), icount, vcount);
+    meshopt_remapIndexBuffer(idx.data(), idx.data(), icount, remap.data());
+    auto apply = [&](auto& v) {
+        using T = typename std::decay_t<decltype(v)>::value_type;
+        std::vector<T> out(vcount);
+        meshopt_remapVertexBuffer(out.data(), v.data(), vcount, sizeof(T), remap.data());
+        out.resize(unique);
+        v = std::move(out);
+    };
+    apply(g.positions);
+    apply(g.normals);
+    apply(g.uvs);
+    if (!part.tangents.empty()) apply(part.tangents);
+    for (std::size_t t = 0; t < g.triangles.size(); ++t) g.triangles[t] = {idx[3 * t], idx[3 * t + 1], idx[3 * t + 2]};
+}
+
+} // namespace
+
 bool PreparedExport::has_billboard() const
 {
     return std::any_of(parts.begin(), parts.end(), [](const ExportPart& p) { return p.kind == ExportPart::Kind::Billboard; });
@@ -228,6 +263,9 @@ PreparedExport prepare_export(const ExportScene& scene, const ExportOptions& opt
         if (!l.leaves.empty())
             out.parts.push_back(make_part(l.leaves, ExportPart::Kind::Leaves, lod, scene.name, scene.base, scale));
     }
+
+    if (options.optimize)
+        for (ExportPart& part : out.parts) optimize_part(part);
 
     if (options.include_lobes) {
         for (std::size_t i = 0; i < scene.lobes.size(); ++i) {

@@ -52,6 +52,9 @@ struct ExportOptions {
     /// .glb only (the OBJ ignores it): quantized vertex data (KHR_mesh_quantization) and
     /// meshopt-compressed buffer views (EXT_meshopt_compression), both required extensions.
     bool compress = false;
+    /// .glb only: quantized vertex data (KHR_mesh_quantization, required) without meshopt
+    /// compression: smaller, and read by importers without EXT_meshopt_compression (Blender).
+    bool quantize = false;
     bool include_lobes = false;   ///< write ExportScene::lobes
     bool include_strokes = false; ///< write ExportScene::strokes (those with two points or more)
 };

@@ -90,7 +90,7 @@ std::string wrote_line(const std::vector<std::string>& files)
     return files.size() > 1 ? out + ")" : out;
 }
 
-std::vector<int> parse_lod_list(const std::string& text, int lod_count)
+std::vector<int> parse_lod_list(const std::string& text, int lod_count, bool billboard)
 {
     if (text.empty() || text == "all") return {};
     std::vector<int> out;
@@ -100,9 +100,10 @@ std::vector<int> parse_lod_list(const std::string& text, int lod_count)
         if (item.empty() || item.size() > 2 || !std::all_of(item.begin(), item.end(), [](unsigned char c) { return std::isdigit(c); }))
             throw InvalidInput("--lod: expected \"all\" or LOD indices such as 0 or 0,2 (got '" + text + "')");
         const int lod = std::stoi(item);
-        if (lod >= lod_count)
+        if (lod >= lod_count + (billboard ? 1 : 0))
             throw InvalidInput("--lod: LOD " + item + " does not exist (the tree has LOD0 to LOD" +
-                               std::to_string(lod_count - 1) + "; settings.branches.lod_count)");
+                               std::to_string(lod_count - 1) + "; settings.branches.lod_count" +
+                               (billboard ? ", and the billboard LOD" + std::to_string(lod_count) : std::string()) + ")");
         if (std::find(out.begin(), out.end(), lod) != out.end()) throw InvalidInput("--lod: LOD " + item + " given twice");
         out.push_back(lod);
     }

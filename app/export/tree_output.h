@@ -39,8 +39,9 @@ std::vector<std::string> write_tree_file(const std::string& path, const Document
 /// "wrote a.obj (a.mtl, a_leaf.png, a_bark.png)": a progress line for the files write_tree_file wrote.
 std::string wrote_line(const std::vector<std::string>& files);
 
-/// Parses a --lod value: "all" (every LOD) or comma-separated indices ("0", "0,2").
+/// Parses a --lod value: "all" (every LOD) or comma-separated indices ("0", "0,2"); with
+/// `billboard`, index lod_count names the billboard level.
 /// \throw InvalidInput
-std::vector<int> parse_lod_list(const std::string& text, int lod_count);
+std::vector<int> parse_lod_list(const std::string& text, int lod_count, bool billboard = false);
 
 } // namespace lobe
