@@ -46,8 +46,8 @@ struct ExportOptions {
     /// Also write a tangent-space normal map of the bark, derived from its texture's
     /// brightness (bark_normal_map): glTF normalTexture, OBJ map_Bump.
     bool bark_normal_map = false;
-    /// Reorder every tree mesh for the post-transform vertex cache, then for overdraw, then
-    /// for vertex fetch (meshoptimizer; same triangles, other order).
+    /// Reorder every tree mesh for the post-transform vertex cache, then (the opaque bark
+    /// only) for overdraw, then for vertex fetch (meshoptimizer; same triangles, other order).
     bool optimize = false;
     /// .glb only (the OBJ ignores it): quantized vertex data (KHR_mesh_quantization) and
     /// meshopt-compressed buffer views (EXT_meshopt_compression), both required extensions.
