@@ -4,6 +4,7 @@
 #include <cstring>
 #include <limits>
 #include <cmath>
+#include <cstdint>
 #include <utility>
 #include <sstream>
 #include <string_view>
@@ -241,9 +242,16 @@ public:
 
     int add_mesh_node(const std::string& name, tinygltf::Primitive primitive)
     {
+        std::vector<tinygltf::Primitive> one;
+        one.push_back(std::move(primitive));
+        return add_mesh_node(name, std::move(one));
+    }
+
+    int add_mesh_node(const std::string& name, std::vector<tinygltf::Primitive> primitives)
+    {
         tinygltf::Mesh mesh;
         mesh.name = name;
-        mesh.primitives.push_back(std::move(primitive));
+        mesh.primitives = std::move(primitives);
         model_.meshes.push_back(std::move(mesh));
         tinygltf::Node node;
         node.name = name;
@@ -395,6 +403,54 @@ tinygltf::Material stroke_material(tinygltf::Model& model)
     return m;
 }
 
+/// A piece of a part small enough for 16-bit indices.
+struct PartChunk {
+    SurfaceGeometry geometry;
+    std::vector<glm::vec4> tangents;
+};
+
+/// `part` as pieces of at most 65,535 vertices (16-bit indices, below the restart value),
+/// triangles in order: a new piece starts where the next triangle would need more vertices.
+/// One piece, the part itself, when it fits.
+std::vector<PartChunk> split_for_16_bit(const ExportPart& part)
+{
+    constexpr std::size_t kMax = 65535;
+    const SurfaceGeometry& g = part.geometry;
+    std::vector<PartChunk> out(1);
+    if (g.vertex_count() <= kMax) {
+        out[0].geometry = g;
+        out[0].tangents = part.tangents;
+        return out;
+    }
+    std::vector<std::uint32_t> local(g.vertex_count(), UINT32_MAX);
+    std::vector<std::uint32_t> used; // global indices mapped in the current piece
+    for (const auto& t : g.triangles) {
+        std::size_t fresh = 0;
+        for (std::uint32_t v : t) fresh += local[v] == UINT32_MAX;
+        if (used.size() + fresh > kMax) { // start a new piece
+            for (std::uint32_t v : used) local[v] = UINT32_MAX;
+            used.clear();
+            out.emplace_back();
+        }
+        PartChunk& c = out.back();
+        std::array<std::uint32_t, 3> tri{};
+        for (std::size_t k = 0; k < 3; ++k) {
+            const std::uint32_t v = t[k];
+            if (local[v] == UINT32_MAX) {
+                local[v] = static_cast<std::uint32_t>(c.geometry.positions.size());
+                used.push_back(v);
+                c.geometry.positions.push_back(g.positions[v]);
+                c.geometry.normals.push_back(g.normals[v]);
+                c.geometry.uvs.push_back(g.uvs[v]);
+                if (!part.tangents.empty()) c.tangents.push_back(part.tangents[v]);
+            }
+            tri[k] = local[v];
+        }
+        c.geometry.triangles.push_back(tri);
+    }
+    return out;
+}
+
 /// The tree's parts as children of `root`: float vertex data, or with `compress` quantized
 /// and meshopt-compressed, each part's node carrying the dequantizing transform.
 void add_tree_parts(const PreparedExport& e, GlbBuilder& b, bool compress, tinygltf::Node& root)
@@ -428,27 +484,31 @@ void add_tree_parts(const PreparedExport& e, GlbBuilder& b, bool compress, tinyg
             material = b.add_material(is_billboard ? billboard_material(e, b)
                                       : is_leaves  ? leaf_material(e, b)
                                                    : bark_material(e, b));
-        const SurfaceGeometry& g = part.geometry;
-        tinygltf::Primitive prim;
-        prim.mode = TINYGLTF_MODE_TRIANGLES;
-        prim.material = material;
-        if (compress) {
-            prim.attributes["POSITION"] = b.add_positions_q(g.positions, lo, step);
-            prim.attributes["NORMAL"] = b.add_units_q(&g.normals[0].x, g.normals.size(), 3);
-            const bool bark_uvs = part.kind == ExportPart::Kind::Branches;
-            prim.attributes["TEXCOORD_0"] = b.add_uvs_q(g.uvs, bark_uvs ? b.bark_uv_lo : glm::dvec2(0.0),
-                                                        bark_uvs ? b.bark_uv_extent : glm::dvec2(1.0));
-            if (!part.tangents.empty())
-                prim.attributes["TANGENT"] = b.add_units_q(&part.tangents[0].x, part.tangents.size(), 4);
-            prim.indices = b.add_indices_q(g.triangles, g.vertex_count());
-        } else {
-            prim.attributes["POSITION"] = b.add_vec3(g.positions, true);
-            prim.attributes["NORMAL"] = b.add_vec3(g.normals, false);
-            prim.attributes["TEXCOORD_0"] = b.add_vec2(g.uvs);
-            if (!part.tangents.empty()) prim.attributes["TANGENT"] = b.add_vec4(part.tangents);
-            prim.indices = b.add_indices(g.triangles, g.vertex_count());
+        std::vector<tinygltf::Primitive> prims;
+        for (const PartChunk& chunk : split_for_16_bit(part)) {
+            const SurfaceGeometry& g = chunk.geometry;
+            tinygltf::Primitive prim;
+            prim.mode = TINYGLTF_MODE_TRIANGLES;
+            prim.material = material;
+            if (compress) {
+                prim.attributes["POSITION"] = b.add_positions_q(g.positions, lo, step);
+                prim.attributes["NORMAL"] = b.add_units_q(&g.normals[0].x, g.normals.size(), 3);
+                const bool bark_uvs = part.kind == ExportPart::Kind::Branches;
+                prim.attributes["TEXCOORD_0"] = b.add_uvs_q(g.uvs, bark_uvs ? b.bark_uv_lo : glm::dvec2(0.0),
+                                                            bark_uvs ? b.bark_uv_extent : glm::dvec2(1.0));
+                if (!chunk.tangents.empty())
+                    prim.attributes["TANGENT"] = b.add_units_q(&chunk.tangents[0].x, chunk.tangents.size(), 4);
+                prim.indices = b.add_indices_q(g.triangles, g.vertex_count());
+            } else {
+                prim.attributes["POSITION"] = b.add_vec3(g.positions, true);
+                prim.attributes["NORMAL"] = b.add_vec3(g.normals, false);
+                prim.attributes["TEXCOORD_0"] = b.add_vec2(g.uvs);
+                if (!chunk.tangents.empty()) prim.attributes["TANGENT"] = b.add_vec4(chunk.tangents);
+                prim.indices = b.add_indices(g.triangles, g.vertex_count());
+            }
+            prims.push_back(std::move(prim));
         }
-        const int node = b.add_mesh_node(part.name, std::move(prim));
+        const int node = b.add_mesh_node(part.name, std::move(prims));
         if (compress) {
             b.model().nodes[std::size_t(node)].translation = {lo.x, lo.y, lo.z};
             b.model().nodes[std::size_t(node)].scale = {step, step, step};

@@ -273,12 +273,11 @@ std::vector<glm::vec3> as_vec3(const std::vector<float>& f)
     return out;
 }
 
-/// The triangle mesh of a glTF mesh's first primitive (normals computed when it has none).
-SurfaceGeometry glb_surface(const tinygltf::Model& m, const tinygltf::Mesh& mesh, const std::string& path)
+/// The triangle mesh of one glTF primitive (normals computed when it has none).
+SurfaceGeometry glb_primitive(const tinygltf::Model& m, const tinygltf::Mesh& mesh, const tinygltf::Primitive& p,
+                              const std::string& path)
 {
     SurfaceGeometry g;
-    if (mesh.primitives.empty()) return g;
-    const tinygltf::Primitive& p = mesh.primitives[0];
     if (p.mode != TINYGLTF_MODE_TRIANGLES) return g;
     const auto pos = p.attributes.find("POSITION");
     if (pos == p.attributes.end()) throw FileError(path, "mesh '" + mesh.name + "' has no POSITION");
@@ -304,6 +303,25 @@ SurfaceGeometry glb_surface(const tinygltf::Model& m, const tinygltf::Mesh& mesh
     }
     if (g.normals.size() != g.positions.size() || (!g.uvs.empty() && g.uvs.size() != g.positions.size()))
         throw FileError(path, "mesh '" + mesh.name + "' has attributes of different lengths");
+    return g;
+}
+
+/// The triangle mesh of a glTF mesh: its triangle primitives one after the other (a large
+/// LOD is split into primitives of at most 65,535 vertices, docs/export.md).
+SurfaceGeometry glb_surface(const tinygltf::Model& m, const tinygltf::Mesh& mesh, const std::string& path)
+{
+    SurfaceGeometry g;
+    for (const tinygltf::Primitive& p : mesh.primitives) {
+        const SurfaceGeometry part = glb_primitive(m, mesh, p, path);
+        if (part.empty()) continue;
+        if (!g.empty() && g.uvs.empty() != part.uvs.empty())
+            throw FileError(path, "mesh '" + mesh.name + "' has primitives with and without texture coordinates");
+        const auto offset = static_cast<std::uint32_t>(g.positions.size());
+        g.positions.insert(g.positions.end(), part.positions.begin(), part.positions.end());
+        g.normals.insert(g.normals.end(), part.normals.begin(), part.normals.end());
+        g.uvs.insert(g.uvs.end(), part.uvs.begin(), part.uvs.end());
+        for (const auto& t : part.triangles) g.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+    }
     return g;
 }
 

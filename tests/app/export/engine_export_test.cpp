@@ -186,7 +186,7 @@ std::vector<unsigned char> decode_view(const nlohmann::json& j, const std::uint8
     return out;
 }
 
-TEST(EngineExport, CompressedGlbDecodesToTheSameTreeWithinTheQuantizationStepAndIsLessThanHalfTheSize)
+TEST(EngineExport, CompressedGlbDecodesToTheSameTreeWithinTheQuantizationStepWith16BitIndicesAndIsLessThanHalfTheSize)
 {
     const ExportScene scene = scene_named("tree");
     ExportOptions plain, compressed, quantized;
@@ -204,36 +204,43 @@ TEST(EngineExport, CompressedGlbDecodesToTheSameTreeWithinTheQuantizationStepAnd
         ASSERT_NE(node, j["nodes"].end()) << part.name;
         const double step = (*node)["scale"][0];
         const glm::dvec3 offset((*node)["translation"][0], (*node)["translation"][1], (*node)["translation"][2]);
-        const nlohmann::json& prim = j["meshes"][std::size_t((*node)["mesh"])]["primitives"][0];
-        const nlohmann::json& pos = j["accessors"][std::size_t(prim["attributes"]["POSITION"])];
-        EXPECT_EQ(pos["componentType"], 5123); // UNSIGNED_SHORT
-        const std::vector<unsigned char> p = decode_view(j, bin_of(glb), pos["bufferView"]);
-        std::vector<glm::vec3> positions(part.geometry.vertex_count());
-        for (std::size_t v = 0; v < positions.size(); ++v) {
-            std::uint16_t q[4];
-            std::memcpy(q, p.data() + 8 * v, 8);
-            positions[v] = glm::vec3(offset + step * glm::dvec3(q[0], q[1], q[2]));
-            ASSERT_LE(glm::length(glm::dvec3(positions[v]) - glm::dvec3(part.geometry.positions[v])), step) << part.name << " " << v;
-        }
-        const nlohmann::json& ind = j["accessors"][std::size_t(prim["indices"])];
-        const std::vector<unsigned char> raw_idx = decode_view(j, bin_of(glb), ind["bufferView"]);
-        std::vector<std::uint32_t> idx(ind["count"].get<std::size_t>());
-        for (std::size_t i = 0; i < idx.size(); ++i)
-            if (ind["componentType"] == 5123) {
+        // Every primitive decoded: its quantized positions within one step of the tree's, its
+        // triangles (as quantized corner triples) those of the part, indices 16-bit.
+        auto on_grid = [&](const glm::vec3& p) {
+            return glm::dvec3(std::round((double(p.x) - offset.x) / step), std::round((double(p.y) - offset.y) / step),
+                              std::round((double(p.z) - offset.z) / step));
+        };
+        std::vector<glm::vec3> expected_q;
+        for (const glm::vec3& p : part.geometry.positions) expected_q.push_back(glm::vec3(on_grid(p)));
+        const std::multiset<std::array<float, 9>> expected = triangle_set(expected_q, flat(part.geometry));
+        std::multiset<std::array<float, 9>> got;
+        for (const nlohmann::json& prim : j["meshes"][std::size_t((*node)["mesh"])]["primitives"]) {
+            const nlohmann::json& pos = j["accessors"][std::size_t(prim["attributes"]["POSITION"])];
+            EXPECT_EQ(pos["componentType"], 5123); // UNSIGNED_SHORT
+            const std::vector<unsigned char> p = decode_view(j, bin_of(glb), pos["bufferView"]);
+            std::vector<glm::vec3> positions(pos["count"].get<std::size_t>());
+            for (std::size_t v = 0; v < positions.size(); ++v) {
+                std::uint16_t q[4];
+                std::memcpy(q, p.data() + 8 * v, 8);
+                positions[v] = glm::vec3(q[0], q[1], q[2]);
+            }
+            const nlohmann::json& ind = j["accessors"][std::size_t(prim["indices"])];
+            EXPECT_EQ(ind["componentType"], 5123) << part.name << ": 16-bit indices";
+            const std::vector<unsigned char> raw_idx = decode_view(j, bin_of(glb), ind["bufferView"]);
+            std::vector<std::uint32_t> idx(ind["count"].get<std::size_t>());
+            for (std::size_t i = 0; i < idx.size(); ++i) {
                 std::uint16_t v16 = 0;
                 std::memcpy(&v16, raw_idx.data() + 2 * i, 2);
                 idx[i] = v16;
-            } else {
-                std::memcpy(&idx[i], raw_idx.data() + 4 * i, 4);
             }
-        // The index codec keeps the triangles and their winding but may start each at another corner.
-        auto rotated = [](std::vector<std::uint32_t> v) {
-            for (std::size_t t = 0; t + 2 < v.size(); t += 3)
-                while (v[t] > v[t + 1] || v[t] > v[t + 2]) std::rotate(v.begin() + std::ptrdiff_t(t), v.begin() + std::ptrdiff_t(t) + 1, v.begin() + std::ptrdiff_t(t) + 3);
-            return v;
-        };
-        EXPECT_EQ(rotated(idx), rotated(flat(part.geometry))) << part.name;
-        EXPECT_EQ(ind["componentType"] == 5123, part.geometry.vertex_count() <= 65535) << "16-bit indices where they fit";
+            // (The index codec keeps each triangle's winding but may start it at another corner:
+            // triangle_set rotates each to its smallest corner.)
+            const auto set = triangle_set(positions, idx);
+            got.insert(set.begin(), set.end());
+        }
+        EXPECT_TRUE(got == expected) << part.name;
+        for (std::size_t v = 0; v < part.geometry.vertex_count(); ++v)
+            ASSERT_LE(glm::length(offset + step * glm::dvec3(expected_q[v]) - glm::dvec3(part.geometry.positions[v])), step);
     }
     nlohmann::json report = validate(glb, "compressed");
     EXPECT_EQ(report["issues"]["numErrors"], 0) << test::describe_gltf_issues(report);
@@ -244,6 +251,41 @@ TEST(EngineExport, CompressedGlbDecodesToTheSameTreeWithinTheQuantizationStepAnd
     EXPECT_EQ(report["issues"]["numWarnings"], 0) << test::describe_gltf_issues(report);
     EXPECT_EQ(report["issues"]["numInfos"], 0) << test::describe_gltf_issues(report);
     EXPECT_EQ(encode_glb(scene, compressed), glb) << "same input, same bytes";
+}
+
+TEST(EngineExport, AMeshOfMoreThan65535VerticesIsSplitIntoPrimitivesWith16BitIndices)
+{
+    static const TreeGeometry large = [] {
+        return build_tree_geometry(test::large_test_tree(), BranchSettings{}, LeafSettings{}, 4, "broadleaf");
+    }();
+    ASSERT_GT(large.lods[0].branches.vertex_count(), 65535u);
+    ExportScene scene;
+    scene.name = "large";
+    scene.tree = &large;
+    ExportOptions options;
+    options.lods = {0};
+    const std::vector<std::uint8_t> glb = encode_glb(scene, options);
+    const nlohmann::json j = json_of(glb);
+    std::size_t triangles = 0, vertices = 0, primitives = 0;
+    for (const nlohmann::json& mesh : j["meshes"]) {
+        if (mesh["name"] != "large_branches_LOD0") continue;
+        for (const nlohmann::json& prim : mesh["primitives"]) {
+            ++primitives;
+            const nlohmann::json& ind = j["accessors"][std::size_t(prim["indices"])];
+            EXPECT_EQ(ind["componentType"], 5123);
+            triangles += ind["count"].get<std::size_t>() / 3;
+            const std::size_t count = j["accessors"][std::size_t(prim["attributes"]["POSITION"])]["count"];
+            EXPECT_LE(count, 65535u);
+            vertices += count;
+        }
+    }
+    EXPECT_GE(primitives, 2u);
+    EXPECT_EQ(triangles, large.lods[0].branches.triangle_count());
+    EXPECT_GE(vertices, large.lods[0].branches.vertex_count()); // seams repeat a few vertices
+    EXPECT_LT(vertices, large.lods[0].branches.vertex_count() * 11 / 10);
+    const nlohmann::json report = validate(glb, "split");
+    EXPECT_EQ(report["issues"]["numErrors"], 0) << test::describe_gltf_issues(report);
+    EXPECT_EQ(report["issues"]["numWarnings"], 0) << test::describe_gltf_issues(report);
 }
 
 TEST(EngineExport, BarkNormalMapComesWithUnitTangentsAcrossTheBranches)

@@ -569,16 +569,24 @@ TEST(ExportGltf, BufferViewsAreFourByteAlignedAndIndicesUseTheSmallestType)
     EXPECT_EQ(m.accessors.at(std::size_t(primitive_of(m, "tree_branches_LOD0").indices)).componentType,
               TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT);
 
-    // 301 × 301 grid vertices: beyond 16-bit indices.
+    // 301 × 301 grid vertices: beyond 16-bit indices, so the mesh is split into primitives
+    // of at most 65,535 vertices, each with 16-bit indices.
     TreeGeometry big;
     big.lods.emplace_back();
     big.lods[0].branches = cylinder(kBase, kBase + glm::vec3(0, 3, 0), 0.2f, 300, 300);
     ASSERT_GT(big.lods[0].branches.vertex_count(), 65535u);
     const tinygltf::Model mb = load_glb(encode_glb(scene_of(big)));
-    const tinygltf::Primitive& p = primitive_of(mb, "tree_branches_LOD0");
-    EXPECT_EQ(mb.accessors.at(std::size_t(p.indices)).componentType, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT);
-    const std::vector<std::uint32_t> idx = read_indices(mb, p.indices);
-    EXPECT_EQ(*std::max_element(idx.begin(), idx.end()), big.lods[0].branches.vertex_count() - 1);
+    const auto mesh = std::find_if(mb.meshes.begin(), mb.meshes.end(), [](const tinygltf::Mesh& x) { return x.name == "tree_branches_LOD0"; });
+    ASSERT_NE(mesh, mb.meshes.end());
+    EXPECT_EQ(mesh->primitives.size(), 2u);
+    std::size_t triangles = 0;
+    for (const tinygltf::Primitive& p : mesh->primitives) {
+        EXPECT_EQ(mb.accessors.at(std::size_t(p.indices)).componentType, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT);
+        const std::vector<std::uint32_t> idx = read_indices(mb, p.indices);
+        EXPECT_LT(*std::max_element(idx.begin(), idx.end()), 65535u);
+        triangles += idx.size() / 3;
+    }
+    EXPECT_EQ(triangles, big.lods[0].branches.triangle_count());
 }
 
 TEST(ExportGltf, KhronosValidatorReportsNoErrorsForTheTree)
