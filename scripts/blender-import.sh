@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
-# Imports every given .glb into Blender headless (Debian's `blender` and `python3-numpy`
+# Imports every given .glb or .obj into Blender headless (Debian's `blender` and `python3-numpy`
 # packages; not installed by scripts/setup.sh, see docs/export.md) and checks that every mesh node of the file became a
 # Blender object with the triangles the file holds: every LOD, the billboard, the sketch extras.
 # Prints one line per file and exits 1 when an import fails or a mesh is missing or differs.
-#   scripts/blender-import.sh tree.glb [more.glb …]
+# For an .obj, also that every image texture of its materials was found.
+#   scripts/blender-import.sh tree.glb [more.glb tree.obj …]
 set -euo pipefail
 if ! command -v blender >/dev/null; then
   echo "blender-import: blender is not installed (apt-get install --no-install-recommends blender python3-numpy)" >&2
@@ -17,18 +18,30 @@ import numpy
 # Blender 3.4's glTF importer uses numpy.bool, which Debian 12's numpy 1.24 no longer has.
 if not hasattr(numpy, 'bool') or 'bool' in getattr(numpy, '__former_attrs__', {}): numpy.bool = bool
 path = sys.argv[sys.argv.index('--') + 1]
-data = open(path, 'rb').read()
-length = struct.unpack('<I', data[12:16])[0]
-gltf = json.loads(data[20:20 + length])
 expected = {}
-for node in gltf.get('nodes', []):
-    if 'mesh' not in node: continue
-    tris = 0
-    for prim in gltf['meshes'][node['mesh']]['primitives']:
-        if prim.get('mode', 4) == 4: tris += gltf['accessors'][prim['indices']]['count'] // 3
-    expected[node['name']] = tris
 bpy.ops.wm.read_factory_settings(use_empty=True)
-bpy.ops.import_scene.gltf(filepath=path)
+if path.lower().endswith('.obj'):
+    name = None
+    for line in open(path):
+        if line.startswith('o '): name = line[2:].strip(); expected[name] = 0
+        elif line.startswith('f ') and name: expected[name] += 1
+    bpy.ops.wm.obj_import(filepath=path, forward_axis='NEGATIVE_Z', up_axis='Y')
+    # Textures that carry the colour: every textured material's image is found and loaded.
+    for mat in bpy.data.materials:
+        for node in (mat.node_tree.nodes if mat.use_nodes else []):
+            if node.type == 'TEX_IMAGE' and (node.image is None or not node.image.has_data and node.image.size[0] == 0):
+                print('BLENDER-IMPORT missing texture in', mat.name); sys.exit(3)
+else:
+    data = open(path, 'rb').read()
+    length = struct.unpack('<I', data[12:16])[0]
+    gltf = json.loads(data[20:20 + length])
+    for node in gltf.get('nodes', []):
+        if 'mesh' not in node: continue
+        tris = 0
+        for prim in gltf['meshes'][node['mesh']]['primitives']:
+            if prim.get('mode', 4) == 4: tris += gltf['accessors'][prim['indices']]['count'] // 3
+        expected[node['name']] = tris
+    bpy.ops.import_scene.gltf(filepath=path)
 got = {}
 for obj in bpy.data.objects:
     if obj.type != 'MESH': continue
