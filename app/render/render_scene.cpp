@@ -4,10 +4,12 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <set>
 #include <sstream>
 
 #include <glm/geometric.hpp>
+#include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
 #include "core/errors.h"
@@ -365,6 +367,26 @@ RgbaImage material_texture(const tinygltf::Model& m, int material)
 
 } // namespace
 
+/// Refuses, with one line, a .glb whose required extensions the reader below does not
+/// decode: the quantized and compressed exports (docs/export.md).
+void refuse_packed_glb(const std::string& path)
+{
+    std::ifstream in(path, std::ios::binary);
+    char header[20] = {};
+    if (!in.read(header, sizeof header) || std::memcmp(header, "glTF", 4) != 0 || std::memcmp(header + 16, "JSON", 4) != 0) return;
+    std::uint32_t length = 0;
+    std::memcpy(&length, header + 12, 4);
+    if (length > (64u << 20)) return; // tinygltf says what is wrong with it
+    std::string json(length, '\0');
+    if (!in.read(json.data(), static_cast<std::streamsize>(length))) return;
+    const nlohmann::json j = nlohmann::json::parse(json, nullptr, false);
+    if (!j.is_object() || !j.contains("extensionsRequired") || !j["extensionsRequired"].is_array()) return;
+    for (const auto& e : j["extensionsRequired"])
+        if (e == "KHR_mesh_quantization" || e == "EXT_meshopt_compression")
+            throw FileError(path, "written with --quantize or --compress (" + e.get<std::string>() +
+                                      "), which render does not read: export the tree again without them");
+}
+
 RenderScene glb_render_scene(const std::string& path, const RenderContent& content)
 {
     std::error_code ec;
@@ -372,6 +394,7 @@ RenderScene glb_render_scene(const std::string& path, const RenderContent& conte
     // The exporter refuses to write more than 4 GiB; a bigger file is not one of ours.
     if (std::filesystem::file_size(path, ec) > (std::uintmax_t(4) << 30))
         throw FileError(path, "larger than 4 GiB: not a tree exported by Lobesketch");
+    refuse_packed_glb(path);
     tinygltf::TinyGLTF loader;
     tinygltf::Model m;
     std::string err, warning;

@@ -339,6 +339,11 @@ TEST(EngineExport, BadBillboardAndTextureSizesAreABadCommandLine)
         return r;
     }();
     EXPECT_EQ(report["issues"]["numErrors"], 0) << test::describe_gltf_issues(report);
+    // render reads plain exports only, and says so in one line.
+    const test::CliRun render = test::run_cli("render " + dir + "/oak.glb --out " + dir + "/oak.png");
+    EXPECT_EQ(render.code, 1) << render.out;
+    EXPECT_EQ(render.out, "lobesketch: error: " + dir + "/oak.glb: written with --quantize or --compress "
+                          "(KHR_mesh_quantization), which render does not read: export the tree again without them\n");
 }
 
 } // namespace
