@@ -3,7 +3,8 @@
 # packages; not installed by scripts/setup.sh, see docs/export.md) and checks that every mesh node of the file became a
 # Blender object with the triangles the file holds: every LOD, the billboard, the sketch extras.
 # Prints one line per file and exits 1 when an import fails or a mesh is missing or differs.
-# For an .obj, also that every image texture of its materials was found.
+# For an .obj, also that the leaf, bark and billboard materials take their base colour from
+# their PNG (the colours are baked in).
 #   scripts/blender-import.sh tree.glb [more.glb tree.obj …]
 set -euo pipefail
 if ! command -v blender >/dev/null; then
@@ -26,11 +27,16 @@ if path.lower().endswith('.obj'):
         if line.startswith('o '): name = line[2:].strip(); expected[name] = 0
         elif line.startswith('f ') and name: expected[name] += 1
     bpy.ops.wm.obj_import(filepath=path, forward_axis='NEGATIVE_Z', up_axis='Y')
-    # Textures that carry the colour: every textured material's image is found and loaded.
+    # The colour comes from the textures: the leaf and bark materials' base colour is an
+    # image that was found, and white Kd leaves it as it is.
     for mat in bpy.data.materials:
-        for node in (mat.node_tree.nodes if mat.use_nodes else []):
-            if node.type == 'TEX_IMAGE' and (node.image is None or not node.image.has_data and node.image.size[0] == 0):
-                print('BLENDER-IMPORT missing texture in', mat.name); sys.exit(3)
+        if mat.name.split('.')[0] not in ('leaf', 'bark', 'billboard') or not mat.use_nodes: continue
+        bsdf = next((n for n in mat.node_tree.nodes if n.type == 'BSDF_PRINCIPLED'), None)
+        links = bsdf.inputs['Base Color'].links if bsdf else []
+        image = links[0].from_node.image if links and links[0].from_node.type == 'TEX_IMAGE' else None
+        if image is None or image.size[0] == 0:
+            print('BLENDER-IMPORT', mat.name, 'has no base colour texture'); sys.exit(3)
+        print('BLENDER-IMPORT', mat.name, 'base colour from', image.name, tuple(image.size))
 else:
     data = open(path, 'rb').read()
     length = struct.unpack('<I', data[12:16])[0]
@@ -57,7 +63,7 @@ sys.exit(3 if bad or missing else 0)
     echo "$out" | grep -E "BLENDER-IMPORT|Error|error" | head -5
     status=1
   else
-    echo "blender-import: $glb: $(echo "$out" | grep BLENDER-IMPORT | sed 's/^BLENDER-IMPORT //')"
+    echo "$out" | grep BLENDER-IMPORT | sed "s|^BLENDER-IMPORT |blender-import: $glb: |"
   fi
 done
 exit $status
