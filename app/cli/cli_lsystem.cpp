@@ -210,9 +210,11 @@ void add_lsystem_command(CLI::App& app, int& exit_code)
             return;
         }
         const TreeGeometry geometry = document_tree_geometry(g.grown.doc, tree);
-        write_tree_file(a->out, g.grown.doc, tree, geometry, ExportOptions{});
+        ExportOptions options;
+        if (lower_extension(a->out) == ".obj") options.lods = {0}; // one LOD per OBJ, as grow writes
+        const std::vector<std::string> written = write_tree_file(a->out, g.grown.doc, tree, geometry, options);
         progress("triangles " + lod_triangle_summary(geometry));
-        progress("wrote " + a->out);
+        progress(wrote_line(written));
         exit_code = kExitOk;
     });
 }

@@ -7,6 +7,7 @@
 
 #include "app/cli/cli.h"
 #include "app/cli/cli_common.h"
+#include "app/cli/cli_export_options.h"
 #include "app/cli/outputs.h"
 #include "app/export/skeleton_json.h"
 #include "app/export/tree_output.h"
@@ -23,6 +24,7 @@ void add_replay_command(CLI::App& app, int& exit_code)
         std::string rec, out, settings, species;
         std::uint64_t seed = 1;
         double height = 0.0;
+        TreeFileArgs file;
     };
     auto a = std::make_shared<Args>();
     cmd->add_option("REC", a->rec, "Recording (binary or text form)")->required();
@@ -37,6 +39,7 @@ void add_replay_command(CLI::App& app, int& exit_code)
         ->check(species_check());
     cmd->add_option("--height", a->height, "Scale tree.glb to this height in metres, as grow does (0 keeps the sketch's)")
         ->check(finite_range(0.0, 1000.0));
+    add_tree_file_options(cmd, a->file);
     cmd->callback([a, &exit_code] {
         check_input_kind(a->rec, "replay", "a recording; grow, export, render and lobes take session documents and meshes",
                          false, false);
@@ -72,6 +75,7 @@ void add_replay_command(CLI::App& app, int& exit_code)
             const TreeGeometry geometry = document_tree_geometry(out_doc, tree);
             ExportOptions options;
             options.target_height_m = a->height;
+            apply_tree_file_options(a->file, options);
             write_tree_file(a->out + "/tree.glb", out_doc, tree, geometry, options);
             write_skeleton_json(a->out + "/tree.json", tree); // the tree graph, as grow --skeleton-out
             tree_written = true;

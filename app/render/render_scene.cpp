@@ -4,10 +4,12 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <set>
 #include <sstream>
 
 #include <glm/geometric.hpp>
+#include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
 #include "core/errors.h"
@@ -339,12 +341,11 @@ std::vector<glm::vec3> as_vec3(const std::vector<float>& f)
     return out;
 }
 
-/// The triangle mesh of a glTF mesh's first primitive (normals computed when it has none).
-SurfaceGeometry glb_surface(const tinygltf::Model& m, const tinygltf::Mesh& mesh, const std::string& path)
+/// The triangle mesh of one glTF primitive (normals computed when it has none).
+SurfaceGeometry glb_primitive(const tinygltf::Model& m, const tinygltf::Mesh& mesh, const tinygltf::Primitive& p,
+                              const std::string& path)
 {
     SurfaceGeometry g;
-    if (mesh.primitives.empty()) return g;
-    const tinygltf::Primitive& p = mesh.primitives[0];
     if (p.mode != TINYGLTF_MODE_TRIANGLES) return g;
     const auto pos = p.attributes.find("POSITION");
     if (pos == p.attributes.end()) throw FileError(path, "mesh '" + mesh.name + "' has no POSITION");
@@ -370,6 +371,25 @@ SurfaceGeometry glb_surface(const tinygltf::Model& m, const tinygltf::Mesh& mesh
     }
     if (g.normals.size() != g.positions.size() || (!g.uvs.empty() && g.uvs.size() != g.positions.size()))
         throw FileError(path, "mesh '" + mesh.name + "' has attributes of different lengths");
+    return g;
+}
+
+/// The triangle mesh of a glTF mesh: its triangle primitives one after the other (a large
+/// LOD is split into primitives of at most 65,535 vertices, docs/export.md).
+SurfaceGeometry glb_surface(const tinygltf::Model& m, const tinygltf::Mesh& mesh, const std::string& path)
+{
+    SurfaceGeometry g;
+    for (const tinygltf::Primitive& p : mesh.primitives) {
+        const SurfaceGeometry part = glb_primitive(m, mesh, p, path);
+        if (part.empty()) continue;
+        if (!g.empty() && g.uvs.empty() != part.uvs.empty())
+            throw FileError(path, "mesh '" + mesh.name + "' has primitives with and without texture coordinates");
+        const auto offset = static_cast<std::uint32_t>(g.positions.size());
+        g.positions.insert(g.positions.end(), part.positions.begin(), part.positions.end());
+        g.normals.insert(g.normals.end(), part.normals.begin(), part.normals.end());
+        g.uvs.insert(g.uvs.end(), part.uvs.begin(), part.uvs.end());
+        for (const auto& t : part.triangles) g.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+    }
     return g;
 }
 
@@ -413,6 +433,26 @@ RgbaImage material_texture(const tinygltf::Model& m, int material)
 
 } // namespace
 
+/// Refuses, with one line, a .glb whose required extensions the reader below does not
+/// decode: the quantized and compressed exports (docs/export.md).
+void refuse_packed_glb(const std::string& path)
+{
+    std::ifstream in(path, std::ios::binary);
+    char header[20] = {};
+    if (!in.read(header, sizeof header) || std::memcmp(header, "glTF", 4) != 0 || std::memcmp(header + 16, "JSON", 4) != 0) return;
+    std::uint32_t length = 0;
+    std::memcpy(&length, header + 12, 4);
+    if (length > (64u << 20)) return; // tinygltf says what is wrong with it
+    std::string json(length, '\0');
+    if (!in.read(json.data(), static_cast<std::streamsize>(length))) return;
+    const nlohmann::json j = nlohmann::json::parse(json, nullptr, false);
+    if (!j.is_object() || !j.contains("extensionsRequired") || !j["extensionsRequired"].is_array()) return;
+    for (const auto& e : j["extensionsRequired"])
+        if (e == "KHR_mesh_quantization" || e == "EXT_meshopt_compression")
+            throw FileError(path, "written with --quantize or --compress (" + e.get<std::string>() +
+                                      "), which render does not read: export the tree again without them");
+}
+
 RenderScene glb_render_scene(const std::string& path, const RenderContent& content)
 {
     std::error_code ec;
@@ -420,6 +460,7 @@ RenderScene glb_render_scene(const std::string& path, const RenderContent& conte
     // The exporter refuses to write more than 4 GiB; a bigger file is not one of ours.
     if (std::filesystem::file_size(path, ec) > (std::uintmax_t(4) << 30))
         throw FileError(path, "larger than 4 GiB: not a tree exported by Lobesketch");
+    refuse_packed_glb(path);
     tinygltf::TinyGLTF loader;
     tinygltf::Model m;
     std::string err, warning;
@@ -439,23 +480,35 @@ RenderScene glb_render_scene(const std::string& path, const RenderContent& conte
         const tinygltf::Mesh& mesh = m.meshes[std::size_t(node.mesh)];
         const int material = mesh.primitives.empty() ? -1 : mesh.primitives[0].material;
         const std::string& name = node.name;
-        const bool branches = name.rfind("tree_branches_LOD", 0) == 0, leaves = name.rfind("tree_leaves_LOD", 0) == 0;
-        if (branches || leaves) {
-            const std::string digits = name.substr(name.rfind("_LOD") + 4);
-            if (!digits.empty() && digits.size() < 3 && std::all_of(digits.begin(), digits.end(), ::isdigit))
-                lods_found.insert(std::stoi(digits));
-        }
-        if (branches && name == "tree_branches" + lod) {
+        // `<stem>_branches_LOD<k>` and `<stem>_leaves_LOD<k>`, whatever the file's stem.
+        const std::size_t at = name.rfind("_LOD");
+        const std::string digits = at == std::string::npos ? std::string() : name.substr(at + 4);
+        const bool lod_name = !digits.empty() && digits.size() < 3 && std::all_of(digits.begin(), digits.end(), ::isdigit);
+        auto part_is = [&](const std::string& part) {
+            return lod_name && at >= part.size() && name.compare(at - part.size(), part.size(), part) == 0;
+        };
+        const bool branches = part_is("_branches"), leaves = part_is("_leaves"), billboard = part_is("_billboard");
+        if (branches || leaves || billboard) lods_found.insert(std::stoi(digits));
+        if (branches && name.compare(at, std::string::npos, lod) == 0) {
             found_lod = true;
             if (content.tree)
                 add_item(scene, kBranchesKey | std::uint64_t(content.lod), RenderMaterial::Bark,
                          material_color(m, material, {0.36f, 0.25f, 0.17f, 1.0f}), glb_surface(m, mesh, path));
-        } else if (leaves && name == "tree_leaves" + lod) {
+        } else if (leaves && name.compare(at, std::string::npos, lod) == 0) {
             found_lod = true;
             if (content.leaves) {
                 std::array<float, 4> c = material_color(m, material, {0.20f, 0.42f, 0.12f, 1.0f});
                 c[3] = 1.0f;
                 add_item(scene, kLeavesKey | std::uint64_t(content.lod), RenderMaterial::Leaf, c, glb_surface(m, mesh, path));
+                scene.leaf_texture = material_texture(m, material);
+                scene.leaf_texture_version = image_hash(scene.leaf_texture);
+            }
+        } else if (billboard && name.compare(at, std::string::npos, lod) == 0) {
+            // The billboard level: cards drawn as leaves are, with its baked picture.
+            found_lod = true;
+            if (content.tree || content.leaves) {
+                add_item(scene, kLeavesKey | std::uint64_t(content.lod), RenderMaterial::Leaf, {1.0f, 1.0f, 1.0f, 1.0f},
+                         glb_surface(m, mesh, path));
                 scene.leaf_texture = material_texture(m, material);
                 scene.leaf_texture_version = image_hash(scene.leaf_texture);
             }
@@ -469,7 +522,7 @@ RenderScene glb_render_scene(const std::string& path, const RenderContent& conte
     }
     if ((content.tree || content.leaves) && !found_lod) {
         if (lods_found.empty())
-            throw FileError(path, "has no tree_branches_LOD<k> meshes (not a tree exported by Lobesketch?)");
+            throw FileError(path, "has no <name>_branches_LOD<k> meshes (not a tree exported by Lobesketch?)");
         std::string has;
         for (const int k : lods_found) has += (has.empty() ? "LOD" : ", LOD") + std::to_string(k);
         throw FileError(path, "has no LOD" + std::to_string(content.lod) + " (it has " + has + "; pick one with --lod)");

@@ -68,8 +68,8 @@ bool replace_lobe_item(RenderScene& scene, std::size_t index, const TriangleMesh
 /// or scaled live); false when `scene` has no such item.
 bool replace_stroke_item(RenderScene& scene, const Stroke& stroke);
 
-/// The scene of a .glb written by Lobesketch (nodes `tree_branches_LOD<k>`,
-/// `tree_leaves_LOD<k>`, `lobe_<i>`, `stroke_<id>`; docs/export.md): its origin is the trunk
+/// The scene of a .glb written by Lobesketch (nodes `<name>_branches_LOD<k>`,
+/// `<name>_leaves_LOD<k>`, `lobe_<id>`, `stroke_<id>`; docs/export.md): its origin is the trunk
 /// base, so the ground is at y = 0.
 /// \throw FileError when the file cannot be read or has no mesh of LOD `content.lod`.
 RenderScene glb_render_scene(const std::string& path, const RenderContent& content);

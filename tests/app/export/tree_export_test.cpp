@@ -118,8 +118,9 @@ TEST(TreeCli, GrowTakesSeedSplitAngleSpeciesLodAndHeightAndExportRewritesASessio
     ASSERT_EQ(a.code, 0) << a.out;
     const tinygltf::Model m = load_glb(out + "/a.glb");
     const auto names = node_names(m);
-    EXPECT_TRUE(has(names, "tree_branches_LOD0"));
-    EXPECT_FALSE(has(names, "tree_branches_LOD1"));
+    EXPECT_TRUE(has(names, "a_branches_LOD0")); // named by the output's stem
+    EXPECT_FALSE(has(names, "a_branches_LOD1"));
+    EXPECT_FALSE(has(names, "tree_branches_LOD0"));
     double top = -1e30;
     for (const char* part : {"branches_LOD0", "leaves_LOD0"}) top = std::max(top, bounds(m, part).second.y);
     EXPECT_NEAR(top, 8.0, 1e-3);
@@ -129,20 +130,24 @@ TEST(TreeCli, GrowTakesSeedSplitAngleSpeciesLodAndHeightAndExportRewritesASessio
 
     // The same tree from the session that replay wrote: grow and export agree byte for byte.
     ASSERT_EQ(run_cli("replay " + recording + " --out " + out + "/r").code, 0);
-    ASSERT_EQ(run_cli("grow " + out + "/r/session.json --out " + out + "/b.glb --skeleton-out " + out + "/b.json").code, 0);
-    ASSERT_EQ(run_cli("export " + out + "/r/session.json --out " + out + "/c.glb").code, 0);
+    // (Same file name, so the same node names: tree_branches_LOD0, …)
+    fs::create_directories(out + "/b");
+    fs::create_directories(out + "/c");
+    ASSERT_EQ(run_cli("grow " + out + "/r/session.json --out " + out + "/b/tree.glb --skeleton-out " + out + "/b/tree.json").code, 0);
+    ASSERT_EQ(run_cli("export " + out + "/r/session.json --out " + out + "/c/tree.glb").code, 0);
     auto bytes = [](const std::string& p) {
         std::ifstream in(p, std::ios::binary);
         return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
     };
-    EXPECT_EQ(bytes(out + "/b.glb"), bytes(out + "/r/tree.glb"));
-    EXPECT_EQ(bytes(out + "/c.glb"), bytes(out + "/r/tree.glb"));
+    EXPECT_EQ(bytes(out + "/b/tree.glb"), bytes(out + "/r/tree.glb"));
+    EXPECT_EQ(bytes(out + "/c/tree.glb"), bytes(out + "/r/tree.glb"));
     // replay also writes the tree graph, as grow --skeleton-out does.
     EXPECT_FALSE(bytes(out + "/r/tree.json").empty());
-    EXPECT_EQ(bytes(out + "/b.json"), bytes(out + "/r/tree.json"));
+    EXPECT_EQ(bytes(out + "/b/tree.json"), bytes(out + "/r/tree.json"));
     // Another seed, another tree.
-    ASSERT_EQ(run_cli("export " + out + "/r/session.json --seed 2 --out " + out + "/d.glb").code, 0);
-    EXPECT_NE(bytes(out + "/d.glb"), bytes(out + "/c.glb"));
+    fs::create_directories(out + "/d");
+    ASSERT_EQ(run_cli("export " + out + "/r/session.json --seed 2 --out " + out + "/d/tree.glb").code, 0);
+    EXPECT_NE(bytes(out + "/d/tree.glb"), bytes(out + "/c/tree.glb"));
     // OBJ with its material file and leaf texture.
     const CliRun o = run_cli("export " + out + "/r/session.json --out " + out + "/t.obj --lobes --strokes");
     ASSERT_EQ(o.code, 0) << o.out;
@@ -150,6 +155,15 @@ TEST(TreeCli, GrowTakesSeedSplitAngleSpeciesLodAndHeightAndExportRewritesASessio
     EXPECT_TRUE(fs::exists(out + "/t.mtl"));
     EXPECT_TRUE(fs::exists(out + "/t_leaf.png"));
     EXPECT_TRUE(fs::exists(out + "/t_bark.png"));
+    // One LOD per OBJ: LOD0 by default, the output line names every file written.
+    EXPECT_FALSE(fs::exists(out + "/t_LOD1.obj"));
+    EXPECT_NE(o.out.find("wrote " + out + "/t.obj (" + out + "/t.mtl, " + out + "/t_leaf.png, " + out + "/t_bark.png)"),
+              std::string::npos) << o.out;
+    const CliRun o2 = run_cli("export " + out + "/r/session.json --out " + out + "/u.obj --lod 0,2");
+    ASSERT_EQ(o2.code, 0) << o2.out;
+    EXPECT_TRUE(fs::exists(out + "/u_LOD2.obj"));
+    EXPECT_FALSE(fs::exists(out + "/u_LOD1.obj"));
+    EXPECT_NE(o2.out.find(out + "/u_LOD2.obj)"), std::string::npos) << o2.out;
 }
 
 TEST(TreeCli, BadGrowOptionsGiveOneLineAndExitCodes)
