@@ -84,9 +84,10 @@ struct GrowthSettings {
     /// surface along V_A.
     double growth_ratio = 0.45;
     /// A node whose signed distance to the surface along V_A falls below this stops; its
-    /// attractors leave the next iteration.
-    double stop_distance_m = 0.012;
-    /// An attractor is reached (and removed) when a node comes within this distance.
+    /// attractors leave the next iteration. This rule decides where growth ends.
+    double stop_distance_m = 0.025;
+    /// Most distance at which a node reaches (and removes) an attractor; the distance follows
+    /// the node's subtree scale (a quarter of its subtree's length) below it.
     double kill_distance_m = 0.05;
     /// Spacing of skeleton nodes along trunk strokes.
     double skeleton_spacing_m = 0.02;

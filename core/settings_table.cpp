@@ -125,7 +125,8 @@ const std::vector<Field<GrowthSettings>>& growth_fields()
         {"stop_distance_m", &GrowthSettings::stop_distance_m, "[0.001, 0.5]",
          "a node closer than this to the lobe surface along V_A stops; its attractors leave the next iteration"},
         {"kill_distance_m", &GrowthSettings::kill_distance_m, "[0.002, 1]",
-         "an attractor is reached (and removed) when a node comes within this distance"},
+         "most distance at which a node reaches (and removes) an attractor; below it the distance follows the "
+         "node's subtree scale (a quarter of its subtree's length), so the stop rule decides where growth ends"},
         {"skeleton_spacing_m", &GrowthSettings::skeleton_spacing_m, "[0.002, 0.5]",
          "spacing of skeleton nodes along trunk strokes"},
         {"max_iterations", &GrowthSettings::max_iterations, "[1, 1000]", "most growth iterations per lobe"},

@@ -13,6 +13,7 @@
 #include "core/errors.h"
 #include "growth/bark_texture.h"
 #include "growth/leaves.h"
+#include "growth/leaf_lod.h"
 #include "growth/real_scale.h"
 
 namespace lobe {
@@ -809,8 +810,8 @@ BranchMeshOptions branch_lod_options(const BranchSettings& branches, int lod)
 double lod_triangle_budget(int lod)
 {
     if (lod <= 0) return 1.0;
-    if (lod == 1) return 0.45;
-    return 0.135 * std::pow(0.3, lod - 2);
+    if (lod == 1) return 0.27;
+    return 0.072 * std::pow(0.3, lod - 2);
 }
 
 void build_tree_geometry_into(TreeGeometry& geo, const TreeGraph& graph, const BranchSettings& branches,
@@ -819,7 +820,7 @@ void build_tree_geometry_into(TreeGeometry& geo, const TreeGraph& graph, const B
 {
     if (branches.lod_count < 1 || branches.lod_count > 6) throw InvalidInput("tree geometry: lod_count must be in [1, 6]");
     check_mesh_options(branch_lod_options(branches, 0));
-    RgbaImage texture = make_leaf_texture(leaves.shape);
+    RgbaImage texture = make_leaf_atlas(make_leaf_texture(leaves.shape));
     static const RgbaImage bark = make_bark_texture(); // the same for every tree
     const TreeGraph clean = merge_coincident_nodes(graph);
     const std::vector<BranchChain> chains = decompose_branch_chains(clean);
@@ -868,6 +869,7 @@ void build_tree_geometry_into(TreeGeometry& geo, const TreeGraph& graph, const B
         sweep_curves(curves, samples, ranges, std::vector<char>(curves.size(), 1), o.radial_segments, geo.lods[0].branches,
                      scratch, nullptr);
         emit_leaf_quads(cloud, LeafLodOptions{}, geo.lods[0].leaves);
+        use_single_leaf_half(geo.lods[0].leaves);
     }
     const double total0 = static_cast<double>(geo.lods[0].branches.triangle_count() + geo.lods[0].leaves.triangle_count());
     const double leaves0 = static_cast<double>(geo.lods[0].leaves.triangle_count());
@@ -879,10 +881,10 @@ void build_tree_geometry_into(TreeGeometry& geo, const TreeGraph& graph, const B
     for (int lod = 1; lod < branches.lod_count; ++lod) {
         TreeLod& out = geo.lods[static_cast<std::size_t>(lod)];
         const double budget = lod_triangle_budget(lod) * total0;
-        // Leaves: fewer and larger; never more than 80 % of the budget.
-        double keep = leaf_lod_keep_fraction(lod);
-        if (leaves0 > 0.0 && leaves0 * keep > 0.8 * budget) keep = std::max(1e-4, 0.8 * budget / leaves0);
-        emit_leaf_quads(cloud, LeafLodOptions{keep}, out.leaves);
+        // Leaves: merged into cluster cards, as many as leaf_lod_keep_fraction of LOD0's
+        // leaves but never more than 80 % of the budget.
+        const double cards = std::min(leaf_lod_keep_fraction(lod) * leaves0 / 2.0, 0.8 * budget / 2.0);
+        emit_leaf_cluster_cards(cloud, static_cast<std::size_t>(std::max(1.0, std::floor(cards))), out.leaves);
 
         // Branches: coarser rings, then the thickest chains that fit the rest of the budget.
         const BranchMeshOptions o = branch_lod_options(branches, lod);

@@ -127,8 +127,8 @@ TreeGraph prune_twigs(const TreeGraph& graph, float min_radius_m, std::vector<in
 /// build_tree_geometry to meet the triangle budgets.
 BranchMeshOptions branch_lod_options(const BranchSettings& branches, int lod);
 
-/// Share of LOD0's triangles (branches + leaves) that LOD `lod` may use: 1, 0.45, 0.135, then
-/// × 0.3 per further level (10 % below the 50 % and 15 % the LODs must stay under).
+/// Share of LOD0's triangles (branches + leaves) that LOD `lod` may use: 1, 0.27, 0.072, then
+/// × 0.3 per further level (10 % below the 30 % and 8 % that LOD1 and LOD2 must stay under).
 double lod_triangle_budget(int lod);
 
 /// Most triangles LOD0 of a tree may have (branches and leaves), estimated from its rings and
@@ -139,9 +139,11 @@ inline constexpr std::size_t kMaxTreeTriangles = 50000000;
 /// leaf texture of leaves.shape, and the colours. LOD0 uses the settings as they are. Coarser
 /// LODs come from the same smoothed skeleton with the coarser resolution of
 /// branch_lod_options, the thinnest twigs pruned (the largest set of chains, thickest first,
-/// that fits the budget lod_triangle_budget × LOD0's triangles), and fewer, larger leaves
-/// (leaf_lod_keep_fraction, lowered when the leaves alone would take more than 80 % of a
-/// LOD's budget) at the same tips, so the foliage keeps its area and silhouette.
+/// that fits the budget lod_triangle_budget × LOD0's triangles), and the leaves merged into
+/// cluster cards (growth/leaf_lod.h: leaf_lod_keep_fraction × LOD0's leaves, fewer when the
+/// leaves alone would take more than 80 % of a LOD's budget), each card no larger than the
+/// leaves it stands for, so the foliage keeps its silhouette. The leaf texture is the leaf
+/// atlas (make_leaf_atlas): LOD0's leaves use its left half, the cards its right half.
 /// Deterministic: the same inputs give the same bytes.
 /// \throw InvalidInput on an invalid graph (see merge_coincident_nodes), lod_count outside
 /// [1, 6], radial_segments outside [3, 1024], ring_spacing_m ≤ 0, an unknown leaf shape, a

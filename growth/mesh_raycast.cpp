@@ -94,6 +94,7 @@ int MeshRaycaster::build(int begin, int end, std::vector<glm::vec3>& centroids)
     return index;
 }
 
+// `visit` returns the ray's new t_max: the boxes beyond it are not visited.
 template <typename Visit>
 void MeshRaycaster::traverse(const glm::vec3& origin, const glm::vec3& dir, float t_max, Visit&& visit) const
 {
@@ -113,7 +114,7 @@ void MeshRaycaster::traverse(const glm::vec3& origin, const glm::vec3& dir, floa
                 const float h = intersect(origin, dir, mesh_.positions[static_cast<std::size_t>(t[0])],
                                           mesh_.positions[static_cast<std::size_t>(t[1])],
                                           mesh_.positions[static_cast<std::size_t>(t[2])]);
-                if (h > 1e-7f) visit(h);
+                if (h > 1e-7f) t_max = visit(h, t_max);
             }
         } else if (top <= 62) { // median splits keep the depth near log2(F / 4) < 62
             stack[top++] = at + 1;      // left child follows its parent
@@ -125,7 +126,10 @@ void MeshRaycaster::traverse(const glm::vec3& origin, const glm::vec3& dir, floa
 void MeshRaycaster::crossings(const glm::vec3& origin, const glm::vec3& dir, std::vector<float>& out) const
 {
     out.clear();
-    traverse(origin, dir, std::numeric_limits<float>::max(), [&](float t) { out.push_back(t); });
+    traverse(origin, dir, std::numeric_limits<float>::max(), [&](float t, float t_max) {
+        out.push_back(t);
+        return t_max;
+    });
     std::sort(out.begin(), out.end());
     // A ray through a shared edge or vertex hits each triangle there: count the crossing once.
     out.erase(std::unique(out.begin(), out.end(), [](float a, float b) { return b - a < 1e-6f; }), out.end());
@@ -134,8 +138,10 @@ void MeshRaycaster::crossings(const glm::vec3& origin, const glm::vec3& dir, std
 float MeshRaycaster::first_hit(const glm::vec3& origin, const glm::vec3& dir, float t_max) const
 {
     float best = -1.0f;
-    traverse(origin, dir, t_max, [&](float t) {
+    // The nearest crossing so far bounds the search: boxes beyond it are skipped.
+    traverse(origin, dir, t_max, [&](float t, float bound) {
         if (t < t_max && (best < 0.0f || t < best)) best = t;
+        return best >= 0.0f ? std::min(bound, best) : bound;
     });
     return best;
 }
@@ -144,7 +150,7 @@ bool MeshRaycaster::inside(const glm::vec3& p) const
 {
     // A direction no mesh of ours is aligned with, so rays rarely graze edges.
     static const glm::vec3 kDir = glm::normalize(glm::vec3(0.5773f, 0.6211f, 0.5302f));
-    std::vector<float> hits;
+    thread_local std::vector<float> hits;
     crossings(p, kDir, hits);
     return hits.size() % 2 == 1;
 }

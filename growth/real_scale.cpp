@@ -97,18 +97,22 @@ void spread_leaves_along_shoots(LeafCloud& cloud, const TreeGraph& graph, const 
     cloud.leaves = std::move(out);
 }
 
-double fit_pipe_exponent(TreeGraph& graph, double tip_radius_m, double dbh_ratio)
+double fit_pipe_exponent(TreeGraph& graph, double tip_radius_m, double dbh_ratio, bool leader)
 {
+    const auto assign = [&](double e) {
+        if (leader) assign_leader_radii(graph, e, tip_radius_m);
+        else assign_pipe_radii(graph, e, tip_radius_m);
+    };
     const std::vector<std::vector<int>> children = tree_children(graph);
     const double target = dbh_ratio * graph_height(graph);
     double lo = 1.0, hi = 4.0;
     for (int i = 0; i < 40; ++i) {
         const double mid = 0.5 * (lo + hi);
-        assign_pipe_radii(graph, mid, tip_radius_m);
+        assign(mid);
         (trunk_dbh(graph, children) > target ? lo : hi) = mid; // too thick: a larger exponent
     }
     const double e = 0.5 * (lo + hi);
-    assign_pipe_radii(graph, e, tip_radius_m);
+    assign(e);
     return e;
 }
 

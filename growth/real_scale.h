@@ -29,11 +29,12 @@ void scale_tree_structure(TreeGraph& graph, double factor);
 /// they are; no-op when spacing_m is 0.
 void spread_leaves_along_shoots(LeafCloud& cloud, const TreeGraph& graph, const LeafSettings& leaves);
 
-/// Pipe-model radii (growth/radii.h) with tip radius `tip_radius_m` and the exponent in
-/// [1, 4] that brings the trunk's diameter at breast height (trunk_dbh) closest to
-/// `dbh_ratio` × graph_height (bisection, 40 steps: the diameter falls as the exponent
-/// grows). Returns the exponent. \pre dbh_ratio > 0, tip_radius_m > 0.
-double fit_pipe_exponent(TreeGraph& graph, double tip_radius_m, double dbh_ratio);
+/// Pipe-model radii (growth/radii.h: assign_leader_radii when `leader`, else
+/// assign_pipe_radii) with tip radius `tip_radius_m` and the exponent in [1, 4] that brings
+/// the trunk's diameter at breast height (trunk_dbh) closest to `dbh_ratio` × graph_height
+/// (bisection, 40 steps: the diameter falls as the exponent grows). Returns the exponent.
+/// \pre dbh_ratio > 0, tip_radius_m > 0.
+double fit_pipe_exponent(TreeGraph& graph, double tip_radius_m, double dbh_ratio, bool leader);
 
 /// How many leaves the tips of `graph` carry with `most` leaves per tip, spread as
 /// spread_leaves_along_shoots would (an upper bound for the triangle estimate).

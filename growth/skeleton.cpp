@@ -5,6 +5,7 @@
 #include <limits>
 #include <optional>
 
+#include <glm/common.hpp>
 #include <glm/geometric.hpp>
 
 #include "growth/mesh_raycast.h"
@@ -15,6 +16,8 @@ namespace lobe {
 namespace {
 
 constexpr float kTouchDistance = 0.05f;
+// A trunk stroke farther than this from every lobe's box is reported (it carries no branches).
+constexpr float kFarFromLobes = 0.3f;
 
 bool finite(const glm::vec3& p)
 {
@@ -130,6 +133,25 @@ private:
     double spacing_;
 };
 
+/// An excurrent tree (SkeletonOptions::leader): the trunk goes on from its highest point up
+/// through the crown (default_leader_points).
+void add_leader(Builder& b, const Skeleton& s, const std::vector<TriangleMesh>& lobes, const std::vector<LobeBox>& boxes,
+                const SkeletonOptions& options)
+{
+    glm::vec3 lo(std::numeric_limits<float>::max()), hi = -lo;
+    for (std::size_t i = 0; i < lobes.size(); ++i) {
+        if (lobes[i].positions.empty()) continue;
+        lo = glm::min(lo, boxes[i].lo);
+        hi = glm::max(hi, boxes[i].hi);
+    }
+    if (s.graph.nodes.empty() || !(lo.y <= hi.y)) return;
+    std::size_t top = 0;
+    for (std::size_t i = 0; i < s.graph.nodes.size(); ++i)
+        if (s.owner[i] == -1 && s.graph.nodes[i].position.y > s.graph.nodes[top].position.y) top = i;
+    b.chain(static_cast<int>(top),
+            default_leader_points(s.graph.nodes[top].position, lo.y, hi.y, options.whorl_spacing, options.spacing_m), -1);
+}
+
 } // namespace
 
 Skeleton build_skeleton(const std::vector<std::vector<glm::vec3>>& trunk_strokes,
@@ -141,6 +163,7 @@ Skeleton build_skeleton(const std::vector<std::vector<glm::vec3>>& trunk_strokes
 
     // Usable strokes: finite points, at least two, longer than the spacing.
     std::vector<std::vector<glm::vec3>> strokes;
+    std::vector<std::size_t> stroke_number; // 1-based, in the caller's list
     for (std::size_t i = 0; i < trunk_strokes.size(); ++i) {
         if (strokes.size() >= kMaxTrunkStrokes) {
             s.messages.push_back("trunk strokes beyond the first " + std::to_string(kMaxTrunkStrokes) + " are left out");
@@ -154,6 +177,7 @@ Skeleton build_skeleton(const std::vector<std::vector<glm::vec3>>& trunk_strokes
             continue;
         }
         strokes.push_back(std::move(pts));
+        stroke_number.push_back(i + 1);
     }
     // Keep the node count bounded however long the strokes are.
     double total = 0.0;
@@ -166,6 +190,19 @@ Skeleton build_skeleton(const std::vector<std::vector<glm::vec3>>& trunk_strokes
 
     std::vector<LobeBox> boxes;
     for (const TriangleMesh& m : lobes) boxes.push_back(lobe_box(m));
+    // A stroke far from every lobe joins the skeleton but carries no branches: say so.
+    if (!lobes.empty())
+        for (std::size_t i = 0; i < strokes.size(); ++i) {
+            float nearest = std::numeric_limits<float>::max();
+            for (const glm::vec3& p : strokes[i])
+                for (std::size_t l = 0; l < lobes.size(); ++l)
+                    if (!lobes[l].positions.empty())
+                        nearest = std::min(nearest, glm::length(glm::max(glm::max(boxes[l].lo - p, p - boxes[l].hi), glm::vec3(0.0f))));
+            if (nearest > kFarFromLobes)
+                s.messages.push_back("trunk stroke " + std::to_string(stroke_number[i]) + " is more than " +
+                                     std::to_string(static_cast<int>(kFarFromLobes * 100)) +
+                                     " cm from every lobe: it grows no branches");
+        }
 
     if (!strokes.empty()) {
         s.from_strokes = true;
@@ -186,27 +223,35 @@ Skeleton build_skeleton(const std::vector<std::vector<glm::vec3>>& trunk_strokes
         std::vector<std::vector<glm::vec3>> rest;
         for (std::size_t i = 0; i < strokes.size(); ++i)
             if (i != main) rest.push_back(resample(strokes[i], spacing));
-        // The others join one by one, the nearest to the skeleton first, at their nearest point.
+        // The others join one by one, the nearest to the skeleton first (§5.1): each at the
+        // skeleton node nearest the stroke, through the stroke's point nearest that node. A
+        // stroke that touches the skeleton at an end grows from there; one that touches it in
+        // its middle grows both ways from there.
         while (!rest.empty()) {
-            std::size_t pick = 0;
-            bool pick_back = false;
+            std::size_t pick = 0, at = 0;
             int attach = 0;
             float best = std::numeric_limits<float>::max();
             for (std::size_t i = 0; i < rest.size(); ++i)
-                for (int end = 0; end < 2; ++end) {
+                for (std::size_t k = 0; k < rest[i].size(); ++k) {
                     float d = 0.0f;
-                    const int n = b.nearest(end == 0 ? rest[i].front() : rest[i].back(), &d);
+                    const int n = b.nearest(rest[i][k], &d);
                     if (d < best) {
                         best = d;
                         pick = i;
-                        pick_back = end == 1;
+                        at = k;
                         attach = n;
                     }
                 }
             std::vector<glm::vec3> st = std::move(rest[pick]);
             rest.erase(rest.begin() + static_cast<std::ptrdiff_t>(pick));
-            if (pick_back) std::reverse(st.begin(), st.end());
-            b.chain(attach, st, -1);
+            // The longer side from the attachment point first (it continues the joint).
+            std::vector<glm::vec3> ahead(st.begin() + static_cast<std::ptrdiff_t>(at), st.end());
+            std::vector<glm::vec3> behind(st.begin(), st.begin() + static_cast<std::ptrdiff_t>(at) + 1);
+            std::reverse(behind.begin(), behind.end());
+            if (polyline_length(behind) > polyline_length(ahead)) std::swap(ahead, behind);
+            const int joint = b.chain(attach, {ahead.front()}, -1);
+            b.chain(joint, ahead, -1);
+            if (behind.size() >= 2 && polyline_length(behind) >= 0.5 * spacing) b.chain(joint, behind, -1);
         }
     } else if (!lobes.empty()) {
         // Default trunk: from the ground below the lobes up to a fork under the lowest lobe.
@@ -231,20 +276,7 @@ Skeleton build_skeleton(const std::vector<std::vector<glm::vec3>>& trunk_strokes
         return s;
     }
 
-    if (options.leader && !lobes.empty()) {
-        // An excurrent tree: the trunk goes on from its highest point up through the crown.
-        glm::vec3 lo(std::numeric_limits<float>::max()), hi = -lo;
-        for (std::size_t i = 0; i < lobes.size(); ++i) {
-            if (lobes[i].positions.empty()) continue;
-            lo = glm::min(lo, boxes[i].lo);
-            hi = glm::max(hi, boxes[i].hi);
-        }
-        std::size_t top = 0;
-        for (std::size_t i = 0; i < s.graph.nodes.size(); ++i)
-            if (s.owner[i] == -1 && s.graph.nodes[i].position.y > s.graph.nodes[top].position.y) top = i;
-        if (lo.y <= hi.y)
-            b.chain(static_cast<int>(top), default_leader_points(s.graph.nodes[top].position, lo.y, hi.y, options.whorl_spacing, options.spacing_m), -1);
-    }
+    if (options.leader) add_leader(b, s, lobes, boxes, options);
 
     // Every lobe must be reached: a lobe that no skeleton node enters gets a limb to its centre.
     for (std::size_t l = 0; l < lobes.size(); ++l) {

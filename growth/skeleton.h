@@ -2,8 +2,10 @@
 /// \file skeleton.h
 /// The tree's skeleton from the sketched trunk strokes (§5.1): the stroke with the lowest
 /// point becomes the main branch, rooted at its lower end (the trunk base, on the ground);
-/// the other strokes join one by one, the one nearest the skeleton first, at their nearest
-/// point on it. With no trunk strokes a default trunk rises from the ground below the lobes
+/// the other strokes join one by one, the one nearest the skeleton first, at the skeleton node
+/// nearest the stroke, through the stroke's point nearest it (an end, or a point in its middle:
+/// then the stroke grows both ways from there). A stroke more than 30 cm from every lobe is
+/// kept, with a message. With no trunk strokes a default trunk rises from the ground below the lobes
 /// and reaches into each of them. A lobe that no skeleton node enters gets a limb from the
 /// nearest skeleton node to its centre, with a message when the trunk stays more than 5 cm
 /// from it (a stroke ending just short of a lobe touches it). docs/growth.md.

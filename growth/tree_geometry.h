@@ -41,7 +41,7 @@ struct TreeLod {
 
 struct TreeGeometry {
     std::vector<TreeLod> lods; ///< LOD0 (finest) first
-    RgbaImage leaf_texture;    ///< alpha-tested (alpha 0 outside the leaf)
+    RgbaImage leaf_texture;    ///< alpha-tested (alpha 0 outside the leaves): the leaf atlas, one leaf left, a spray right (growth/leaf_lod.h)
     RgbaImage bark_texture;    ///< tiles (REPEAT) over the bark UVs; multiplied by bark_color; may be empty
     std::array<float, 3> bark_color{0.36f, 0.25f, 0.17f}; ///< linear RGB
     std::array<float, 3> leaf_color{0.20f, 0.42f, 0.12f}; ///< linear RGB (multiplies the texture)

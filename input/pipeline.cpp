@@ -103,6 +103,14 @@ void InputPipeline::push_event(const InputEvent& event)
         return;
     }
     if (event.kind != InputEventKind::Key || event.value != 1) return; // act on key presses
+    if (event.code == keys::kLSystemSketch) {
+        // The mode takes the hands: a stroke being drawn ends where it is.
+        lsystem_sketch_ = !lsystem_sketch_;
+        for (int h = 0; h < kHandCount; ++h)
+            if (pen_[h].down) pen_up(h, pen_[h].last_good_t);
+        return;
+    }
+    if (lsystem_sketch_) return;
     auto set_tool = [&](Tool t) {
         tool_ = t;
         a.type = InputAction::Type::ToolChanged;
@@ -214,6 +222,7 @@ void InputPipeline::push_frame(const HandFrame& frame)
     for (int h = 0; h < kHandCount; ++h) {
         const HandGesture& g = gs[h];
         Pen& pen = pen_[h];
+        if (lsystem_sketch_) continue; // the L-system sketch mode's hands
         if (g.pinch_ended) {
             // A long loss ends the stroke at its last tracked point, the release where it was.
             pen_up(h, g.tracked ? frame.time : pen.last_good_t);

@@ -106,6 +106,9 @@ public:
     std::vector<InputAction> take_actions();
     const GestureRecognizer& gestures() const { return gestures_; }
     Tool tool() const { return tool_; }
+    /// The L-system sketch mode is on (keys::kLSystemSketch toggles it): pinches draw
+    /// nothing and other keys do nothing here.
+    bool lsystem_sketch() const { return lsystem_sketch_; }
     /// Where the document sits in stage space (Scene events).
     const SceneTransform& scene_transform() const { return scene_; }
     /// True while `hand` is drawing; `current_stroke` then holds the points so far.
@@ -140,6 +143,7 @@ private:
     InputOptions options_;
     GestureRecognizer gestures_;
     Tool tool_ = Tool::DrawLobe;
+    bool lsystem_sketch_ = false;
     std::array<Pen, kHandCount> pen_{};
     std::int64_t next_stroke_id_ = 1;
     double last_time_ = 0.0;

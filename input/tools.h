@@ -31,6 +31,9 @@ inline constexpr int kScaleLobe = 75;  // GLFW_KEY_K (S is the desktop app's sav
 inline constexpr int kGrow = 71;       // GLFW_KEY_G
 inline constexpr int kUndo = 90;       // GLFW_KEY_Z
 inline constexpr int kRedo = 89;       // GLFW_KEY_Y
+/// GLFW_KEY_P: the L-system sketch mode on / off (app/live/lsystem_sketch_mode.h). While it is
+/// on the pipeline draws nothing and acts on no other key: the hands and keys are the mode's.
+inline constexpr int kLSystemSketch = 80;
 // Actions on what the fingertip is at when the key is pressed (docs/editing.md, "Delete,
 // duplicate, mirror"): the right hand's filtered index tip, else the left hand's.
 inline constexpr int kDeleteStroke = 259; // GLFW_KEY_BACKSPACE: delete the stroke under the fingertip

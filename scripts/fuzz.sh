@@ -25,7 +25,7 @@ declare -A MAX_LEN=(
   [import_leap]=16384 [import_webxr]=16384
   [document]=16384 [settings]=8192 [species]=4096
   [mesh_obj]=8192 [mesh_ply]=8192 [mesh_off]=8192 [mesh_repair]=4096 [hole_fill]=1024 [lobe_strokes]=128
-  [desktop_script]=4096 [scenario]=8192 [lsystem]=4096
+  [desktop_script]=4096 [scenario]=8192 [lsystem]=4096 [lsystem_sketch]=4096
 )
 # target → seconds one input may take (LOBE_FUZZ_TIMEOUT sets every target's): a lobe of six
 # strokes, each built twice (continued and whole) and checked for self-intersections, takes
@@ -33,7 +33,7 @@ declare -A MAX_LEN=(
 # bisected, and by whole triangles; docs/lobes-from-models.md, step 5): the slowest seed takes
 # 19 s under ASan (1.4 s in release), the slowest input found so far 34 s (3.5 s).
 declare -A TIMEOUT=([lobe_strokes]=30 [hole_fill]=45)
-ALL=(recording_binary recording_text import_leap import_webxr document settings species lsystem mesh_obj mesh_ply mesh_off mesh_repair hole_fill lobe_strokes desktop_script scenario)
+ALL=(recording_binary recording_text import_leap import_webxr document settings species lsystem lsystem_sketch mesh_obj mesh_ply mesh_off mesh_repair hole_fill lobe_strokes desktop_script scenario)
 TARGETS=("$@")
 [ ${#TARGETS[@]} -eq 0 ] && TARGETS=("${ALL[@]}")
 

@@ -11,7 +11,7 @@ if [[ ! -x "$CLI" ]]; then
   exit 1
 fi
 shopt -s nullglob
-scenarios=(recordings/*.scenario.json)
+scenarios=(recordings/*.scenario.json recordings/lsystem-sketch/*.scenario.json)
 if (( ${#scenarios[@]} == 0 )); then
   echo "make-recordings: no recordings/*.scenario.json" >&2
   exit 1

@@ -39,6 +39,10 @@ capture() { # BIN OUT
     "$bin" grow ../shared/data/models/stanford-bunny.obj --out "$out/grow/bunny.glb" >/dev/null 2>&1
   "$bin" grow recordings/demo.lrec --species conifer --seed 7 --out "$out/grow/demo-conifer.glb" >/dev/null 2>&1
   "$bin" grow recordings/demo.lrec --out "$out/grow/demo.obj" >/dev/null 2>&1
+  "$bin" grow recordings/demo.lrec --out "$out/grow/demo-all.obj" --lod all --bark-normal-map >/dev/null 2>&1
+  "$bin" grow recordings/demo.lrec --out "$out/grow/demo-compressed.glb" --compress --bark-normal-map \
+    --texture-size 256 --billboard 512 >/dev/null 2>&1
+  "$bin" grow recordings/demo.lrec --out "$out/grow/demo-quantized.glb" --quantize >/dev/null 2>&1
   "$bin" lobes recordings/table1-3lobes-16strokes.lrec --out "$out/lobes" >/dev/null 2>&1
   for s in recordings/*.scenario.json; do
     n="$(basename "$s" .scenario.json)"

@@ -17,7 +17,7 @@ PACKAGES=(
   build-essential cmake ninja-build ccache pkg-config git
   nlohmann-json3-dev libcli11-dev libglm-dev libeigen3-dev
   libcgal-dev libopenmesh-dev libgmp-dev libmpfr-dev
-  libnanoflann-dev libtinygltf-dev libstb-dev
+  libnanoflann-dev libtinygltf-dev libstb-dev libmeshoptimizer-dev
   libvulkan-dev mesa-vulkan-drivers glslc libopenxr-dev libopenxr-loader1
   libglfw3-dev libimgui-dev
 )

@@ -24,11 +24,16 @@ for rec in recordings/*.lrec; do
     "./build/$build/app/lobesketch" replay "$rec" --out "$replays/$build/$name" >/dev/null
   done
 done
-# The other growers too: a self-organizing tree in the demo's lobes and a stochastic L-system.
+# The other growers too: a self-organizing tree in the demo's lobes, a stochastic L-system and
+# a sketched one.
 for build in release asan; do
   "./build/$build/app/lobesketch" grow recordings/demo.lrec --grower self-organizing \
     --out "$replays/$build/demo-self-organizing.glb" >/dev/null
   "./build/$build/app/lobesketch" lsystem willow --seed 5 --out "$replays/$build/willow.glb" >/dev/null
+  # A sketched L-system tree: the live mode's recording replayed, its rules, sketch and tree.
+  "./build/$build/app/lobesketch" lsystem --sketch recordings/lsystem-sketch/maple.lrec --growth 14 \
+    --rules-out "$replays/$build/maple-sketch.l" --sketch-out "$replays/$build/maple-sketch.json" \
+    --out "$replays/$build/maple-sketch.glb" >/dev/null 2>&1
 done
 diff -r "$replays/release" "$replays/asan" >/dev/null ||
   { echo "the release and asan builds replay a recording to different bytes:" >&2; diff -rq "$replays/release" "$replays/asan" >&2; exit 1; }

@@ -9,6 +9,7 @@
 #include "app/session/session_file.h"
 #include "app/cli/cli.h"
 #include "app/cli/cli_common.h"
+#include "app/cli/cli_export_options.h"
 #include "app/export/tree_output.h"
 #include "app/export/export_scene.h"
 #include "app/export/skeleton_json.h"
@@ -23,15 +24,17 @@ namespace {
 
 struct TreeArgs {
     TreeInputOptions in;
-    std::string input, out, lod = "all", report, skeleton_out;
+    std::string input, out, lod, report, skeleton_out; // lod empty: the format's default
     bool lobes = false, strokes = false;
+    TreeFileArgs file;
 };
 
 void add_tree_options(CLI::App* cmd, TreeArgs& a)
 {
     add_tree_input_options(cmd, a.in);
-    cmd->add_option("--lod", a.lod, "LODs to write: all, or indices such as 0 or 0,2")
-        ->capture_default_str()
+    cmd->add_option("--lod", a.lod,
+                    "LODs to write: all, or indices such as 0 or 0,2 (default: all in a .glb, LOD0 in an .obj; "
+                    "an .obj holds one LOD, the others go to NAME_LODk.obj)")
         ->check(CLI::Validator(
             [](std::string& text) {
                 // The form here; whether each LOD exists is known once the settings are.
@@ -49,6 +52,7 @@ void add_tree_options(CLI::App* cmd, TreeArgs& a)
                     "Real scale: the tree's structure is scaled to this height in metres, its leaves and twigs keep "
                     "the species' sizes (settings.growth.height_m; 0 or none: the session's, else as sketched)")
         ->check(finite_range(0.0, 1000.0));
+    add_tree_file_options(cmd, a.file);
     cmd->add_flag("--lobes", a.lobes, "Also write the lobes as extra nodes");
     cmd->add_flag("--strokes", a.strokes, "Also write the strokes as extra nodes");
     cmd->add_option("--report", a.report,
@@ -89,10 +93,12 @@ void report_and_write(const TreeArgs& a, const Document& doc, const BuiltTree& t
     const TreeGeometry geometry = document_tree_geometry(doc, tree);
     const double geometry_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     ExportOptions options;
-    options.lods = parse_lod_list(a.lod, static_cast<int>(geometry.lods.size()));
+    options.lods = parse_lod_list(a.lod, static_cast<int>(geometry.lods.size()), a.file.billboard > 0);
+    if (a.lod.empty() && lower_extension(a.out) == ".obj") options.lods = {0}; // one LOD per OBJ
+    apply_tree_file_options(a.file, options);
     options.include_lobes = a.lobes;
     options.include_strokes = a.strokes;
-    write_tree_file(a.out, doc, tree, geometry, options);
+    const std::vector<std::string> written = write_tree_file(a.out, doc, tree, geometry, options);
     if (!a.report.empty()) {
         write_file_atomic(a.report, wood_report(a, doc, tree, geometry));
         progress("wrote " + a.report);
@@ -101,19 +107,21 @@ void report_and_write(const TreeArgs& a, const Document& doc, const BuiltTree& t
         write_skeleton_json(a.skeleton_out, tree);
         progress("wrote " + a.skeleton_out);
     }
-    std::size_t attractors = 0, reached = 0;
+    std::size_t attractors = 0, reached = 0, stopped = 0;
     for (const LobeGrowthStats& l : tree.growth.lobes) {
         attractors += l.attractors;
         reached += l.reached;
+        stopped += l.stopped;
     }
     if (attractors > 0)
         progress("grew " + std::to_string(tree.growth.tree.size()) + " nodes in " + std::to_string(tree.lobes.size()) +
-                 " lobe(s), " + std::to_string(reached) + " of " + std::to_string(attractors) + " attractors reached");
+                 " lobe(s); of " + std::to_string(attractors) + " attractors " + std::to_string(stopped) +
+                 " ended by the stop rule, " + std::to_string(reached) + " reached");
     else
         progress("grew " + std::to_string(tree.growth.tree.size()) + " nodes (" + std::to_string(tree.lobes.size()) +
                  " lobe(s))");
     progress("geometry in " + std::to_string(static_cast<int>(geometry_ms)) + " ms, triangles " + lod_triangle_summary(geometry));
-    progress("wrote " + a.out);
+    progress(wrote_line(written));
     exit_code = kExitOk;
 }
 
@@ -153,7 +161,7 @@ void add_grow_command(CLI::App& app, int& exit_code)
         require_outputs_folders(*a);
         // The LODs asked for exist: known before growing for a session or a mesh.
         const GrownInput grown = grow_input_tree(a->input, a->in, [a](const Document& doc) {
-            parse_lod_list(a->lod, doc.settings.branches.lod_count);
+            parse_lod_list(a->lod, doc.settings.branches.lod_count, a->file.billboard > 0);
         });
         report_and_write(*a, grown.doc, grown.tree, a->input, exit_code);
     });
@@ -182,7 +190,7 @@ void add_export_command(CLI::App& app, int& exit_code)
         if (!a->in.settings.empty()) doc.settings = load_settings_file(a->in.settings);
         apply_tree_input_options(doc.settings, a->in);
         apply_document_options(doc, a->in);
-        parse_lod_list(a->lod, doc.settings.branches.lod_count); // the LODs asked for exist, before growing
+        parse_lod_list(a->lod, doc.settings.branches.lod_count, a->file.billboard > 0); // the LODs asked for exist, before growing
         BuiltTree tree = build_document_tree(doc);
         apply_real_scale(doc, tree);
         report_and_write(*a, doc, tree, a->input, exit_code);

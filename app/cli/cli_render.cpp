@@ -73,7 +73,8 @@ void add_render_command(CLI::App& app, int& exit_code)
                 return parse_size(s, w, h) ? std::string() : "expected WxH with each side 16 to 8192 (got '" + s + "')";
             },
             "WxH"));
-    cmd->add_option("--show", a->show, "What to draw, comma-separated: tree, leaves, lobes, strokes")
+    cmd->add_option("--show", a->show, "What to draw, comma-separated: tree, leaves, lobes, strokes, clusters (the first growth "
+                    "iteration's attractor clusters, each piece in its own colour)")
         ->capture_default_str()
         ->check(CLI::Validator(
             [](std::string& s) {
@@ -119,6 +120,7 @@ void add_render_command(CLI::App& app, int& exit_code)
                 a->in.seed || a->in.split_angle || a->in.spacing)
                 warn(a->input + ": a .glb holds a grown tree; --settings, --species, --grower, --set, --seed, "
                                 "--split-angle and --attractor-spacing do not apply");
+            if (content.clusters) warn(a->input + ": --show clusters: a .glb holds no attractor clusters");
             scene = glb_render_scene(a->input, content);
         } else {
             // An L-system file grows alone (its messages printed as it grows); anything else
@@ -140,6 +142,11 @@ void add_render_command(CLI::App& app, int& exit_code)
             std::vector<Stroke> strokes;
             if (content.strokes) strokes = effective_strokes(grown.doc);
             scene = tree_render_scene(geometry, lobes, strokes, tree.growth.tree.nodes[0].position.y, content);
+            if (content.clusters) {
+                if (tree.growth.first_clusters.empty())
+                    warn(a->input + ": --show clusters: this grower has no attractor clusters (the subtrees grower has)");
+                add_cluster_items(scene, tree.growth.first_clusters, tree.growth.tree);
+            }
         }
         if (scene.items.empty()) {
             error(a->input + ": nothing to draw for --show " + a->show);

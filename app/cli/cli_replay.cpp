@@ -7,8 +7,12 @@
 
 #include "app/cli/cli.h"
 #include "app/cli/cli_common.h"
+#include "app/cli/cli_export_options.h"
 #include "app/cli/outputs.h"
+#include "app/export/skeleton_json.h"
 #include "app/export/tree_output.h"
+#include "app/live/lsystem_sketch_mode.h"
+#include "core/atomic_file.h"
 #include "core/errors.h"
 
 namespace lobe::cli {
@@ -21,10 +25,12 @@ void add_replay_command(CLI::App& app, int& exit_code)
         std::uint64_t seed = 1;
         double height = 0.0;
         TreeInputOptions radii;
+        TreeFileArgs file;
     };
     auto a = std::make_shared<Args>();
     cmd->add_option("REC", a->rec, "Recording (binary or text form)")->required();
-    cmd->add_option("-o,--out", a->out, "Output folder (created): strokes.json, session.json, lobes/lobe_N.ply, tree.glb")
+    cmd->add_option("-o,--out", a->out,
+                    "Output folder (created): strokes.json, session.json, lobes/lobe_N.ply, tree.glb, tree.json")
         ->required();
     cmd->add_option("--settings", a->settings, "Settings JSON (a settings object or a session document)");
     cmd->add_option("--seed", a->seed, "Seed of every random choice downstream")->capture_default_str()->check(seed_check());
@@ -37,6 +43,7 @@ void add_replay_command(CLI::App& app, int& exit_code)
                     "the species' sizes (stored in session.json as settings.growth.height_m; 0: as sketched)")
         ->check(finite_range(0.0, 1000.0));
     add_radius_options(cmd, a->radii);
+    add_tree_file_options(cmd, a->file);
     cmd->callback([a, &exit_code] {
         check_input_kind(a->rec, "replay", "a recording; grow, export, render and lobes take session documents and meshes",
                          false, false);
@@ -77,7 +84,10 @@ void add_replay_command(CLI::App& app, int& exit_code)
             apply_real_scale(out_doc, tree);
             for (const std::string& w : tree.warnings) warn(a->rec + ": " + w);
             const TreeGeometry geometry = document_tree_geometry(out_doc, tree);
-            write_tree_file(a->out + "/tree.glb", out_doc, tree, geometry, ExportOptions{});
+            ExportOptions options;
+            apply_tree_file_options(a->file, options);
+            write_tree_file(a->out + "/tree.glb", out_doc, tree, geometry, options);
+            write_skeleton_json(a->out + "/tree.json", tree); // the tree graph, as grow --skeleton-out
             tree_written = true;
             progress("grew a tree of " + std::to_string(tree.growth.tree.size()) + " nodes (triangles " +
                      lod_triangle_summary(geometry) + ")");
@@ -89,8 +99,16 @@ void add_replay_command(CLI::App& app, int& exit_code)
                  " lobe group(s), " + std::to_string(out_doc.edits.size()) + " edit(s) from " +
                  std::to_string(drags) + " drag(s)");
         progress("wrote " + a->out + "/strokes.json, " + a->out + "/session.json, " + std::to_string(lobe_files) +
-                 " lobe mesh(es) in " + a->out + "/lobes" + (tree_written ? " and " + a->out + "/tree.glb" : ""));
-        if (out_doc.strokes.empty() && drags == 0 && out_doc.lobes.empty()) {
+                 " lobe mesh(es) in " + a->out + "/lobes" +
+                 (tree_written ? ", " + a->out + "/tree.glb and " + a->out + "/tree.json" : ""));
+        // The L-system sketch mode's sketch (docs/lsystem-sketch.md), when the recording made one.
+        const LSystemSketchMode sketch_mode = replay_lsystem_sketch(read_recording(a->rec));
+        const bool sketched = sketch_mode.sketch().trunk.size() >= 2;
+        if (sketched) {
+            write_file_atomic(a->out + "/lsystem-sketch.json", lsystem::sketch_json(sketch_mode.sketch_file()) + "\n");
+            progress("wrote " + a->out + "/lsystem-sketch.json (the L-system sketch: lobesketch lsystem --sketch grows it)");
+        }
+        if (out_doc.strokes.empty() && drags == 0 && out_doc.lobes.empty() && !sketched) {
             error(a->rec + ": no strokes in this recording");
             exit_code = kExitFailure;
             return;

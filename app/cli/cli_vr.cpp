@@ -13,6 +13,7 @@
 #include "app/cli/cli_common.h"
 #include "app/cli/outputs.h"
 #include "app/render/renderer.h"
+#include "app/export/skeleton_json.h"
 #include "app/export/tree_output.h"
 #include "app/vr/vr_session.h"
 #include "app/vr/vr_xr.h"
@@ -60,12 +61,13 @@ void write_outputs(const std::string& dir, Document doc, const std::string& sour
         for (const std::string& w : tree.warnings) warn(source + ": " + w);
         const TreeGeometry geometry = document_tree_geometry(doc, tree);
         write_tree_file(dir + "/tree.glb", doc, tree, geometry, ExportOptions{});
+        write_skeleton_json(dir + "/tree.json", tree);
         tree_written = true;
         progress("grew a tree of " + std::to_string(tree.growth.tree.size()) + " nodes (triangles " +
                  lod_triangle_summary(geometry) + ")");
     }
     progress("wrote " + dir + "/strokes.json, " + dir + "/session.json, " + std::to_string(lobe_files) +
-             " lobe mesh(es) in " + dir + "/lobes" + (tree_written ? " and " + dir + "/tree.glb" : ""));
+             " lobe mesh(es) in " + dir + "/lobes" + (tree_written ? ", " + dir + "/tree.glb and " + dir + "/tree.json" : ""));
 }
 
 } // namespace
@@ -100,7 +102,7 @@ void add_vr_command(CLI::App& app, int& exit_code)
     cmd->add_flag("--sync-regrowth", a->sync_regrowth,
                   "Rebuild lobes and the tree on the frame thread (every frame shows the current tree; for replays)");
     cmd->add_option("-o,--out", a->out,
-                    "After the session, write what `replay --out` writes here: strokes.json, session.json, lobes, tree.glb");
+                    "After the session, write what `replay --out` writes here: strokes.json, session.json, lobes, tree.glb, tree.json");
     cmd->callback([a, &exit_code] {
         const std::string session = a->session.empty() ? "lobesketch-" + timestamp() + ".json" : a->session;
         VrOptions options;

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "app/desktop/desktop_session.h"
+#include "app/live/lsystem_sketch_mode.h"
 #include "core/errors.h"
 #include "input/tools.h"
 
@@ -43,6 +44,7 @@ int key_code(const std::string& name_in)
     static const std::pair<const char*, int> named[] = {
         {"escape", 256}, {"enter", 257}, {"tab", 258}, {"backspace", 259}, {"delete", 261},
         {"shift", 340},  {"space", 32},  {"f1", 290},  {"f2", 291},        {"home", 268},
+        {"comma", 44},   {"period", 46}, {"minus", 45}, {"equal", 61},     {"leftbracket", 91}, {"rightbracket", 93},
     };
     for (const auto& [n, code] : named)
         if (name == n) return code;
@@ -72,6 +74,9 @@ const std::vector<PanelAction>& panel_actions()
         {"save", "Save (S)", desktop_keys::kSave},
         {"export", "Export (W)", desktop_keys::kExport},
         {"frame", "Frame (F)", desktop_keys::kFrame},
+        // The L-system sketch mode (docs/lsystem-sketch.md); its other keys act while it is on.
+        {"lsystem", "L-system (P)", keys::kLSystemSketch},
+        {"lsystem-branch", "Branch (B)", lsystem_sketch_keys::kBranch},
     };
     return actions;
 }

@@ -123,6 +123,8 @@ public:
     Camera camera() const { return orbit_.camera(); }
     OrbitCamera& orbit() { return orbit_; }
     const Document& document() const { return live_->document(); }
+    /// The L-system sketch mode (P): its sketch, growth and tree.
+    const LSystemSketchMode& lsystem_sketch() const { return live_->lsystem_sketch(); }
     const DesktopStatus& status() const { return status_; }
     /// Every warning and result line so far, oldest first (at most the last 200).
     const std::deque<std::string>& messages() const { return live_->messages(); }

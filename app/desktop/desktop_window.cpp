@@ -298,6 +298,19 @@ DesktopRunResult DesktopWindow::run(DesktopSession& ds, const std::string& sessi
     return r;
 }
 
+/// The L-system sketch mode's state in a script mark.
+static nlohmann::json lsystem_sketch_mark(const LSystemSketchMode& m)
+{
+    nlohmann::json branches = nlohmann::json::array();
+    for (const lsystem::SketchBranch& b : m.sketch().branches) branches.push_back({{"attach", b.attach}, {"points", b.points.size()}});
+    return {{"active", m.active()},
+            {"trunk_sections", m.sketch().trunk_sections()},
+            {"branches", branches},
+            {"growth", m.growth()},
+            {"divergence_deg", m.sketch().divergence_deg},
+            {"tree_nodes", m.tree().size()}};
+}
+
 std::string desktop_mark_json(const DesktopSession& s, const std::string& label, int frame)
 {
     const Document& d = s.document();
@@ -327,7 +340,8 @@ std::string desktop_mark_json(const DesktopSession& s, const std::string& label,
             {"seed", d.seed},
             {"tree_triangles", s.status().tree_triangles},
             {"tree_error", s.status().tree_error},
-            {"last_message", s.status().last_message}};
+            {"last_message", s.status().last_message},
+            {"lsystem_sketch", lsystem_sketch_mark(s.lsystem_sketch())}};
     return mark.dump();
 }
 

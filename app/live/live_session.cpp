@@ -10,6 +10,7 @@
 #include "app/session/edit_hooks.h"
 #include "app/session/edit_ops.h"
 #include "app/session/stage_options.h"
+#include "core/atomic_file.h"
 #include "core/errors.h"
 #include "meshing/mesh_io.h"
 #include "meshing/mesh_quality.h"
@@ -24,7 +25,8 @@ constexpr std::size_t kMaxMessages = 200;
 } // namespace
 
 LiveSession::LiveSession(Document doc, LiveSessionOptions options)
-    : options_(std::move(options)), pipeline_(input_options(doc.settings)), scene_(options_.lod)
+    : options_(std::move(options)), pipeline_(input_options(doc.settings)), scene_(options_.lod),
+      lsystem_sketch_(options_.lsystem_platform)
 {
     if (!options_.record_path.empty()) {
         recording_ = std::make_unique<RecordingWriter>(options_.record_path, options_.recording_header,
@@ -75,11 +77,32 @@ void LiveSession::push_event(const InputEvent& e)
 {
     if (recording_) recording_->append(e);
     pipeline_.push_event(e);
+    lsystem_sketch_.push_event(e);
+    for (; lsystem_messages_seen_ < lsystem_sketch_.messages().size(); ++lsystem_messages_seen_)
+        note(lsystem_sketch_.messages()[lsystem_messages_seen_]);
+}
+
+RenderScene& LiveSession::begin_frame_items()
+{
+    lsystem_view_.reclaim(scene_.items_before_frame());
+    RenderScene& scene = scene_.begin_frame_items();
+    lsystem_view_.append(lsystem_sketch_, scene, pipeline_.scene_transform());
+    return scene;
+}
+
+std::string lsystem_sketch_path(const std::string& session_path)
+{
+    std::filesystem::path p(session_path);
+    p.replace_extension(".lsystem-sketch.json");
+    return p.string();
 }
 
 void LiveSession::push_frame(const HandFrame& frame)
 {
     pipeline_.push_frame(frame);
+    lsystem_sketch_.push_frame(frame);
+    for (; lsystem_messages_seen_ < lsystem_sketch_.messages().size(); ++lsystem_messages_seen_)
+        note(lsystem_sketch_.messages()[lsystem_messages_seen_]);
     if (recording_) {
         recording_->append(frame);
         ++frames_recorded_;
@@ -327,6 +350,11 @@ bool LiveSession::save()
         save_document(options_.session_path,
                       at_recording_position(document(), recording_ != nullptr, frames_recorded_, finished_));
         note("saved " + options_.session_path);
+        if (lsystem_sketch_.sketch().trunk.size() >= 2) {
+            const std::string path = lsystem_sketch_path(options_.session_path);
+            write_file_atomic(path, lsystem::sketch_json(lsystem_sketch_.sketch_file()) + "\n");
+            note("saved the L-system sketch to " + path);
+        }
         return true;
     } catch (const Error& e) {
         note(std::string("save failed: ") + e.what());

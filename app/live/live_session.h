@@ -26,6 +26,8 @@
 #include "app/live/autosave.h"
 #include "app/live/drag_preview.h"
 #include "app/live/live_edit_view.h"
+#include "app/live/lsystem_sketch_mode.h"
+#include "app/live/lsystem_sketch_view.h"
 #include "app/live/regrow_worker.h"
 #include "app/live/session_scene.h"
 #include "app/session/session_builder.h"
@@ -54,6 +56,8 @@ struct LiveSessionOptions {
     std::string export_file_hint;
     /// Why meshes cannot be imported into this app (empty: they can; import_mesh).
     std::string imports_refused;
+    /// Where the L-system sketch mode's platform stands (keys::kLSystemSketch turns it on).
+    SketchPlatform lsystem_platform;
 };
 
 class LiveSession {
@@ -109,8 +113,12 @@ public:
     SessionScene& view() { return scene_; }
     const SessionScene& view() const { return scene_; }
     const RenderScene& scene() const { return scene_.scene(); }
-    /// The scene cut back to the document's items, for the adapter to add this frame's own.
-    RenderScene& begin_frame_items() { return scene_.begin_frame_items(); }
+    /// The scene cut back to the document's items and the L-system sketch mode's, for the
+    /// adapter to add this frame's own.
+    RenderScene& begin_frame_items();
+    /// The L-system sketch mode (its sketch and tree; it reads the same raw input as the
+    /// pipeline, and save() writes its sketch beside the session).
+    const LSystemSketchMode& lsystem_sketch() const { return lsystem_sketch_; }
     /// Shows the tree at `lod` (the desktop lowers it when frames take too long).
     void set_lod(int lod);
 
@@ -127,7 +135,8 @@ public:
     void note(std::string line);
 
     // --- Saving ---------------------------------------------------------------------------
-    /// Saves the document to session_path (atomic). False, with the reason in messages().
+    /// Saves the document to session_path (atomic), and an L-system sketch (of at least one
+    /// trunk section) beside it as lsystem_sketch_path(). False, with the reason in messages().
     bool save();
     /// Writes the current tree (.glb, every LOD, with lobes and strokes) to export_path;
     /// false, with the reason in messages(), when there is no tree or no file.
@@ -189,6 +198,14 @@ private:
 
     std::deque<std::string> messages_;
     std::string last_message_, tree_error_;
+
+    LSystemSketchMode lsystem_sketch_;
+    LSystemSketchView lsystem_view_;
+    std::size_t lsystem_messages_seen_ = 0;
 };
+
+/// Where save() writes the L-system sketch of the session saved at `session_path`:
+/// "NAME.lsystem-sketch.json" beside "NAME.json" (docs/lsystem-sketch.md).
+std::string lsystem_sketch_path(const std::string& session_path);
 
 } // namespace lobe

@@ -55,6 +55,9 @@ public:
     const RenderScene& scene() const { return scene_; }
     /// The scene with only its grown and stroke items, for the app to append this frame's.
     RenderScene& begin_frame_items();
+    /// The items as they are, last frame's appended ones included: for an app to take back a
+    /// large mesh it appends every frame (moving it, not copying) before begin_frame_items.
+    std::vector<RenderItem>& items_before_frame() { return scene_.items; }
     std::size_t static_items() const { return static_items_; }
 
 private:

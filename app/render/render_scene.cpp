@@ -4,10 +4,12 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <set>
 #include <sstream>
 
 #include <glm/geometric.hpp>
+#include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
 #include "core/errors.h"
@@ -17,7 +19,8 @@ namespace lobe {
 namespace {
 
 // Item keys: the part kind in the top byte, an index below.
-constexpr std::uint64_t kBranchesKey = 1ull << 56, kLeavesKey = 2ull << 56, kLobeKey = 3ull << 56, kStrokeKey = 4ull << 56;
+constexpr std::uint64_t kBranchesKey = 1ull << 56, kLeavesKey = 2ull << 56, kLobeKey = 3ull << 56, kStrokeKey = 4ull << 56,
+                        kClusterKey = 5ull << 56;
 
 /// FNV-1a over the mesh's arrays: the version of a mesh is its content.
 std::uint64_t content_hash(const SurfaceGeometry& g)
@@ -81,11 +84,13 @@ RenderContent parse_show_list(const std::string& text)
             c.lobes = true;
         else if (item == "strokes")
             c.strokes = true;
+        else if (item == "clusters")
+            c.clusters = true;
         else
-            throw InvalidInput("--show: unknown item '" + item + "' (expected tree, leaves, lobes, strokes)");
+            throw InvalidInput("--show: unknown item '" + item + "' (expected tree, leaves, lobes, strokes, clusters)");
         any = true;
     }
-    if (!any) throw InvalidInput("--show: expected a list of tree, leaves, lobes, strokes");
+    if (!any) throw InvalidInput("--show: expected a list of tree, leaves, lobes, strokes, clusters");
     return c;
 }
 
@@ -215,6 +220,69 @@ RenderScene tree_render_scene(const TreeGeometry& geometry, const std::vector<Tr
 
 namespace {
 
+// Twelve colours far apart (linear RGB): piece k of the tree gets colour k mod 12.
+constexpr std::array<std::array<float, 3>, 12> kPieceColors{{{0.90f, 0.10f, 0.10f}, {0.10f, 0.45f, 0.95f},
+                                                            {0.95f, 0.80f, 0.05f}, {0.55f, 0.10f, 0.85f},
+                                                            {0.05f, 0.80f, 0.30f}, {0.95f, 0.45f, 0.05f},
+                                                            {0.05f, 0.80f, 0.85f}, {0.95f, 0.25f, 0.65f},
+                                                            {0.45f, 0.80f, 0.05f}, {0.25f, 0.15f, 0.60f},
+                                                            {0.70f, 0.45f, 0.25f}, {0.60f, 0.60f, 0.60f}}};
+
+void add_octahedron(SurfaceGeometry& g, const glm::vec3& c, float r)
+{
+    const auto base = static_cast<std::uint32_t>(g.positions.size());
+    const glm::vec3 dirs[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    for (const glm::vec3& d : dirs) {
+        g.positions.push_back(c + r * d);
+        g.normals.push_back(d);
+        g.uvs.emplace_back(0.0f, 0.0f);
+    }
+    const std::uint32_t faces[8][3] = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+    for (const auto& f : faces) g.triangles.push_back({base + f[0], base + f[1], base + f[2]});
+}
+
+void append(SurfaceGeometry& to, const SurfaceGeometry& from)
+{
+    const auto base = static_cast<std::uint32_t>(to.positions.size());
+    to.positions.insert(to.positions.end(), from.positions.begin(), from.positions.end());
+    to.normals.insert(to.normals.end(), from.normals.begin(), from.normals.end());
+    to.uvs.insert(to.uvs.end(), from.uvs.begin(), from.uvs.end());
+    for (const auto& t : from.triangles) to.triangles.push_back({base + t[0], base + t[1], base + t[2]});
+}
+
+} // namespace
+
+void add_cluster_items(RenderScene& scene, const std::vector<ClusteredAttractor>& clusters, const TreeGraph& tree)
+{
+    std::array<SurfaceGeometry, kPieceColors.size()> by_color;
+    // Each piece's attractors, centre and node, in piece order.
+    std::vector<glm::vec3> centre;
+    std::vector<int> count, node;
+    for (const ClusteredAttractor& a : clusters) {
+        if (a.piece < 0 || a.node < 0 || static_cast<std::size_t>(a.node) >= tree.nodes.size()) continue;
+        const auto p = static_cast<std::size_t>(a.piece);
+        if (p >= centre.size()) {
+            centre.resize(p + 1, glm::vec3(0.0f));
+            count.resize(p + 1, 0);
+            node.resize(p + 1, -1);
+        }
+        centre[p] += a.position;
+        ++count[p];
+        node[p] = a.node;
+        add_octahedron(by_color[p % by_color.size()], a.position, 0.006f);
+    }
+    for (std::size_t p = 0; p < centre.size(); ++p) {
+        if (count[p] == 0) continue;
+        const glm::vec3 from = tree.nodes[static_cast<std::size_t>(node[p])].position;
+        append(by_color[p % by_color.size()], polyline_tube({from, centre[p] / static_cast<float>(count[p])}, 0.002f, 5));
+    }
+    for (std::size_t c = 0; c < by_color.size(); ++c)
+        add_item(scene, kClusterKey | c, RenderMaterial::Stroke,
+                 {kPieceColors[c][0], kPieceColors[c][1], kPieceColors[c][2], 1.0f}, std::move(by_color[c]));
+}
+
+namespace {
+
 /// Reads a glTF accessor of `components` floats per element, bounds-checked.
 std::vector<float> read_floats(const tinygltf::Model& m, int index, int type, const std::string& path)
 {
@@ -273,12 +341,11 @@ std::vector<glm::vec3> as_vec3(const std::vector<float>& f)
     return out;
 }
 
-/// The triangle mesh of a glTF mesh's first primitive (normals computed when it has none).
-SurfaceGeometry glb_surface(const tinygltf::Model& m, const tinygltf::Mesh& mesh, const std::string& path)
+/// The triangle mesh of one glTF primitive (normals computed when it has none).
+SurfaceGeometry glb_primitive(const tinygltf::Model& m, const tinygltf::Mesh& mesh, const tinygltf::Primitive& p,
+                              const std::string& path)
 {
     SurfaceGeometry g;
-    if (mesh.primitives.empty()) return g;
-    const tinygltf::Primitive& p = mesh.primitives[0];
     if (p.mode != TINYGLTF_MODE_TRIANGLES) return g;
     const auto pos = p.attributes.find("POSITION");
     if (pos == p.attributes.end()) throw FileError(path, "mesh '" + mesh.name + "' has no POSITION");
@@ -304,6 +371,25 @@ SurfaceGeometry glb_surface(const tinygltf::Model& m, const tinygltf::Mesh& mesh
     }
     if (g.normals.size() != g.positions.size() || (!g.uvs.empty() && g.uvs.size() != g.positions.size()))
         throw FileError(path, "mesh '" + mesh.name + "' has attributes of different lengths");
+    return g;
+}
+
+/// The triangle mesh of a glTF mesh: its triangle primitives one after the other (a large
+/// LOD is split into primitives of at most 65,535 vertices, docs/export.md).
+SurfaceGeometry glb_surface(const tinygltf::Model& m, const tinygltf::Mesh& mesh, const std::string& path)
+{
+    SurfaceGeometry g;
+    for (const tinygltf::Primitive& p : mesh.primitives) {
+        const SurfaceGeometry part = glb_primitive(m, mesh, p, path);
+        if (part.empty()) continue;
+        if (!g.empty() && g.uvs.empty() != part.uvs.empty())
+            throw FileError(path, "mesh '" + mesh.name + "' has primitives with and without texture coordinates");
+        const auto offset = static_cast<std::uint32_t>(g.positions.size());
+        g.positions.insert(g.positions.end(), part.positions.begin(), part.positions.end());
+        g.normals.insert(g.normals.end(), part.normals.begin(), part.normals.end());
+        g.uvs.insert(g.uvs.end(), part.uvs.begin(), part.uvs.end());
+        for (const auto& t : part.triangles) g.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+    }
     return g;
 }
 
@@ -347,6 +433,26 @@ RgbaImage material_texture(const tinygltf::Model& m, int material)
 
 } // namespace
 
+/// Refuses, with one line, a .glb whose required extensions the reader below does not
+/// decode: the quantized and compressed exports (docs/export.md).
+void refuse_packed_glb(const std::string& path)
+{
+    std::ifstream in(path, std::ios::binary);
+    char header[20] = {};
+    if (!in.read(header, sizeof header) || std::memcmp(header, "glTF", 4) != 0 || std::memcmp(header + 16, "JSON", 4) != 0) return;
+    std::uint32_t length = 0;
+    std::memcpy(&length, header + 12, 4);
+    if (length > (64u << 20)) return; // tinygltf says what is wrong with it
+    std::string json(length, '\0');
+    if (!in.read(json.data(), static_cast<std::streamsize>(length))) return;
+    const nlohmann::json j = nlohmann::json::parse(json, nullptr, false);
+    if (!j.is_object() || !j.contains("extensionsRequired") || !j["extensionsRequired"].is_array()) return;
+    for (const auto& e : j["extensionsRequired"])
+        if (e == "KHR_mesh_quantization" || e == "EXT_meshopt_compression")
+            throw FileError(path, "written with --quantize or --compress (" + e.get<std::string>() +
+                                      "), which render does not read: export the tree again without them");
+}
+
 RenderScene glb_render_scene(const std::string& path, const RenderContent& content)
 {
     std::error_code ec;
@@ -354,6 +460,7 @@ RenderScene glb_render_scene(const std::string& path, const RenderContent& conte
     // The exporter refuses to write more than 4 GiB; a bigger file is not one of ours.
     if (std::filesystem::file_size(path, ec) > (std::uintmax_t(4) << 30))
         throw FileError(path, "larger than 4 GiB: not a tree exported by Lobesketch");
+    refuse_packed_glb(path);
     tinygltf::TinyGLTF loader;
     tinygltf::Model m;
     std::string err, warning;
@@ -373,23 +480,35 @@ RenderScene glb_render_scene(const std::string& path, const RenderContent& conte
         const tinygltf::Mesh& mesh = m.meshes[std::size_t(node.mesh)];
         const int material = mesh.primitives.empty() ? -1 : mesh.primitives[0].material;
         const std::string& name = node.name;
-        const bool branches = name.rfind("tree_branches_LOD", 0) == 0, leaves = name.rfind("tree_leaves_LOD", 0) == 0;
-        if (branches || leaves) {
-            const std::string digits = name.substr(name.rfind("_LOD") + 4);
-            if (!digits.empty() && digits.size() < 3 && std::all_of(digits.begin(), digits.end(), ::isdigit))
-                lods_found.insert(std::stoi(digits));
-        }
-        if (branches && name == "tree_branches" + lod) {
+        // `<stem>_branches_LOD<k>` and `<stem>_leaves_LOD<k>`, whatever the file's stem.
+        const std::size_t at = name.rfind("_LOD");
+        const std::string digits = at == std::string::npos ? std::string() : name.substr(at + 4);
+        const bool lod_name = !digits.empty() && digits.size() < 3 && std::all_of(digits.begin(), digits.end(), ::isdigit);
+        auto part_is = [&](const std::string& part) {
+            return lod_name && at >= part.size() && name.compare(at - part.size(), part.size(), part) == 0;
+        };
+        const bool branches = part_is("_branches"), leaves = part_is("_leaves"), billboard = part_is("_billboard");
+        if (branches || leaves || billboard) lods_found.insert(std::stoi(digits));
+        if (branches && name.compare(at, std::string::npos, lod) == 0) {
             found_lod = true;
             if (content.tree)
                 add_item(scene, kBranchesKey | std::uint64_t(content.lod), RenderMaterial::Bark,
                          material_color(m, material, {0.36f, 0.25f, 0.17f, 1.0f}), glb_surface(m, mesh, path));
-        } else if (leaves && name == "tree_leaves" + lod) {
+        } else if (leaves && name.compare(at, std::string::npos, lod) == 0) {
             found_lod = true;
             if (content.leaves) {
                 std::array<float, 4> c = material_color(m, material, {0.20f, 0.42f, 0.12f, 1.0f});
                 c[3] = 1.0f;
                 add_item(scene, kLeavesKey | std::uint64_t(content.lod), RenderMaterial::Leaf, c, glb_surface(m, mesh, path));
+                scene.leaf_texture = material_texture(m, material);
+                scene.leaf_texture_version = image_hash(scene.leaf_texture);
+            }
+        } else if (billboard && name.compare(at, std::string::npos, lod) == 0) {
+            // The billboard level: cards drawn as leaves are, with its baked picture.
+            found_lod = true;
+            if (content.tree || content.leaves) {
+                add_item(scene, kLeavesKey | std::uint64_t(content.lod), RenderMaterial::Leaf, {1.0f, 1.0f, 1.0f, 1.0f},
+                         glb_surface(m, mesh, path));
                 scene.leaf_texture = material_texture(m, material);
                 scene.leaf_texture_version = image_hash(scene.leaf_texture);
             }
@@ -403,7 +522,7 @@ RenderScene glb_render_scene(const std::string& path, const RenderContent& conte
     }
     if ((content.tree || content.leaves) && !found_lod) {
         if (lods_found.empty())
-            throw FileError(path, "has no tree_branches_LOD<k> meshes (not a tree exported by Lobesketch?)");
+            throw FileError(path, "has no <name>_branches_LOD<k> meshes (not a tree exported by Lobesketch?)");
         std::string has;
         for (const int k : lods_found) has += (has.empty() ? "LOD" : ", LOD") + std::to_string(k);
         throw FileError(path, "has no LOD" + std::to_string(content.lod) + " (it has " + has + "; pick one with --lod)");

@@ -12,6 +12,7 @@
 #include "app/render/renderer.h"
 #include "core/mesh.h"
 #include "core/stroke.h"
+#include "growth/grow.h"
 #include "growth/tree_geometry.h"
 
 namespace lobe {
@@ -22,13 +23,14 @@ struct RenderContent {
     bool leaves = true;
     bool lobes = false;   ///< translucent lobe meshes
     bool strokes = false; ///< the sketch's strokes as tubes
+    bool clusters = false; ///< the first growth iteration's attractor clusters and pieces (Fig. 7)
     int lod = 0;          ///< level of detail of the tree
 };
 
 /// FNV-1a over `bytes` bytes: the content hashes that scene items' versions are made of.
 std::uint64_t bytes_hash(const void* data, std::size_t bytes);
 
-/// Parses a comma-separated `--show` list of tree, leaves, lobes, strokes.
+/// Parses a comma-separated `--show` list of tree, leaves, lobes, strokes, clusters.
 /// \throw InvalidInput naming an unknown or empty item.
 RenderContent parse_show_list(const std::string& text);
 
@@ -51,6 +53,12 @@ SurfaceGeometry lobe_surface(const TriangleMesh& mesh);
 RenderScene tree_render_scene(const TreeGeometry& geometry, const std::vector<TriangleMesh>& lobes,
                               const std::vector<Stroke>& strokes, float ground_y, const RenderContent& content);
 
+/// Adds the first growth iteration's clusters (§5.2, Fig. 7b–c) to `scene`: each attractor a
+/// small octahedron coloured by the piece of its node's cluster it fell in (twelve colours,
+/// neighbouring pieces differ), and a tube from the node to each piece's centre in its colour.
+/// `tree` is the grown tree the clusters' node indices refer to. Nothing for an empty list.
+void add_cluster_items(RenderScene& scene, const std::vector<ClusteredAttractor>& clusters, const TreeGraph& tree);
+
 /// Replaces the mesh of the item tree_render_scene made for lobe `index` (a lobe being
 /// deformed live); false when `scene` has no such item. \throw InvalidInput as lobe_surface.
 bool replace_lobe_item(RenderScene& scene, std::size_t index, const TriangleMesh& mesh);
@@ -60,8 +68,8 @@ bool replace_lobe_item(RenderScene& scene, std::size_t index, const TriangleMesh
 /// or scaled live); false when `scene` has no such item.
 bool replace_stroke_item(RenderScene& scene, const Stroke& stroke);
 
-/// The scene of a .glb written by Lobesketch (nodes `tree_branches_LOD<k>`,
-/// `tree_leaves_LOD<k>`, `lobe_<i>`, `stroke_<id>`; docs/export.md): its origin is the trunk
+/// The scene of a .glb written by Lobesketch (nodes `<name>_branches_LOD<k>`,
+/// `<name>_leaves_LOD<k>`, `lobe_<id>`, `stroke_<id>`; docs/export.md): its origin is the trunk
 /// base, so the ground is at y = 0.
 /// \throw FileError when the file cannot be read or has no mesh of LOD `content.lod`.
 RenderScene glb_render_scene(const std::string& path, const RenderContent& content);

@@ -65,7 +65,10 @@ void finish_grown_tree(const Document& doc, BuiltTree& tree)
 {
     if (!tree.growth.radii_set) {
         const PipeRadiiOptions radii = pipe_radii_options(doc.settings);
-        assign_pipe_radii(tree.growth.tree, radii.exponent, radii.tip_radius_m);
+        if (tree.growth.leader_radii)
+            assign_leader_radii(tree.growth.tree, radii.exponent, radii.tip_radius_m);
+        else
+            assign_pipe_radii(tree.growth.tree, radii.exponent, radii.tip_radius_m);
     }
     for (const std::string& m : tree.growth.messages) tree.warnings.push_back("growth: " + m);
 }
@@ -94,7 +97,9 @@ void apply_real_scale(const Document& doc, BuiltTree& tree)
     } else {
         const PipeRadiiOptions radii = pipe_radii_options(doc.settings);
         if (doc.settings.branches.dbh_ratio > 0.0)
-            fit_pipe_exponent(graph, radii.tip_radius_m, doc.settings.branches.dbh_ratio);
+            fit_pipe_exponent(graph, radii.tip_radius_m, doc.settings.branches.dbh_ratio, tree.growth.leader_radii);
+        else if (tree.growth.leader_radii)
+            assign_leader_radii(graph, radii.exponent, radii.tip_radius_m);
         else
             assign_pipe_radii(graph, radii.exponent, radii.tip_radius_m);
     }

@@ -151,6 +151,14 @@ VrPanel vr_panel_layout(const Pose& head)
          setting_button("LEAF COLOUR", kNextLeafColor), setting_button("BARK COLOUR", kNextBarkColor),
          setting_button("TWIG -", kTwigDown), setting_button("TWIG +", kTwigUp)},
         {setting_button("PIPE -", kPipeDown), setting_button("PIPE +", kPipeUp)},
+        // The L-system sketch mode (app/live/lsystem_sketch_mode.h): on/off, a branch from the
+        // trunk node at the fingertip, scrap, divergence and iterations. (TRUNK goes back to
+        // the trunk, DEL STROKE erases the node at the fingertip while it is on.)
+        {key_button("L-SYSTEM", keys::kLSystemSketch), key_button("BRANCH", lsystem_sketch_keys::kBranch),
+         key_button("SCRAP", lsystem_sketch_keys::kScrap), key_button("DIV -", lsystem_sketch_keys::kDivergenceDown),
+         key_button("DIV +", lsystem_sketch_keys::kDivergenceUp), key_button("ITER +", lsystem_sketch_keys::kIterationForward)},
+        {key_button("ITER -", lsystem_sketch_keys::kIterationBack), key_button("GROW -", lsystem_sketch_keys::kGrowthDown),
+         key_button("GROW +", lsystem_sketch_keys::kGrowthUp)},
     };
     const float pitch_x = kButtonW + kButtonGap, pitch_y = kButtonH + kButtonGap;
     const float top = 0.5f * float(rows.size() - 1) * pitch_y;
@@ -639,6 +647,7 @@ VrSession::VrSession(Document doc, VrOptions options)
     o.grow_hint = std::string("GROW on the panel");
     o.export_file_hint = std::string("start with --export FILE.glb");
     o.imports_refused = std::string("the VR app imports no meshes (use lobesketch desktop)");
+    o.lsystem_platform = sketch_platform_for(o.recording_header.source);
     live_ = std::make_unique<LiveSession>(std::move(doc), std::move(o));
     Bounds floor;
     floor.add(glm::vec3(-0.5f, 0.0f, -0.5f));

@@ -122,6 +122,8 @@ public:
     EyeView eye_in_document(const EyeView& stage_eye) const;
 
     const Document& document() const;
+    /// The L-system sketch mode (the panel's L-SYSTEM row; app/live/lsystem_sketch_mode.h).
+    const LSystemSketchMode& lsystem_sketch() const { return live_->lsystem_sketch(); }
     const VrStatus& status() const { return status_; }
     const VrPanel& panel() const { return panel_; }
     /// Every warning and result line so far, oldest first (at most the last 200).

@@ -85,6 +85,10 @@ struct ViewSettings {
     double elasticity = 0.0;           ///< `initial elasticity:` / `tropism ... elasticity` (e)
     double elasticity_increment = 0.0; ///< `elasticity increment:`
     bool tropism = false;              ///< a tropism line was given
+    /// `metres per unit:` (a Lobesketch line, not cpfg's): when > 0 the model is drawn at
+    /// this scale, metres per model unit, instead of being fitted to a height (the L-system
+    /// grower); 0, the default, fits it.
+    double metres_per_unit = 0.0;
 };
 
 /// Where a tree may grow: answers the turtle's position queries for the model's environment

@@ -346,6 +346,11 @@ LSystemRun run_lsystem(const GrowerInput& in)
     turtle.origin = base;
     const double top = lobes_top(in.lobes) - base.y;
     turtle.fit_height_m = in_lobes && top > 0.01 ? top : number_param(in.choice, "height_m").value_or(kDefaultFreeHeightM);
+    if (view.metres_per_unit > 0.0) {
+        // The view file fixes the scale (a sketched tree is drawn in metres).
+        turtle.fit_height_m = 0.0;
+        turtle.metres_per_unit = view.metres_per_unit;
+    }
     TurtleResult drawn = interpret(run.system, interpretation_word(run.system, run.word, derive_options), turtle);
     run.metres_per_unit = drawn.metres_per_unit;
 

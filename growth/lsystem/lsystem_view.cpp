@@ -143,6 +143,10 @@ void read_view_line(std::string_view clean, std::size_t p, std::size_t end, cons
         v.line_width_increment = numbers(1, false)[0];
     } else if (label == "scale factor") {
         v.scale_factor = numbers(1, false)[0];
+    } else if (label == "metres per unit") {
+        const double m = numbers(1, false)[0];
+        if (!(m > 0.0 && m <= 1000.0)) src.fail(vb, "'metres per unit' must be a number in (0, 1000]");
+        v.metres_per_unit = m;
     } else if (label == "tropism direction") {
         v.tropism_direction = unit_direction(numbers(3, false), src, vb);
         v.tropism = true;

@@ -1,7 +1,8 @@
 // Tree growth in the lobes of the three Table 1 recordings (issue: ≤ 5, 15 and 9 ms
 // single-threaded for 1 lobe/5 strokes, 4/22, 3/16; the paper reports 96, 310 and 172 ms),
+// with the shares of attractors ended by the stop rule ("stopped") and removed ("reached"),
 // and a plain space-colonization grower (Runions et al. 2007) with the same spatial index on
-// the same attractors, run until it reaches the same attractor coverage, for the ratio.
+// the same attractors, run until it reaches 90 % of them, for the ratio.
 #include <benchmark/benchmark.h>
 
 #include <cmath>
@@ -27,21 +28,25 @@ const char* const kScenes[] = {"table1-1lobe-5strokes", "table1-4lobes-22strokes
 void BM_GrowTable1(benchmark::State& state)
 {
     const Scene& s = scene(kScenes[state.range(0)]);
-    std::size_t nodes = 0, attractors = 0, reached = 0;
+    std::size_t nodes = 0, attractors = 0, reached = 0, stopped = 0;
     for (auto _ : state) {
         BuiltTree t = grow_document_tree(s.doc, s.lobes);
         nodes = t.growth.tree.size();
-        attractors = reached = 0;
+        attractors = reached = stopped = 0;
         for (const LobeGrowthStats& l : t.growth.lobes) {
             attractors += l.attractors;
             reached += l.reached;
+            stopped += l.stopped;
         }
         benchmark::DoNotOptimize(t);
     }
     state.SetLabel(kScenes[state.range(0)]);
+    const double a = attractors ? static_cast<double>(attractors) : 1.0;
     state.counters["nodes"] = static_cast<double>(nodes);
     state.counters["attractors"] = static_cast<double>(attractors);
-    state.counters["coverage"] = attractors ? static_cast<double>(reached) / static_cast<double>(attractors) : 0.0;
+    // How growth ended (§5.2): attractors left by the stop rule, and removed by reach.
+    state.counters["stopped"] = static_cast<double>(stopped) / a;
+    state.counters["reached"] = static_cast<double>(reached) / a;
 }
 BENCHMARK(BM_GrowTable1)->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
 
@@ -126,10 +131,13 @@ std::size_t space_colonize(const std::vector<glm::vec3>& start, const std::vecto
     return nodes.size() - start.size();
 }
 
+constexpr double kColonizationTarget = 0.9;
+
 void BM_SpaceColonizationTable1(benchmark::State& state)
 {
     const Scene& s = scene(kScenes[state.range(0)]);
-    // Our grower's coverage per lobe is the target.
+    // The baseline grows until it has reached 90 % of each lobe's attractors (ours ends by the
+    // stop rule, with its tips within 4 cm of ≥ 90 % of them: tests/growth/tree_checks_test.cpp).
     const BuiltTree ours = grow_document_tree(s.doc, s.lobes);
     std::vector<glm::vec3> start;
     for (std::size_t i = 0; i < ours.growth.skeleton_nodes; ++i) start.push_back(ours.growth.tree.nodes[i].position);
@@ -141,7 +149,7 @@ void BM_SpaceColonizationTable1(benchmark::State& state)
         double sum = 0.0;
         for (std::size_t l = 0; l < s.lobes.size(); ++l) {
             double c = 0.0;
-            nodes += space_colonize(start, s.lobes[l].mesh.positions, ours.growth.lobes[l].coverage(), 0.01f, kill, &c);
+            nodes += space_colonize(start, s.lobes[l].mesh.positions, kColonizationTarget, 0.01f, kill, &c);
             sum += c;
         }
         coverage = sum / static_cast<double>(s.lobes.size());

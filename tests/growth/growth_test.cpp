@@ -1,6 +1,8 @@
 // Growth inside lobes (§5): the paper's rules (V_A, cluster split, stop rule, signed
 // distance), the subtree library, and trees grown in generated lobes.
+#include <algorithm>
 #include <cmath>
+#include <map>
 #include <numbers>
 #include <set>
 
@@ -15,6 +17,7 @@
 #include "growth/species.h"
 #include "growth/subtree_library.h"
 #include "tests/support/shapes.h"
+#include "tests/support/tree_checks.h"
 
 namespace lobe {
 namespace {
@@ -93,17 +96,75 @@ TEST(Growth, ClusterWithinTheSplitAngleStaysOnePieceAcrossTheAzimuthSeam)
 {
     std::vector<glm::vec3> dirs;
     for (double a = 170; a <= 195; a += 5) dirs.push_back(dir_from(a, 10.0)); // crosses ±180°
+    // Measured about the cluster's own mean direction there is no seam: 25° of azimuth at 10°
+    // of elevation is 25° × cos 10° of arc.
     const ClusterSpan span = cluster_span(dirs);
-    EXPECT_NEAR(span.horizontal_deg, 25.0, 1e-3);
+    EXPECT_NEAR(span.horizontal_deg, 25.0 * std::cos(10.0 * kDeg), 0.05);
     EXPECT_EQ(split_cluster(dirs, 30.0).size(), 1u);
 }
 
-TEST(Growth, ClusterDirectionWeightsNearAttractorsMore)
+TEST(Growth, ClusterDirectionWeightsDistantAttractorsMoreAsSection52Says)
 {
     const glm::vec3 node(0.0f);
+    // d_i·V_i: the attractor 1 m away pulls ten times harder than the one 10 cm away.
     const glm::dvec3 v = cluster_direction(node, {glm::vec3(0.1f, 0, 0), glm::vec3(0, 0, 1.0f)});
     EXPECT_NEAR(glm::length(v), 1.0, 1e-9);
-    EXPECT_GT(v.x, 5 * v.z); // weights 1/0.1 against 1/1
+    EXPECT_NEAR(v.z / v.x, 10.0, 1e-4);
+    // Σ d_i·V_i / Σ d_i, normalised, for three attractors at other distances.
+    const std::vector<glm::vec3> a = {glm::vec3(0.3f, 0.1f, 0), glm::vec3(-0.05f, 0.4f, 0.2f), glm::vec3(0, 0, -0.7f)};
+    glm::dvec3 expected(0.0);
+    for (const glm::vec3& p : a) {
+        const glm::dvec3 d(p);
+        expected += glm::length(d) * (d / glm::length(d));
+    }
+    expected = glm::normalize(expected);
+    const glm::dvec3 got = cluster_direction(node, a);
+    EXPECT_NEAR(got.x, expected.x, 1e-6);
+    EXPECT_NEAR(got.y, expected.y, 1e-6);
+    EXPECT_NEAR(got.z, expected.z, 1e-6);
+    // Degenerate clusters: one attractor, attractors cancelling out on a line: finite.
+    EXPECT_NEAR(cluster_direction(node, {glm::vec3(0, 0, 0.2f)}).z, 1.0, 1e-9);
+    const glm::dvec3 line = cluster_direction(node, {glm::vec3(-0.2f, 0, 0), glm::vec3(0.2f, 0, 0)});
+    EXPECT_TRUE(std::isfinite(line.x) && std::isfinite(line.y) && std::isfinite(line.z));
+}
+
+// Directions filling a cone of half-angle `half_deg` about `axis` (rings of 72).
+std::vector<glm::vec3> cone(const glm::dvec3& axis, double half_deg)
+{
+    const glm::dvec3 a = glm::normalize(axis);
+    const glm::dvec3 ref = std::fabs(a.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 0, 1);
+    const glm::dvec3 u = glm::normalize(glm::cross(a, ref)), w = glm::cross(a, u);
+    std::vector<glm::vec3> out{glm::vec3(a)};
+    for (double r = half_deg / 6; r <= half_deg + 1e-9; r += half_deg / 6)
+        for (int k = 0; k < 72; ++k) {
+            const double phi = k * 5.0 * kDeg;
+            out.emplace_back(std::cos(r * kDeg) * a + std::sin(r * kDeg) * (std::cos(phi) * u + std::sin(phi) * w));
+        }
+    return out;
+}
+
+TEST(Growth, ConeSplitsIntoTheSamePiecesPointingUpSidewaysOrDown)
+{
+    // No pole: spans are measured about the cluster's mean direction (§5.2, Fig. 7c).
+    for (const glm::dvec3 axis : {glm::dvec3(0, 1, 0), glm::dvec3(1, 0, 0), glm::dvec3(0, 0, -1), glm::dvec3(0, -1, 0),
+                                  glm::dvec3(0.3, 0.9, -0.2), glm::dvec3(-0.5, -0.5, 0.7)}) {
+        // A 20° cone (10° half-angle): one piece with t = 30°.
+        const ClusterSpan narrow = cluster_span(cone(axis, 10.0));
+        EXPECT_NEAR(narrow.horizontal_deg, 20.0, 0.5) << axis.x << " " << axis.y << " " << axis.z;
+        EXPECT_NEAR(narrow.vertical_deg, 20.0, 0.5);
+        EXPECT_EQ(split_cluster(cone(axis, 10.0), 30.0).size(), 1u);
+        // A 50° cone: 2 × 2 pieces of about the same size, whichever way it points.
+        int gh = 0, gv = 0;
+        const std::vector<glm::vec3> wide = cone(axis, 25.0);
+        const auto pieces = split_cluster(wide, 30.0, &gh, &gv);
+        EXPECT_EQ(gh, 2);
+        EXPECT_EQ(gv, 2);
+        ASSERT_EQ(pieces.size(), 4u);
+        for (const auto& p : pieces) {
+            EXPECT_GT(p.size(), wide.size() / 6);
+            EXPECT_LT(p.size(), wide.size() / 3);
+        }
+    }
 }
 
 TEST(Growth, SignedDistanceAlongIsPositiveInsideAndEnteringNegativeWhenMissing)
@@ -226,7 +287,7 @@ protected:
     GrowthSettings settings;
 };
 
-TEST_F(GrowInLobes, OneConnectedTreeRootedAtTheTrunkBaseReachingNinetyPercentOfAttractors)
+TEST_F(GrowInLobes, OneConnectedTreeRootedAtTheTrunkBaseWithTipsAtTheSurface)
 {
     const GrowthResult r = grow_tree(trunk, lobes, settings, default_subtree_library(), 1);
     ASSERT_GT(r.tree.size(), r.skeleton_nodes + 100);
@@ -244,7 +305,8 @@ TEST_F(GrowInLobes, OneConnectedTreeRootedAtTheTrunkBaseReachingNinetyPercentOfA
         }
     }
     ASSERT_EQ(r.lobes.size(), 1u);
-    EXPECT_GE(r.lobes[0].coverage(), 0.9) << r.lobes[0].reached << " of " << r.lobes[0].attractors;
+    // Tips reach the surface: a branch tip within 4 cm of 90 % of the lobe's vertices.
+    EXPECT_GE(test::tip_reach_share(r.tree, {lobes[0].mesh}), 0.9);
     EXPECT_LE(outside_fraction(r.tree, lobes), 0.02);
     EXPECT_FALSE(r.lobes[0].iteration_cap);
     EXPECT_FALSE(r.lobes[0].node_cap);
@@ -265,24 +327,96 @@ TEST_F(GrowInLobes, SameSeedSameTreeAndAnotherSeedAnotherTree)
     EXPECT_TRUE(differs);
 }
 
-TEST_F(GrowInLobes, SmallerSplitAngleGivesDenserBranching)
+TEST_F(GrowInLobes, FirstIterationPiecesSpanAtMostTheSplitAngleAndSmallerAnglesMakeMore)
 {
-    settings.split_angle_deg = 45;
-    lobes[0].split_angle_deg = 45;
-    const GrowthResult coarse = grow_tree(trunk, lobes, settings, default_subtree_library(), 1);
-    lobes[0].split_angle_deg = 15;
-    const GrowthResult fine = grow_tree(trunk, lobes, settings, default_subtree_library(), 1);
-    EXPECT_GT(fine.lobes[0].subtrees, coarse.lobes[0].subtrees);
+    // The first iteration's clusters depend only on the skeleton: the same for every t.
+    auto pieces_of = [&](double t, std::size_t* count) {
+        lobes[0].split_angle_deg = t;
+        const GrowthResult r = grow_tree(trunk, lobes, settings, default_subtree_library(), 1);
+        // Every attractor not reached before the first iteration is in one piece.
+        EXPECT_LE(r.first_clusters.size(), lobes[0].mesh.positions.size());
+        EXPECT_GE(r.first_clusters.size(), lobes[0].mesh.positions.size() * 98 / 100);
+        std::map<int, std::vector<glm::vec3>> by_piece;
+        std::map<int, int> node_of;
+        for (const ClusteredAttractor& a : r.first_clusters) {
+            const glm::vec3 d = a.position - r.tree.nodes[static_cast<std::size_t>(a.node)].position;
+            by_piece[a.piece].push_back(glm::normalize(d));
+            node_of[a.piece] = a.node;
+        }
+        double widest = 0.0;
+        for (const auto& [piece, dirs] : by_piece) {
+            const ClusterSpan span = cluster_span(dirs);
+            widest = std::max({widest, span.horizontal_deg, span.vertical_deg});
+        }
+        *count = by_piece.size();
+        return widest;
+    };
+    std::size_t coarse = 0, fine = 0;
+    const double widest_coarse = pieces_of(45.0, &coarse), widest_fine = pieces_of(15.0, &fine);
+    // Each piece spans about t at most (measured in its own frame, so a little more at most).
+    EXPECT_LE(widest_coarse, 1.3 * 45.0);
+    EXPECT_LE(widest_fine, 1.3 * 15.0);
+    // A third of the angle: many more pieces (⌈θ/t⌉² per large cluster).
+    EXPECT_GE(fine, 4 * coarse) << coarse << " pieces at 45°, " << fine << " at 15°";
 }
 
-TEST_F(GrowInLobes, StopRuleDropsTheAttractorsOfNodesNearTheSurface)
+TEST_F(GrowInLobes, TheStopRuleNotAttractorRemovalDecidesWhereGrowthEnds)
 {
-    // A stop distance larger than the lobe: nothing grows, every attractor leaves as stopped.
-    settings.stop_distance_m = 0.45;
     const GrowthResult r = grow_tree(trunk, lobes, settings, default_subtree_library(), 1);
-    EXPECT_EQ(r.lobes[0].nodes, 0u);
-    EXPECT_EQ(r.lobes[0].reached + r.lobes[0].stopped, r.lobes[0].attractors);
-    EXPECT_GT(r.lobes[0].stopped, 0u);
+    const LobeGrowthStats& st = r.lobes[0];
+    EXPECT_EQ(st.reached + st.stopped + st.left, st.attractors);
+    EXPECT_GE(st.stop_share(), 0.8) << st.stopped << " stopped, " << st.reached << " reached of " << st.attractors;
+    // Shrinking the kill distance to 2 mm leaves the tree nearly as it was.
+    GrowthSettings tiny_kill = settings;
+    tiny_kill.kill_distance_m = 0.002;
+    const GrowthResult k = grow_tree(trunk, lobes, tiny_kill, default_subtree_library(), 1);
+    EXPECT_NEAR(static_cast<double>(k.tree.size()), static_cast<double>(r.tree.size()), 0.15 * static_cast<double>(r.tree.size()));
+    // A larger stop distance ends growth farther from the surface, with fewer nodes.
+    auto tip_gap = [&](const GrowthResult& g) { // median distance from a grown tip to the nearest lobe vertex
+        const auto children = tree_children(g.tree);
+        std::vector<double> gaps;
+        for (std::size_t i = g.skeleton_nodes; i < g.tree.size(); ++i) {
+            if (!children[i].empty()) continue;
+            double best = 1e9;
+            for (const glm::vec3& v : lobes[0].mesh.positions) best = std::min(best, static_cast<double>(glm::distance(v, g.tree.nodes[i].position)));
+            gaps.push_back(best);
+        }
+        std::sort(gaps.begin(), gaps.end());
+        return gaps.empty() ? 0.0 : gaps[gaps.size() / 2];
+    };
+    GrowthSettings far = settings;
+    far.stop_distance_m = 0.06;
+    const GrowthResult f = grow_tree(trunk, lobes, far, default_subtree_library(), 1);
+    EXPECT_LT(f.tree.size(), r.tree.size());
+    EXPECT_GT(tip_gap(f), tip_gap(r) + 0.01);
+    EXPECT_LT(tip_gap(r), settings.stop_distance_m + 0.02); // tips end near the surface
+}
+
+TEST_F(GrowInLobes, SubtreeLengthIsProportionalToTheDistanceToTheSurface)
+{
+    // A ball centred on the trunk's top node: every direction from it meets the surface at
+    // the radius, so the first subtrees it grows reach growth_ratio × radius from it.
+    const glm::vec3 top(0, 1.3f, 0);
+    lobes[0].mesh = ellipsoid({0.0, 1.3, 0.0}, glm::dvec3(0.2), 4);
+    const GrowthResult r = grow_tree(trunk, lobes, settings, default_subtree_library(), 1);
+    std::size_t top_index = 0;
+    for (std::size_t i = 0; i < r.skeleton_nodes; ++i)
+        if (glm::distance(r.tree.nodes[i].position, top) < 1e-4f) top_index = i;
+    ASSERT_GT(top_index, 0u);
+    // Each subtree the top node grew: its first segment is the library subtree's first
+    // segment (the root has one child in every shipped subtree) scaled by the subtree's length.
+    const SubtreeLibrary& lib = default_subtree_library();
+    std::size_t measured = 0;
+    for (std::size_t i = r.skeleton_nodes; i < r.tree.size(); ++i) {
+        const TreeNode& n = r.tree.nodes[i];
+        if (n.parent != static_cast<int>(top_index)) continue;
+        const Subtree& st = lib.subtrees[static_cast<std::size_t>(n.subtree_id)];
+        ASSERT_EQ(st.parents[1], 0);
+        const double length = glm::distance(n.position, top) / glm::length(st.nodes[1]);
+        EXPECT_NEAR(length, settings.growth_ratio * 0.2, 0.006) << st.name;
+        ++measured;
+    }
+    EXPECT_GE(measured, 4u);
 }
 
 TEST_F(GrowInLobes, CapsStopGrowthWithAMessage)
@@ -321,6 +455,61 @@ TEST_F(GrowInLobes, PipeRadiiNeverIncreaseFromRootToTip)
             break;
         }
     EXPECT_GT(r.tree.nodes[0].radius, 0.01f);
+}
+
+TEST_F(GrowInLobes, LeaderRadiiTaperWithoutStepsAlongTheTrunkIntoTheLobe)
+{
+    GrowthResult r = grow_tree(trunk, lobes, settings, default_subtree_library(), 1);
+    EXPECT_TRUE(r.leader_radii);
+    assign_leader_radii(r.tree, 2.0, 0.0012);
+    EXPECT_TRUE(test::radii_non_increasing(r.tree));
+    EXPECT_GE(test::leader_share(r.tree), 0.98);
+    const auto children = tree_children(r.tree);
+    for (std::size_t i = 0; i < r.tree.size(); ++i)
+        if (children[i].empty()) {
+            EXPECT_FLOAT_EQ(r.tree.nodes[i].radius, 0.0012f);
+        }
+    // Along the sketched trunk the radius falls by at most a few percent per node (2 cm), and
+    // the thickest subtree it grows into starts at the trunk's radius less its taper.
+    for (std::size_t i = 1; i < r.skeleton_nodes; ++i) {
+        const float parent = r.tree.nodes[static_cast<std::size_t>(r.tree.nodes[i].parent)].radius;
+        EXPECT_GE(r.tree.nodes[i].radius, 0.9f * parent) << i;
+    }
+    const std::size_t last = r.skeleton_nodes - 1;
+    float thickest = 0.0f;
+    for (int c : children[last]) thickest = std::max(thickest, r.tree.nodes[static_cast<std::size_t>(c)].radius);
+    EXPECT_GE(thickest, 0.7f * r.tree.nodes[last].radius);
+}
+
+TEST(Growth, DefaultTrunkTapersWithoutSteps)
+{
+    const std::vector<GrowthLobe> lobes = {growth_lobe(1, ellipsoid({-0.25, 1.4, 0}, {0.15, 0.12, 0.15})),
+                                           growth_lobe(2, ellipsoid({0.25, 1.45, 0.05}, {0.14, 0.13, 0.14}))};
+    GrowthResult r = grow_tree({}, lobes, GrowthSettings{}, default_subtree_library(), 1);
+    assign_leader_radii(r.tree, 2.0, 0.0012);
+    // Along the trunk's axis (from the root, always the thickest child, through the fork and
+    // into a lobe) the radius falls at a steady rate per metre: no step where the trunk forks
+    // or enters a lobe (the plain pipe model kept it constant, then dropped it at once).
+    const auto children = tree_children(r.tree);
+    std::vector<double> slopes;
+    for (std::size_t i = 0; i < r.skeleton_nodes;) {
+        std::size_t next = i;
+        float thickest = -1.0f;
+        for (int c : children[i])
+            if (static_cast<std::size_t>(c) < r.skeleton_nodes && r.tree.nodes[static_cast<std::size_t>(c)].radius > thickest) {
+                thickest = r.tree.nodes[static_cast<std::size_t>(c)].radius;
+                next = static_cast<std::size_t>(c);
+            }
+        if (next == i) break;
+        const double len = glm::distance(r.tree.nodes[i].position, r.tree.nodes[next].position);
+        slopes.push_back((r.tree.nodes[i].radius - r.tree.nodes[next].radius) / len);
+        i = next;
+    }
+    ASSERT_GT(slopes.size(), 10u);
+    const auto [lo, hi] = std::minmax_element(slopes.begin(), slopes.end());
+    EXPECT_GT(*lo, 0.0);
+    EXPECT_LE(*hi, 1.5 * *lo) << "taper per metre from " << *lo << " to " << *hi;
+    EXPECT_TRUE(test::radii_non_increasing(r.tree));
 }
 
 TEST(Growth, EditingOneLobeLeavesTheBranchesOfTheOthersBitIdentical)
@@ -377,6 +566,115 @@ TEST(Growth, BadLobesAndStrokesGiveATreeOrNothingButNeverNaN)
         ASSERT_TRUE(std::isfinite(n.radius));
     }
     EXPECT_LE(r.tree.size(), static_cast<std::size_t>(3 * settings.max_nodes + 20000));
+}
+
+TEST(Growth, TrunkStrokeCrossingTheSkeletonJoinsAtItsNearestPointAndGrowsBothWays)
+{
+    // §5.1: the side stroke passes 5 cm from the trunk in its middle; both its halves grow
+    // from the joint there (joined by an end, one half would run through the other).
+    const std::vector<std::vector<glm::vec3>> strokes = {
+        {{0, 0.8f, 0}, {0, 1.0f, 0}, {0, 1.2f, 0}, {0, 1.4f, 0}},
+        {{-0.3f, 1.2f, 0.05f}, {0.0f, 1.2f, 0.05f}, {0.35f, 1.2f, 0.05f}},
+    };
+    const Skeleton s = build_skeleton(strokes, {});
+    auto nearest = [&](const glm::vec3& p) {
+        std::size_t best = 0;
+        for (std::size_t i = 0; i < s.graph.nodes.size(); ++i)
+            if (glm::distance(s.graph.nodes[i].position, p) < glm::distance(s.graph.nodes[best].position, p)) best = i;
+        return best;
+    };
+    const std::size_t left = nearest({-0.3f, 1.2f, 0.05f}), right = nearest({0.35f, 1.2f, 0.05f});
+    auto ancestors = [&](std::size_t i) {
+        std::set<std::size_t> up;
+        for (int p = s.graph.nodes[i].parent; p >= 0; p = s.graph.nodes[static_cast<std::size_t>(p)].parent)
+            up.insert(static_cast<std::size_t>(p));
+        return up;
+    };
+    EXPECT_FALSE(ancestors(right).count(left));
+    EXPECT_FALSE(ancestors(left).count(right));
+    // Both reach the trunk through the joint at the trunk's node nearest the stroke.
+    const std::size_t joint_trunk = nearest({0, 1.2f, 0});
+    EXPECT_TRUE(ancestors(left).count(joint_trunk));
+    EXPECT_TRUE(ancestors(right).count(joint_trunk));
+    for (std::size_t i : {left, right})
+        for (std::size_t a : ancestors(i)) EXPECT_GE(s.graph.nodes[a].position.y, 0.8f);
+}
+
+TEST(Growth, OverlappingLobesAreClusteredAsOneTree)
+{
+    // Attractors go to their nearest node of the whole tree: where two lobes overlap, nodes
+    // grown for one take the other's attractors and grow into it.
+    const std::vector<std::vector<glm::vec3>> trunk{{{-0.1f, 0.9f, 0}, {-0.1f, 1.1f, 0}, {-0.1f, 1.3f, 0}}};
+    const std::vector<GrowthLobe> lobes = {growth_lobe(1, ellipsoid({-0.1, 1.4, 0}, {0.18, 0.14, 0.15})),
+                                           growth_lobe(2, ellipsoid({0.12, 1.42, 0.0}, {0.18, 0.14, 0.15}))};
+    const GrowthResult r = grow_tree(trunk, lobes, GrowthSettings{}, default_subtree_library(), 1);
+    std::size_t crossed = 0;
+    for (std::size_t i = r.skeleton_nodes; i < r.tree.size(); ++i) {
+        const TreeNode& n = r.tree.nodes[i];
+        const TreeNode& p = r.tree.nodes[static_cast<std::size_t>(n.parent)];
+        if (n.lobe == 1 && p.kind == TreeNodeKind::Grown && p.lobe == 0) ++crossed;
+    }
+    EXPECT_GT(crossed, 0u);
+    std::vector<TriangleMesh> meshes{lobes[0].mesh, lobes[1].mesh};
+    EXPECT_GE(test::tip_reach_share(r.tree, meshes), 0.9);
+}
+
+TEST(Growth, DifferentTrunkStrokesChangeTheBranchingInTheSameLobe)
+{
+    // Fig. 11: one lobe, a straight trunk to its centre or a trunk bending in from the left:
+    // the attractors cluster around other nodes, so the branching differs.
+    const std::vector<GrowthLobe> lobes = {growth_lobe(1, ellipsoid({0.0, 1.4, 0.0}, {0.2, 0.15, 0.18}))};
+    const std::vector<std::vector<glm::vec3>> straight{{{0, 0.8f, 0}, {0, 1.1f, 0}, {0, 1.4f, 0}}};
+    const std::vector<std::vector<glm::vec3>> bent{{{0, 0.8f, 0}, {-0.1f, 1.1f, 0}, {-0.12f, 1.3f, 0}, {0.05f, 1.45f, 0}},
+                                                   {{-0.1f, 1.1f, 0}, {0.1f, 1.3f, 0.05f}}};
+    const GrowthResult a = grow_tree(straight, lobes, GrowthSettings{}, default_subtree_library(), 1);
+    const GrowthResult b = grow_tree(bent, lobes, GrowthSettings{}, default_subtree_library(), 1);
+    ASSERT_EQ(a.first_clusters.size(), b.first_clusters.size());
+    std::size_t moved = 0;
+    for (std::size_t i = 0; i < a.first_clusters.size(); ++i) {
+        const glm::vec3 na = a.tree.nodes[static_cast<std::size_t>(a.first_clusters[i].node)].position;
+        const glm::vec3 nb = b.tree.nodes[static_cast<std::size_t>(b.first_clusters[i].node)].position;
+        if (glm::distance(na, nb) > 0.05f) ++moved;
+    }
+    EXPECT_GE(static_cast<double>(moved) / static_cast<double>(a.first_clusters.size()), 0.3);
+    // Both fill the lobe.
+    EXPECT_GE(test::tip_reach_share(a.tree, {lobes[0].mesh}), 0.9);
+    EXPECT_GE(test::tip_reach_share(b.tree, {lobes[0].mesh}), 0.9);
+}
+
+TEST(Growth, UnreachableLobesFarStrokesAndDegenerateClustersGiveOneLineMessagesAndAFiniteTree)
+{
+    const SubtreeLibrary& lib = default_subtree_library();
+    TriangleMesh line; // "a lobe" whose vertices lie on a line
+    for (int i = 0; i < 20; ++i) line.positions.emplace_back(0.5f + 0.01f * static_cast<float>(i), 1.3f, 0.0f);
+    for (int i = 0; i + 2 < 20; ++i) line.triangles.push_back({i, i + 1, i + 2});
+    TriangleMesh point; // one attractor
+    point.positions.emplace_back(-0.4f, 1.2f, 0.1f);
+    const std::vector<GrowthLobe> lobes = {growth_lobe(1, ellipsoid({0.0, 1.4, 0.0}, {0.17, 0.14, 0.16})),
+                                           growth_lobe(2, line), growth_lobe(3, point)};
+    const std::vector<std::vector<glm::vec3>> trunk{{{0, 1.0f, 0}, {0, 1.3f, 0}}, {{3.0f, 0.5f, 3.0f}, {3.0f, 0.9f, 3.0f}}};
+    GrowthResult r = grow_tree(trunk, lobes, GrowthSettings{}, lib, 1);
+    ASSERT_EQ(r.lobes.size(), 3u);
+    EXPECT_GT(r.lobes[0].nodes, 100u); // the good lobe grows
+    bool far_said = false;
+    for (const std::string& m : r.messages) {
+        EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+        far_said = far_said || m.find("trunk stroke 2 is more than") != std::string::npos;
+    }
+    EXPECT_TRUE(far_said);
+    assign_leader_radii(r.tree);
+    for (const TreeNode& n : r.tree.nodes) {
+        ASSERT_TRUE(std::isfinite(n.position.x) && std::isfinite(n.position.y) && std::isfinite(n.position.z));
+        ASSERT_TRUE(std::isfinite(n.radius) && n.radius > 0.0f);
+    }
+    EXPECT_TRUE(test::radii_non_increasing(r.tree));
+    // A lobe nothing can grow into says so.
+    const std::vector<GrowthLobe> only_line = {growth_lobe(1, line)};
+    const GrowthResult q = grow_tree({{{0, 1.0f, 0}, {0, 1.3f, 0}}}, only_line, GrowthSettings{}, lib, 1);
+    bool said = false;
+    for (const std::string& m : q.messages) said = said || m.find("lobe 1: no branch could grow into it") != std::string::npos;
+    EXPECT_TRUE(said) << q.lobes[0].nodes << " nodes grew";
+    EXPECT_EQ(q.lobes[0].nodes, 0u);
 }
 
 TEST(Species, ShippedPresetsParseAndVisiblyDiffer)

@@ -221,17 +221,22 @@ TEST(CliCommandLine, InputsOfTheWrongKindAreNamedForWhatTheyAre)
     EXPECT_NE(r.out.find("renamed.autosave: a Lobesketch session document, not a recording"), std::string::npos) << r.out;
     EXPECT_EQ(r.out.find("import-leap"), std::string::npos) << r.out;
     // An LOD the settings do not make, said before anything is grown (no "grew" line).
-    r = test::run_cli("export " + in.session + " --out " + dir + "/x.glb --set branches.lod_count=2 --lod 2");
+    // (LOD n of a tree of n LODs is its billboard.)
+    r = test::run_cli("export " + in.session + " --out " + dir + "/x.glb --set branches.lod_count=2 --lod 3");
+    EXPECT_EQ(r.code, 1) << r.out;
+    EXPECT_EQ(r.out, "lobesketch: error: --lod: LOD 3 does not exist (the tree has LOD0 to LOD1; "
+                     "settings.branches.lod_count, and the billboard LOD2)\n");
+    r = test::run_cli("export " + in.session + " --out " + dir + "/x.glb --set branches.lod_count=2 --lod 2 --billboard 0");
     EXPECT_EQ(r.code, 1) << r.out;
     EXPECT_EQ(r.out, "lobesketch: error: --lod: LOD 2 does not exist (the tree has LOD0 to LOD1; "
                      "settings.branches.lod_count)\n");
     // A session with nothing to grow: growing it first would warn and say so instead.
     std::ofstream(dir + "/empty.json") << R"({"format": "lobesketch-session", "version": 1})";
     for (const char* command : {"grow", "export"}) {
-        r = test::run_cli(std::string(command) + " " + dir + "/empty.json --out " + dir + "/x.glb --lod 3");
+        r = test::run_cli(std::string(command) + " " + dir + "/empty.json --out " + dir + "/x.glb --lod 4");
         EXPECT_EQ(r.code, 1) << r.out;
-        EXPECT_EQ(r.out, "lobesketch: error: --lod: LOD 3 does not exist (the tree has LOD0 to LOD2; "
-                         "settings.branches.lod_count)\n");
+        EXPECT_EQ(r.out, "lobesketch: error: --lod: LOD 4 does not exist (the tree has LOD0 to LOD2; "
+                         "settings.branches.lod_count, and the billboard LOD3)\n");
     }
     // A folder that does not exist, said before anything is grown.
     r = test::run_cli("grow " + in.rec + " --out " + dir + "/missing/dir/x.glb");
@@ -298,15 +303,17 @@ TEST(CliCommandLine, TheSameOptionNamesWorkInEveryCommand)
     // grow and lobes take render's --mesh-size beside --size.
     ASSERT_EQ(test::run_cli("-q lobes " + rec + " --out " + dir + "/l").code, 0);
     const std::string mesh = dir + "/l/lobes/lobe_1.ply";
-    ASSERT_EQ(test::run_cli("-q grow " + mesh + " --out " + dir + "/a.glb --size 0.5").code, 0);
-    ASSERT_EQ(test::run_cli("-q grow " + mesh + " --out " + dir + "/b.glb --mesh-size 0.5").code, 0);
-    ASSERT_EQ(test::run_cli("-q grow " + mesh + " --out " + dir + "/c.glb").code, 0);
+    // (One file name in three folders: the node names come from it.)
+    for (const char* sub : {"/a", "/b", "/c"}) fs::create_directories(dir + sub);
+    ASSERT_EQ(test::run_cli("-q grow " + mesh + " --out " + dir + "/a/t.glb --size 0.5").code, 0);
+    ASSERT_EQ(test::run_cli("-q grow " + mesh + " --out " + dir + "/b/t.glb --mesh-size 0.5").code, 0);
+    ASSERT_EQ(test::run_cli("-q grow " + mesh + " --out " + dir + "/c/t.glb").code, 0);
     auto bytes = [](const std::string& path) {
         std::ifstream in(path, std::ios::binary);
         return std::string(std::istreambuf_iterator<char>(in), {});
     };
-    EXPECT_EQ(bytes(dir + "/a.glb"), bytes(dir + "/b.glb"));
-    EXPECT_NE(bytes(dir + "/a.glb"), bytes(dir + "/c.glb"));
+    EXPECT_EQ(bytes(dir + "/a/t.glb"), bytes(dir + "/b/t.glb"));
+    EXPECT_NE(bytes(dir + "/a/t.glb"), bytes(dir + "/c/t.glb"));
     ASSERT_EQ(test::run_cli("-q lobes " + mesh + " --out " + dir + "/m --mesh-size 0.5").code, 0);
 }
 
@@ -317,12 +324,13 @@ TEST(CliCommandLine, ReplayTakesSpeciesAndHeightAsGrowDoes)
     ASSERT_EQ(test::run_cli("-q replay " + rec + " --out " + dir + "/plain").code, 0);
     CliRun r = test::run_cli("-q replay " + rec + " --out " + dir + "/conifer --species conifer --height 8");
     ASSERT_EQ(r.code, 0) << r.out;
-    ASSERT_EQ(test::run_cli("-q grow " + rec + " --out " + dir + "/grown.glb --species conifer --height 8").code, 0);
+    fs::create_directories(dir + "/grown");
+    ASSERT_EQ(test::run_cli("-q grow " + rec + " --out " + dir + "/grown/tree.glb --species conifer --height 8").code, 0);
     auto bytes = [](const std::string& path) {
         std::ifstream in(path, std::ios::binary);
         return std::string(std::istreambuf_iterator<char>(in), {});
     };
-    EXPECT_EQ(bytes(dir + "/conifer/tree.glb"), bytes(dir + "/grown.glb"));
+    EXPECT_EQ(bytes(dir + "/conifer/tree.glb"), bytes(dir + "/grown/tree.glb"));
     EXPECT_NE(bytes(dir + "/conifer/tree.glb"), bytes(dir + "/plain/tree.glb"));
     EXPECT_NE(bytes(dir + "/conifer/session.json").find("\"species\": \"conifer\""), std::string::npos);
     expect_usage_error("replay " + rec + " --out " + dir + "/x --species oak", "unknown species 'oak'");

@@ -1,5 +1,6 @@
 // `lobesketch grow --grower self-organizing` and its options (app/cli/cli_common.h), and the
 // wood report (`--report`, growth/wood.h) every grower writes.
+#include <filesystem>
 #include <fstream>
 #include <string>
 #include <variant>
@@ -29,11 +30,14 @@ TEST(SelfOrganizingCli, GrowsWithEveryOptionAndTheSameSeedWritesTheSameBytes)
     const std::string rec = test::source_path("recordings/table1-1lobe-5strokes.lrec");
     const std::string opts = " --grower self-organizing --environment shadow --bud-fate priority --iterations 12 "
                              "--species conifer --seed 4 --out ";
-    const test::CliRun a = test::run_cli("grow " + rec + opts + out + "/a.glb");
+    // One file name in two folders: node names come from the file's stem.
+    std::filesystem::create_directories(out + "/a");
+    std::filesystem::create_directories(out + "/b");
+    const test::CliRun a = test::run_cli("grow " + rec + opts + out + "/a/tree.glb");
     ASSERT_EQ(a.code, 0) << a.out;
-    const test::CliRun b = test::run_cli("grow " + rec + opts + out + "/b.glb");
+    const test::CliRun b = test::run_cli("grow " + rec + opts + out + "/b/tree.glb");
     ASSERT_EQ(b.code, 0) << b.out;
-    EXPECT_EQ(bytes(out + "/a.glb"), bytes(out + "/b.glb"));
+    EXPECT_EQ(bytes(out + "/a/tree.glb"), bytes(out + "/b/tree.glb"));
     const test::CliRun markers = test::run_cli("grow " + rec + " --grower self-organizing --out " + out + "/c.glb");
     ASSERT_EQ(markers.code, 0) << markers.out;
     EXPECT_NE(bytes(out + "/a.glb"), bytes(out + "/c.glb"));

@@ -35,12 +35,14 @@ test::CliRun grow(const std::string& name, const std::string& options)
 
 TEST(CliSettings, SetChangesTheSettingTheTreeIsBuiltWith)
 {
-    // Three LODs by default; branches.lod_count=1 leaves only LOD0, so LOD 1 cannot be written.
-    const test::CliRun plain = grow("cli-set-plain", "--lod 1");
+    // Three LODs by default (and the billboard LOD3); branches.lod_count=1 leaves only LOD0
+    // and the billboard LOD1, so LOD 2 cannot be written.
+    const test::CliRun plain = grow("cli-set-plain", "--lod 2");
     EXPECT_EQ(plain.code, 0) << plain.out;
-    const test::CliRun one = grow("cli-set-one-lod", "--set branches.lod_count=1 --lod 1");
+    const test::CliRun one = grow("cli-set-one-lod", "--set branches.lod_count=1 --lod 2");
     EXPECT_EQ(one.code, 1) << one.out;
-    EXPECT_NE(one.out.find("the tree has LOD0 to LOD0; settings.branches.lod_count"), std::string::npos) << one.out;
+    EXPECT_NE(one.out.find("the tree has LOD0 to LOD0; settings.branches.lod_count, and the billboard LOD1"), std::string::npos)
+        << one.out;
     // Repeated, with a value holding commas.
     const test::CliRun two = grow("cli-set-two", "--set branches.lod_count=1 --set leaves.color=0.2,0.4,0.1 --lod 0");
     EXPECT_EQ(two.code, 0) << two.out;

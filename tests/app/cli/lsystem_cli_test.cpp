@@ -162,12 +162,15 @@ TEST(LSystemCli, GrowsInTheLobesOfASessionAndWithGrow)
 TEST(LSystemCli, APresetsNameStandsForItsShippedFile)
 {
     const std::string dir = test::temp_dir("lsystem-cli-preset");
-    const test::CliRun named = run("lsystem abop-monopodial --out " + dir + "/named.glb");
+    // One file name in two folders: node names come from the file's stem.
+    std::filesystem::create_directories(dir + "/named");
+    std::filesystem::create_directories(dir + "/file");
+    const test::CliRun named = run("lsystem abop-monopodial --out " + dir + "/named/tree.glb");
     ASSERT_EQ(named.code, 0) << named.out;
     const test::CliRun file =
-        run("lsystem " + test::source_path("growth/data/lsystems/abop-monopodial.l") + " --out " + dir + "/file.glb");
+        run("lsystem " + test::source_path("growth/data/lsystems/abop-monopodial.l") + " --out " + dir + "/file/tree.glb");
     ASSERT_EQ(file.code, 0) << file.out;
-    EXPECT_EQ(read(dir + "/named.glb"), read(dir + "/file.glb"));
+    EXPECT_EQ(read(dir + "/named/tree.glb"), read(dir + "/file/tree.glb"));
     const test::CliRun neither = run("lsystem no-such-preset --out " + dir + "/x.glb");
     EXPECT_NE(neither.code, 0);
     EXPECT_NE(neither.out.find("no-such-preset"), std::string::npos) << neither.out;

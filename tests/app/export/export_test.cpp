@@ -513,7 +513,8 @@ TEST(ExportGltf, LobesAndStrokesAppearOnlyWhenAsked)
     ExportOptions options;
     options.include_lobes = true;
     const tinygltf::Model lobes_only = load_glb(encode_glb(scene, options));
-    EXPECT_NE(find_node(lobes_only, "lobe_0"), nullptr);
+    EXPECT_NE(find_node(lobes_only, "lobe_1"), nullptr); // named by id: 1, 2, … when the scene gives no ids
+    EXPECT_EQ(find_node(lobes_only, "lobe_0"), nullptr);
     EXPECT_EQ(find_node(lobes_only, "stroke_7"), nullptr);
 
     options.include_strokes = true;
@@ -522,9 +523,9 @@ TEST(ExportGltf, LobesAndStrokesAppearOnlyWhenAsked)
     const tinygltf::Node& sketch = m.nodes.at(std::size_t(m.scenes[0].nodes[1]));
     EXPECT_EQ(sketch.name, "tree_sketch");
     // The one-point stroke 11 is left out: a line needs two points.
-    EXPECT_EQ(child_names(m, sketch), (std::vector<std::string>{"lobe_0", "lobe_1", "stroke_7", "stroke_9"}));
+    EXPECT_EQ(child_names(m, sketch), (std::vector<std::string>{"lobe_1", "lobe_2", "stroke_7", "stroke_9"}));
 
-    const tinygltf::Primitive& lobe = primitive_of(m, "lobe_1");
+    const tinygltf::Primitive& lobe = primitive_of(m, "lobe_2");
     EXPECT_EQ(lobe.mode, TINYGLTF_MODE_TRIANGLES);
     const tinygltf::Material& lobe_mat = m.materials.at(std::size_t(lobe.material));
     EXPECT_EQ(lobe_mat.alphaMode, "BLEND");
@@ -568,16 +569,24 @@ TEST(ExportGltf, BufferViewsAreFourByteAlignedAndIndicesUseTheSmallestType)
     EXPECT_EQ(m.accessors.at(std::size_t(primitive_of(m, "tree_branches_LOD0").indices)).componentType,
               TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT);
 
-    // 301 × 301 grid vertices: beyond 16-bit indices.
+    // 301 × 301 grid vertices: beyond 16-bit indices, so the mesh is split into primitives
+    // of at most 65,535 vertices, each with 16-bit indices.
     TreeGeometry big;
     big.lods.emplace_back();
     big.lods[0].branches = cylinder(kBase, kBase + glm::vec3(0, 3, 0), 0.2f, 300, 300);
     ASSERT_GT(big.lods[0].branches.vertex_count(), 65535u);
     const tinygltf::Model mb = load_glb(encode_glb(scene_of(big)));
-    const tinygltf::Primitive& p = primitive_of(mb, "tree_branches_LOD0");
-    EXPECT_EQ(mb.accessors.at(std::size_t(p.indices)).componentType, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT);
-    const std::vector<std::uint32_t> idx = read_indices(mb, p.indices);
-    EXPECT_EQ(*std::max_element(idx.begin(), idx.end()), big.lods[0].branches.vertex_count() - 1);
+    const auto mesh = std::find_if(mb.meshes.begin(), mb.meshes.end(), [](const tinygltf::Mesh& x) { return x.name == "tree_branches_LOD0"; });
+    ASSERT_NE(mesh, mb.meshes.end());
+    EXPECT_EQ(mesh->primitives.size(), 2u);
+    std::size_t triangles = 0;
+    for (const tinygltf::Primitive& p : mesh->primitives) {
+        EXPECT_EQ(mb.accessors.at(std::size_t(p.indices)).componentType, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT);
+        const std::vector<std::uint32_t> idx = read_indices(mb, p.indices);
+        EXPECT_LT(*std::max_element(idx.begin(), idx.end()), 65535u);
+        triangles += idx.size() / 3;
+    }
+    EXPECT_EQ(triangles, big.lods[0].branches.triangle_count());
 }
 
 TEST(ExportGltf, KhronosValidatorReportsNoErrorsForTheTree)
@@ -758,31 +767,32 @@ ObjSummary parse_obj(const std::string& text)
     return s;
 }
 
-TEST(ExportObj, WritesOneNamedObjectPerLodMeshWithFaceIndicesInRange)
+TEST(ExportObj, WritesOneLodPerObjWithNamedObjectsAndFaceIndicesInRange)
 {
     const TreeGeometry tree = test_tree();
     const std::string dir = test::temp_dir("export-obj");
-    write_obj(dir + "/tree.obj", scene_of(tree));
-    const ObjSummary s = parse_obj(read_text(dir + "/tree.obj"));
-    const std::vector<std::string> expected = {"tree_branches_LOD0", "tree_leaves_LOD0", "tree_branches_LOD1",
-                                               "tree_leaves_LOD1", "tree_branches_LOD2"};
-    EXPECT_EQ(s.objects, expected);
-    for (const std::string& o : expected)
-        EXPECT_EQ(s.material_of.at(o), o.find("_leaves_") != std::string::npos ? "leaf" : "bark") << o;
-    EXPECT_EQ(s.mtllib, "tree.mtl");
-    std::size_t vertices = 0, triangles = 0;
-    for (const TreeLod& lod : tree.lods) {
-        vertices += lod.branches.vertex_count() + lod.leaves.vertex_count();
-        triangles += lod.branches.triangle_count() + lod.leaves.triangle_count();
+    const std::vector<std::string> written = write_obj(dir + "/tree.obj", scene_of(tree));
+    EXPECT_EQ(written, (std::vector<std::string>{dir + "/tree.obj", dir + "/tree.mtl", dir + "/tree_leaf.png",
+                                                 dir + "/tree_LOD1.obj", dir + "/tree_LOD2.obj"}));
+    const std::vector<std::vector<std::string>> expected = {
+        {"tree_branches_LOD0", "tree_leaves_LOD0"}, {"tree_branches_LOD1", "tree_leaves_LOD1"}, {"tree_branches_LOD2"}};
+    for (std::size_t lod = 0; lod < 3; ++lod) {
+        const std::string file = dir + (lod == 0 ? "/tree.obj" : "/tree_LOD" + std::to_string(lod) + ".obj");
+        const ObjSummary s = parse_obj(read_text(file));
+        EXPECT_EQ(s.objects, expected[lod]) << file;
+        for (const std::string& o : expected[lod])
+            EXPECT_EQ(s.material_of.at(o), o.find("_leaves_") != std::string::npos ? "leaf" : "bark") << o;
+        EXPECT_EQ(s.mtllib, "tree.mtl");
+        const TreeLod& l = tree.lods[lod];
+        EXPECT_EQ(s.v, l.branches.vertex_count() + l.leaves.vertex_count()) << file;
+        EXPECT_EQ(s.vt, s.v);
+        EXPECT_EQ(s.vn, s.v);
+        EXPECT_EQ(s.faces, l.branches.triangle_count() + l.leaves.triangle_count()) << file;
+        EXPECT_TRUE(s.indices_in_range) << s.first_bad;
+        float min_y = 1e30f;
+        for (const glm::vec3& p : s.positions) min_y = std::min(min_y, p.y);
+        EXPECT_NEAR(min_y, 0.0f, 1e-6f) << "the trunk base is the origin";
     }
-    EXPECT_EQ(s.v, vertices);
-    EXPECT_EQ(s.vt, vertices);
-    EXPECT_EQ(s.vn, vertices);
-    EXPECT_EQ(s.faces, triangles);
-    EXPECT_TRUE(s.indices_in_range) << s.first_bad;
-    float min_y = 1e30f;
-    for (const glm::vec3& p : s.positions) min_y = std::min(min_y, p.y);
-    EXPECT_NEAR(min_y, 0.0f, 1e-6f) << "the trunk base is the origin";
 }
 
 TEST(ExportObj, MtlDefinesBarkAndLeafAndReferencesTheLeafPngWhichExistsAndDecodes)
@@ -793,8 +803,10 @@ TEST(ExportObj, MtlDefinesBarkAndLeafAndReferencesTheLeafPngWhichExistsAndDecode
     const std::string mtl = read_text(dir + "/oak.mtl");
     EXPECT_NE(mtl.find("newmtl bark\n"), std::string::npos) << mtl;
     EXPECT_NE(mtl.find("newmtl leaf\n"), std::string::npos) << mtl;
+    // The leaf colour is baked into its texture (Kd white); the untextured bark keeps its Kd.
     EXPECT_NE(mtl.find("Kd 0.3 0.2 0.1\n"), std::string::npos) << mtl;
-    EXPECT_NE(mtl.find("Kd 0.25 0.5 0.15\n"), std::string::npos) << mtl;
+    EXPECT_EQ(mtl.find("Kd 0.25 0.5 0.15\n"), std::string::npos) << mtl;
+    EXPECT_NE(mtl.find("Kd 1 1 1\n"), std::string::npos) << mtl;
     EXPECT_NE(mtl.find("map_Kd oak_leaf.png\n"), std::string::npos) << mtl;
     EXPECT_NE(mtl.find("map_d oak_leaf.png\n"), std::string::npos) << mtl;
     const std::string png_path = dir + "/oak_leaf.png";
@@ -805,7 +817,13 @@ TEST(ExportObj, MtlDefinesBarkAndLeafAndReferencesTheLeafPngWhichExistsAndDecode
     ASSERT_TRUE(tinygltf::LoadImageData(&img, 0, &err, &warn, 0, 0, png.data(), int(png.size()), nullptr)) << err;
     EXPECT_EQ(img.width, 64);
     EXPECT_EQ(img.height, 64);
-    EXPECT_EQ(img.image, tree.leaf_texture.pixels);
+    EXPECT_EQ(img.image, tinted_texture(tree.leaf_texture, tree.leaf_color).pixels);
+    // Tinting is what a glTF viewer does with the factor: white (sRGB 255) becomes the colour
+    // itself in sRGB, alpha is kept.
+    RgbaImage white{1, 1, {255, 255, 255, 77}};
+    const RgbaImage t = tinted_texture(white, {0.25f, 0.5f, 0.15f});
+    EXPECT_EQ(t.pixels, (std::vector<std::uint8_t>{linear_to_srgb(0.25), linear_to_srgb(0.5), linear_to_srgb(0.15), 77}));
+    EXPECT_EQ(linear_to_srgb(0.5), 188);
 }
 
 TEST(ExportObj, FlipsVForObjAndFollowsTheSameOriginHeightAndExtrasRules)
@@ -817,9 +835,9 @@ TEST(ExportObj, FlipsVForObjAndFollowsTheSameOriginHeightAndExtrasRules)
     options.include_lobes = options.include_strokes = true;
     const ObjFiles files = encode_obj(scene_of(tree, true), options, "t.mtl", "t_leaf.png");
     const ObjSummary s = parse_obj(files.obj);
-    EXPECT_EQ(s.objects, (std::vector<std::string>{"tree_branches_LOD1", "tree_leaves_LOD1", "lobe_0", "lobe_1",
+    EXPECT_EQ(s.objects, (std::vector<std::string>{"tree_branches_LOD1", "tree_leaves_LOD1", "lobe_1", "lobe_2",
                                                    "stroke_7", "stroke_9"}));
-    EXPECT_EQ(s.material_of.at("lobe_0"), "lobe");
+    EXPECT_EQ(s.material_of.at("lobe_1"), "lobe");
     EXPECT_EQ(s.material_of.at("stroke_9"), "stroke");
     EXPECT_EQ(s.lines, 2u);
     EXPECT_TRUE(s.indices_in_range) << s.first_bad;

@@ -1,5 +1,6 @@
 // An L-system tree in a session (docs/session-format.md, trees[].grower): the grower and its
 // source travel in the file, and the session regrows the same tree, byte for byte.
+#include <filesystem>
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -75,14 +76,18 @@ TEST(LSystemGrowerSession, TheGrowerAndItsSourceRoundTripAndRegrowTheSameBytes)
     EXPECT_NE(read(dir + "/session.json").find("\"source\""), std::string::npos);
     const Document loaded = load_session(dir + "/session.json");
     EXPECT_EQ(scene_grower(loaded), scene_grower(doc));
-    const std::string a = grown_glb(doc, dir + "/a.glb");
-    const std::string b = grown_glb(loaded, dir + "/b.glb");
+    // One file name in two folders: node names come from the file's stem.
+    std::filesystem::create_directories(dir + "/a");
+    std::filesystem::create_directories(dir + "/b");
+    std::filesystem::create_directories(dir + "/c");
+    const std::string a = grown_glb(doc, dir + "/a/tree.glb");
+    const std::string b = grown_glb(loaded, dir + "/b/tree.glb");
     ASSERT_GT(a.size(), 1000u);
     EXPECT_TRUE(a == b) << "the reloaded session grew another tree";
     // Another seed picks other stochastic productions: another tree.
     Document other = loaded;
     other.seed = 12;
-    EXPECT_FALSE(grown_glb(other, dir + "/c.glb") == a);
+    EXPECT_FALSE(grown_glb(other, dir + "/c/tree.glb") == a);
 }
 
 TEST(LSystemGrowerSession, ASessionNamingABadParameterIsRefusedWhenLoaded)

@@ -74,10 +74,13 @@ TEST(SessionFile, GrowWithTheDefaultGrowerNamedGivesTheSameTreeAndAnUnknownOneIs
 {
     const std::string out = test::temp_dir("grow-grower");
     const std::string rec = test::source_path("recordings/table1-1lobe-5strokes.lrec");
-    ASSERT_EQ(test::run_cli("grow " + rec + " --out " + out + "/a.glb").code, 0);
-    const test::CliRun named = test::run_cli("grow " + rec + " --grower " + kDefaultGrowerName + " --out " + out + "/b.glb");
+    // One file name in two folders: node names come from the file's stem.
+    std::filesystem::create_directories(out + "/a");
+    std::filesystem::create_directories(out + "/b");
+    ASSERT_EQ(test::run_cli("grow " + rec + " --out " + out + "/a/tree.glb").code, 0);
+    const test::CliRun named = test::run_cli("grow " + rec + " --grower " + kDefaultGrowerName + " --out " + out + "/b/tree.glb");
     ASSERT_EQ(named.code, 0) << named.out;
-    EXPECT_EQ(bytes(out + "/a.glb"), bytes(out + "/b.glb"));
+    EXPECT_EQ(bytes(out + "/a/tree.glb"), bytes(out + "/b/tree.glb"));
     const test::CliRun bad = test::run_cli("grow " + rec + " --grower l-sistem --out " + out + "/c.glb");
     EXPECT_EQ(bad.code, 2) << bad.out;
     EXPECT_NE(bad.out.find("--grower"), std::string::npos) << bad.out;

@@ -80,7 +80,7 @@ TEST(VrSession, PanelLayoutStandsInFrontOfAndBelowTheFirstHeadPoseFacingIt)
     EXPECT_LT(p.origin.y, head.position.y - 0.2f); // below the eyes
     const glm::vec3 n = p.orientation * glm::vec3(0, 0, 1);
     EXPECT_GT(glm::dot(n, glm::normalize(head.position - p.origin)), 0.99f); // faces the eyes
-    EXPECT_EQ(p.buttons.size(), 38u);
+    EXPECT_EQ(p.buttons.size(), 47u); // 30, the L-system sketch mode's 9 and the tree's appearance 8
     for (const char* appearance : {"WIDTH -", "WIDTH +", "LEAF COLOUR", "BARK COLOUR", "TWIG -", "TWIG +", "PIPE -", "PIPE +"})
         EXPECT_EQ(std::count_if(p.buttons.begin(), p.buttons.end(), [&](const VrButton& b) { return b.text == appearance; }), 1)
             << appearance << ": the tree's leaf width, colours and radii";
