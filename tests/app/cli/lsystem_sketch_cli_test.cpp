@@ -44,18 +44,22 @@ std::string maple() { return test::source_path("tests/data/sketches/maple.json")
 TEST(LSystemSketchCli, TheWrittenRulesGrowTheSameTreeBytes)
 {
     const std::string dir = test::temp_dir("lsystem-sketch-cli-same");
+    // Same output file names, so the same node names (they follow the stem).
+    std::filesystem::create_directories(dir + "/a");
+    std::filesystem::create_directories(dir + "/b");
     const test::CliRun a = run("-q lsystem --sketch " + maple() + " --rules-out " + dir + "/rules.l --out " + dir +
-                               "/a.glb --skeleton-out " + dir + "/a.json");
+                               "/a/tree.glb --skeleton-out " + dir + "/a.json");
     ASSERT_EQ(a.code, 0) << a.out;
     ASSERT_TRUE(std::filesystem::exists(dir + "/rules.l"));
     ASSERT_TRUE(std::filesystem::exists(dir + "/rules.v"));
     EXPECT_NE(read(dir + "/rules.l").find("A(x,t) < B(b,s)"), std::string::npos);
-    const test::CliRun b = run("-q lsystem " + dir + "/rules.l --out " + dir + "/b.glb --skeleton-out " + dir + "/b.json");
+    const test::CliRun b = run("-q lsystem " + dir + "/rules.l --out " + dir + "/b/tree.glb --skeleton-out " + dir + "/b.json");
     ASSERT_EQ(b.code, 0) << b.out;
-    EXPECT_EQ(read(dir + "/a.glb"), read(dir + "/b.glb"));
+    // (Compared as booleans: a failure would print megabytes of binary.)
+    EXPECT_TRUE(read(dir + "/a/tree.glb") == read(dir + "/b/tree.glb"));
     EXPECT_EQ(read(dir + "/a.json"), read(dir + "/b.json"));
     nlohmann::json report;
-    ASSERT_TRUE(test::validate_gltf(dir + "/a.glb", report));
+    ASSERT_TRUE(test::validate_gltf(dir + "/a/tree.glb", report));
     EXPECT_EQ(report["issues"]["numErrors"], 0) << test::describe_gltf_issues(report);
     // In metres as sketched, and past the sketch's 2.3 m by iteration 8 (its sections repeat).
     const nlohmann::json sk = nlohmann::json::parse(read(dir + "/a.json"));
@@ -85,16 +89,19 @@ TEST(LSystemSketchCli, ARecordingOfTheSketchModeGrowsAsItsReplayedSketch)
     // `lsystem --sketch REC.lrec` grows the same bytes as that sketch file at the growth the
     // recording left (7).
     const std::string dir = test::temp_dir("lsystem-sketch-cli-rec");
+    // Same output file names, so the same node names (they follow the stem).
+    std::filesystem::create_directories(dir + "/a");
+    std::filesystem::create_directories(dir + "/b");
     const std::string rec = test::source_path("recordings/lsystem-sketch/maple.lrec");
     const test::CliRun rp = run("-q replay " + rec + " --out " + dir + "/replayed");
     ASSERT_EQ(rp.code, 0) << rp.out;
     ASSERT_TRUE(std::filesystem::exists(dir + "/replayed/lsystem-sketch.json"));
-    const test::CliRun a = run("-q lsystem --sketch " + rec + " --sketch-out " + dir + "/s.json --out " + dir + "/a.glb");
+    const test::CliRun a = run("-q lsystem --sketch " + rec + " --sketch-out " + dir + "/s.json --out " + dir + "/a/tree.glb");
     ASSERT_EQ(a.code, 0) << a.out;
     EXPECT_EQ(read(dir + "/s.json"), read(dir + "/replayed/lsystem-sketch.json"));
-    const test::CliRun b = run("-q lsystem --sketch " + dir + "/s.json --growth 7 --out " + dir + "/b.glb");
+    const test::CliRun b = run("-q lsystem --sketch " + dir + "/s.json --growth 7 --out " + dir + "/b/tree.glb");
     ASSERT_EQ(b.code, 0) << b.out;
-    EXPECT_EQ(read(dir + "/a.glb"), read(dir + "/b.glb"));
+    EXPECT_TRUE(read(dir + "/a/tree.glb") == read(dir + "/b/tree.glb"));
     // A recording without the mode is no sketch.
     const test::CliRun c = run("lsystem --sketch " + test::source_path("recordings/pinch-edit.lrec") + " --out " + dir + "/c.glb");
     EXPECT_EQ(c.code, 1) << c.out;
