@@ -120,7 +120,9 @@ TEST(SessionFile, SessionsWrittenBeforeGrowersAndTypedEditsLoadUpgradeAndSaveToT
             added = true;
         }
         EXPECT_EQ(saved, old) << name;
-        if (!added) EXPECT_EQ(bytes(dir + "/" + name), bytes(e.path().string())) << name;
+        if (!added) {
+            EXPECT_EQ(bytes(dir + "/" + name), bytes(e.path().string())) << name;
+        }
         ++files;
     }
     EXPECT_EQ(files, 2u);

@@ -76,8 +76,9 @@ TEST(SpeciesForm, SpeciesSkeletonsDifferInBranchAngleAndDroop)
     // willow's branch angles differ from the broadleaf's.
     for (const char* a : kSpecies)
         for (const char* b : kSpecies)
-            if (std::string(a) < b)
+            if (std::string(a) < b) {
                 EXPECT_GT(ks_distance(st[a].tip_elevations_deg, st[b].tip_elevations_deg), 0.15) << a << " vs " << b;
+            }
     EXPECT_GT(ks_distance(st["broadleaf"].branch_angles_deg, st["conifer"].branch_angles_deg), 0.1);
     EXPECT_GT(ks_distance(st["broadleaf"].branch_angles_deg, st["willow"].branch_angles_deg), 0.1);
 }
