@@ -2,7 +2,9 @@
 # Installs the Debian 12 packages Lobesketch needs (only those missing, quietly), the Khronos
 # glTF validator the export tests run (npm, pinned, into build/tools/gltf-validator), the npm
 # L-system library scripts/lsystem-compare.sh runs (build/tools/lindenmayer) and builds the
-# given CMake preset (default: release). Safe to run again and again.
+# given CMake preset (default: release). Safe to run again and again. With `--blender` after
+# the preset it also installs Blender (headless imports of the exported trees,
+# scripts/blender-import.sh; scripts/test.sh asks for it, a developer need not).
 #
 # The preset `demo` (scripts/demo.sh) installs only what building and running `lobesketch`
 # needs and builds only that program, into build/release: no test frameworks, sanitizer
@@ -11,6 +13,10 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 PRESET="${1:-release}"
+WITH_BLENDER="${2:-}"
+if [ -n "$WITH_BLENDER" ] && [ "$WITH_BLENDER" != "--blender" ]; then
+  echo "setup: unknown option $WITH_BLENDER (usage: scripts/setup.sh [PRESET] [--blender])" >&2; exit 2
+fi
 
 # What building and running `lobesketch` needs (the demo).
 PACKAGES=(
@@ -25,6 +31,8 @@ PACKAGES=(
 if [ "$PRESET" != "demo" ]; then
   PACKAGES+=(libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev xvfb xauth)
 fi
+# Blender 3.4 and the numpy its glTF importer needs (docs/export.md: 127 packages, 541 MB).
+[ -n "$WITH_BLENDER" ] && PACKAGES+=(blender python3-numpy)
 
 missing=()
 for p in "${PACKAGES[@]}"; do

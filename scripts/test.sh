@@ -7,7 +7,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 JOBS="$(nproc)"
 
-./scripts/setup.sh release
+./scripts/setup.sh release --blender
 ctest --preset release -j "$JOBS"
 
 cmake --preset asan >/dev/null
@@ -38,5 +38,15 @@ done
 diff -r "$replays/release" "$replays/asan" >/dev/null ||
   { echo "the release and asan builds replay a recording to different bytes:" >&2; diff -rq "$replays/release" "$replays/asan" >&2; exit 1; }
 echo "release and asan builds: every recording replays to the same bytes, and the other growers grow the same trees"
+
+# Blender imports every level of an exported tree (LOD0-2 and the billboard, plain and
+# quantized, and the OBJ levels) with the triangles the file holds (docs/export.md).
+exports="$(mktemp -d)"
+trap 'rm -rf "$replays" "$exports"' EXIT
+./build/release/app/lobesketch grow recordings/demo.lrec --out "$exports/demo.glb" -q
+mkdir -p "$exports/quantized"
+./build/release/app/lobesketch grow recordings/demo.lrec --quantize --out "$exports/quantized/demo.glb" -q
+./build/release/app/lobesketch grow recordings/demo.lrec --lod all --out "$exports/demo.obj" -q
+./scripts/blender-import.sh "$exports/demo.glb" "$exports/quantized/demo.glb" "$exports"/demo*.obj
 
 ./scripts/fuzz.sh 15
