@@ -105,7 +105,7 @@ struct PlacedLeaf {
 /// (per_node 1), its keep offset drawn from a stream keyed by (seed, its index), so coarser
 /// LODs keep each leaf with probability keep_fraction (emit_leaf_quads) and every LOD thins
 /// the same leaves whatever else changed.
-/// 	hrow InvalidInput for a leaf with a non-finite position or direction, or a size not > 0.
+/// \throw InvalidInput for a leaf with a non-finite position or direction, or a size not > 0.
 LeafCloud make_placed_leaf_cloud(const std::vector<PlacedLeaf>& placed, std::uint64_t seed);
 
 /// Number of quads emit_leaf_quads writes for `keep_fraction`.

@@ -127,7 +127,7 @@ GrowerChoice sketch_grower_choice(const SketchRules& rules, const std::string& n
 /// A sketch's tree: the rules derived and grown by the `lsystem` grower (no lobes, model
 /// units metres, the root at the model's origin, so sketched point p lands at p − trunk[0]).
 /// Radii are not set (GrowthResult::radii_set false: the pipe model's, growth/radii.h).
-/// 	hrow InvalidInput as sketch_rules, or a derivation past the engine's limits.
+/// \throw InvalidInput as sketch_rules, or a derivation past the engine's limits.
 struct SketchGrown {
     SketchRules rules;
     GrowthResult growth;
