@@ -76,6 +76,7 @@ void add_desktop_command(CLI::App& app, int& exit_code)
             // The damaged or older session file stays as it is: saves go beside it.
             if (fs::exists(session, ec)) options.session_path = beside(session, ".recovered.json");
             progress("recovered " + autosave + "; Save writes " + options.session_path);
+            options.lsystem_sketch_file = lsystem_sketch_path(autosave); // the autosave's, if any
         } else if (fs::exists(session, ec)) {
             try {
                 doc = load_session(session);
@@ -86,6 +87,8 @@ void add_desktop_command(CLI::App& app, int& exit_code)
                                         : "";
                 throw Error(std::string(e.what()) + "; nothing was changed." + offer);
             }
+            // The L-system sketch saved beside it, if any (docs/lsystem-sketch.md).
+            options.lsystem_sketch_file = lsystem_sketch_path(session);
             // Work after the last save (a crash, a killed program) is in a newer autosave.
             std::error_code e1, e2;
             const auto saved_at = fs::last_write_time(session, e1), autosaved_at = fs::last_write_time(autosave, e2);

@@ -8,13 +8,16 @@
 
 #include <CLI/CLI.hpp>
 
+#include "app/live/live_session.h"
 #include "app/session/session_file.h"
 #include "app/cli/cli.h"
 #include "app/cli/cli_common.h"
 #include "app/session/edit_hooks.h"
 #include "app/session/stage_options.h"
+#include "core/atomic_file.h"
 #include "core/document.h"
 #include "core/errors.h"
+#include "growth/lsystem/sketch.h"
 #include "input/pipeline.h"
 #include "input/recording.h"
 #include "app/session/session_builder.h"
@@ -79,6 +82,23 @@ bool same_file(const std::string& a, const std::string& b)
     return std::filesystem::equivalent(a, b, ec) && !ec;
 }
 
+/// The text of the L-system sketch autosaved beside `autosave` (lsystem_sketch_path), when
+/// there is one and it reads as a sketch; a damaged one is a warning and none.
+std::optional<std::string> autosaved_lsystem_sketch(const std::string& autosave)
+{
+    const std::string path = lsystem_sketch_path(autosave);
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) return std::nullopt;
+    try {
+        std::string text = read_file_limited(path, lsystem::kMaxSketchFileBytes);
+        (void)lsystem::parse_sketch(text, path);
+        return text;
+    } catch (const Error& e) {
+        warn(std::string(e.what()) + "; the session is recovered without its L-system sketch");
+        return std::nullopt;
+    }
+}
+
 } // namespace
 
 void add_recover_command(CLI::App& app, int& exit_code)
@@ -104,6 +124,11 @@ void add_recover_command(CLI::App& app, int& exit_code)
             throw FileError(out, "is the autosave or the recording: choose another --out");
         if (std::filesystem::exists(out, ec) && !a->force)
             throw FileError(out, "exists: choose another --out, or add --force to replace it");
+        // The L-system sketch autosaved beside the autosave goes beside the recovered session.
+        const std::optional<std::string> sketch = autosaved_lsystem_sketch(a->autosave);
+        const std::string sketch_out = lsystem_sketch_path(out);
+        if (sketch && std::filesystem::exists(sketch_out, ec) && !a->force)
+            throw FileError(sketch_out, "exists: choose another --out, or add --force to replace it");
 
         std::string used;
         Document doc = load_newest_autosave(a->autosave, used);
@@ -183,6 +208,10 @@ void add_recover_command(CLI::App& app, int& exit_code)
                      " change(s), " + std::to_string(tail.size()) + " action(s)");
         }
         save_document(out, doc);
+        if (sketch) {
+            write_file_atomic(sketch_out, *sketch);
+            progress("recovered the L-system sketch into " + sketch_out);
+        }
         progress("recovered " + std::to_string(doc.strokes.size()) + " strokes (" + std::to_string(saved_strokes) +
                  " in " + used + "), " + std::to_string(doc.lobes.size()) + " lobe group(s), " +
                  std::to_string(doc.edits.size()) + " edit(s) into " + out);

@@ -122,6 +122,8 @@ void add_vr_command(CLI::App& app, int& exit_code)
                 throw Error(std::string(e.what()) + "; nothing was changed. Its autosave, if any, is " +
                             options.autosave_path);
             }
+            // The L-system sketch saved beside it, if any (docs/lsystem-sketch.md).
+            options.lsystem_sketch_file = lsystem_sketch_path(session);
         }
         if (!a->events.empty()) {
             const Recording rec = load_recording_verbose(a->events);

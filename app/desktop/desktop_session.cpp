@@ -78,6 +78,7 @@ DesktopSession::DesktopSession(Document doc, DesktopOptions options)
     o.background_regrowth = options.background_regrowth;
     o.lod = 0; // the whole tree; the window lowers it when frames take too long
     o.lsystem_platform = sketch_platform_for(o.recording_header.source);
+    o.lsystem_sketch_file = std::move(options.lsystem_sketch_file);
     live_ = std::make_unique<LiveSession>(std::move(doc), std::move(o));
     frame_view_on_scene();
 }

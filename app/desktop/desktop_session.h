@@ -57,6 +57,8 @@ struct DesktopOptions {
     std::string autosave_path; ///< written after every change of the document (empty: none)
     std::string record_path;   ///< the session's recording (empty: not recorded)
     std::string export_path;   ///< Export writes the tree here (.glb)
+    /// The L-system sketch to start from (LiveSessionOptions::lsystem_sketch_file; empty: none).
+    std::string lsystem_sketch_file;
     /// A regrowth is asked for after every change; false runs it on this thread instead
     /// (deterministic frames for tests: the scene is current after every frame()).
     bool background_regrowth = true;

@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "core/document.h"
@@ -37,7 +38,11 @@ public:
 
     /// Queues `doc` (stamped) to be written as the autosave. Never waits for the disk.
     void submit(Document doc);
-    /// Waits until every document submitted so far is written (or failed to be).
+    /// Queues `text` to be written atomically to `path` beside the autosave (empty `text`: the
+    /// file is removed), on the same thread after the waiting document: what a live session
+    /// keeps outside its document (the L-system sketch). Newest wins, as for documents.
+    void submit_beside(std::string path, std::string text);
+    /// Waits until every document and file submitted so far is written (or failed to be).
     void wait();
     /// Why writes failed since the last call, one line each, oldest first.
     std::vector<std::string> take_failures();
@@ -60,6 +65,7 @@ private:
     mutable std::mutex mutex_;
     std::condition_variable wake_, idle_;
     std::optional<Document> pending_;
+    std::optional<std::pair<std::string, std::string>> pending_beside_; ///< path, text
     bool busy_ = false, stop_ = false;
     std::uint64_t written_ = 0;
     std::vector<std::string> failures_;

@@ -50,6 +50,10 @@ LiveSession::LiveSession(Document doc, LiveSessionOptions options)
     builder_ = std::make_unique<SessionBuilder>(std::move(doc), pick, std::move(hooks));
     if (!options_.autosave_path.empty()) autosaver_ = std::make_unique<AutosaveWriter>(options_.autosave_path);
     worker_ = std::make_unique<RegrowWorker>([this](RegrowResult& r) { scene_.prepare(r); });
+    load_lsystem_sketch();
+    // A loaded sketch is autosaved with the first change: until then an older session's
+    // autosaves (of a crash not yet recovered) stay as they are.
+    lsystem_autosaved_generation_ = lsystem_sketch_.tree_generation();
     if (!document().strokes.empty() || !document().lobes.empty()) request_regrowth();
     show_strokes();
 }
@@ -63,6 +67,19 @@ LiveSession::~LiveSession()
         // A recording that cannot be flushed at exit: nothing more can be done here.
     }
     worker_.reset(); // its thread uses scene_ (prepare) until it is joined
+}
+
+void LiveSession::load_lsystem_sketch()
+{
+    const std::string& path = options_.lsystem_sketch_file;
+    std::error_code ec;
+    if (path.empty() || !std::filesystem::exists(path, ec)) return;
+    try {
+        lsystem_sketch_.load(lsystem::parse_sketch(read_file_limited(path, lsystem::kMaxSketchFileBytes), path), path);
+    } catch (const Error& e) {
+        // Left as it is: save() writes over it only once a new sketch is drawn.
+        note(std::string("L-system sketch not loaded: ") + e.what());
+    }
 }
 
 void LiveSession::note(std::string line)
@@ -131,6 +148,7 @@ void LiveSession::update()
 {
     if (options_.background_regrowth) take_regrowth(worker_->take());
     update_live_edits();
+    autosave_lsystem_sketch(false);
     report_autosave_failures();
 }
 
@@ -162,6 +180,31 @@ void LiveSession::autosave()
     const std::string why = autosaver_->submit_after_change(recording_.get(), document(), frames_recorded_, finished_,
                                                             !options_.background_regrowth);
     if (!why.empty()) note("autosave failed: " + why);
+    document_autosaved_ = true;
+    autosave_lsystem_sketch(true);
+}
+
+void LiveSession::autosave_lsystem_sketch(bool with_document)
+{
+    if (!autosaver_) return;
+    const std::uint64_t generation = lsystem_sketch_.tree_generation();
+    if (!with_document && generation == lsystem_autosaved_generation_) return;
+    lsystem_autosaved_generation_ = generation;
+    // What save() would write beside the session; none (the file removed) for a scrapped one.
+    std::string text;
+    if (lsystem_sketch_.sketch().trunk.size() >= 2) text = lsystem::sketch_json(lsystem_sketch_.sketch_file()) + "\n";
+    if (lsystem_autosaved_ && *lsystem_autosaved_ == text) return;
+    if (!document_autosaved_) {
+        // Nothing drawn yet: an older session's autosaves stay until this session makes its own.
+        if (text.empty()) return;
+        // The first autosave of this session: the document goes with the sketch, so that
+        // `recover` finds both (autosave() comes back here).
+        autosave();
+        return;
+    }
+    lsystem_autosaved_ = text;
+    autosaver_->submit_beside(lsystem_sketch_path(options_.autosave_path), std::move(text));
+    if (!options_.background_regrowth) autosaver_->wait();
 }
 
 void LiveSession::report_autosave_failures()
@@ -406,7 +449,8 @@ void LiveSession::close(std::uint64_t revision_before)
     closed_ = true;
     // The end changed nothing: the last autosave still says so, for `recover` to see that
     // nothing of the recording is left to replay.
-    if (revision_ == revision_before && revision_ > 0) autosave();
+    if (revision_ == revision_before && document_autosaved_) autosave();
+    autosave_lsystem_sketch(false);
     if (autosaver_) {
         autosaver_->wait();
         report_autosave_failures();

@@ -58,11 +58,16 @@ struct LiveSessionOptions {
     std::string imports_refused;
     /// Where the L-system sketch mode's platform stands (keys::kLSystemSketch turns it on).
     SketchPlatform lsystem_platform;
+    /// A sketch file the L-system sketch mode starts from (the one saved beside an opened
+    /// session, or an autosave's): empty or missing, none. Untrusted: one that does not load
+    /// is one message line, the mode starts empty and the file is left as it is.
+    std::string lsystem_sketch_file;
 };
 
 class LiveSession {
 public:
-    /// Starts from `doc` (a loaded session or an empty one).
+    /// Starts from `doc` (a loaded session or an empty one), and the L-system sketch of
+    /// options.lsystem_sketch_file when there is one.
     /// \throw FileError when the recording cannot be created.
     LiveSession(Document doc, LiveSessionOptions options);
     /// Finishes the session (finish_input, close) when the app did not.
@@ -154,8 +159,15 @@ public:
 
 private:
     void document_changed();
+    /// Loads options_.lsystem_sketch_file into the sketch mode (a failure is one message line).
+    void load_lsystem_sketch();
     void autosave();
     void report_autosave_failures();
+    /// The L-system sketch beside the autosave (lsystem_sketch_path(autosave_path); removed
+    /// when there is none) when it changed since it was last handed over. Called by autosave()
+    /// `with_document` just submitted; else (every update) a sketch changed before this
+    /// session's first autosave makes that autosave, with the document.
+    void autosave_lsystem_sketch(bool with_document);
     void request_regrowth();
     void submit_preview(Document doc);
     void take_regrowth(std::optional<RegrowResult> result);
@@ -202,10 +214,15 @@ private:
     LSystemSketchMode lsystem_sketch_;
     LSystemSketchView lsystem_view_;
     std::size_t lsystem_messages_seen_ = 0;
+    /// The sketch file text last handed to the autosave (empty: removed); none before the first.
+    std::optional<std::string> lsystem_autosaved_;
+    bool document_autosaved_ = false; ///< this session has submitted an autosave of its document
+    std::uint64_t lsystem_autosaved_generation_ = 0;
 };
 
 /// Where save() writes the L-system sketch of the session saved at `session_path`:
-/// "NAME.lsystem-sketch.json" beside "NAME.json" (docs/lsystem-sketch.md).
+/// "NAME.lsystem-sketch.json" beside "NAME.json" (docs/lsystem-sketch.md); the autosave
+/// keeps its own beside the autosave, and `recover` puts it beside the recovered session.
 std::string lsystem_sketch_path(const std::string& session_path);
 
 } // namespace lobe

@@ -135,6 +135,29 @@ bool LSystemSketchMode::commit(lsystem::Sketch next, const std::string& what, bo
     }
 }
 
+void LSystemSketchMode::load(lsystem::Sketch s, const std::string& name)
+{
+    // The growth is the mode's own: a sketch file's iterations are the growth it was saved at.
+    const std::optional<double> growth =
+        s.iterations > 0 ? std::optional<double>(static_cast<double>(s.iterations)) : std::nullopt;
+    s.iterations = 0;
+    const std::optional<double> before = growth_;
+    growth_ = growth;
+    try {
+        check_live(s);
+        TreeGraph tree = grow(s);
+        sketch_ = std::move(s);
+        tree_local_ = std::move(tree);
+    } catch (const InvalidInput& e) {
+        growth_ = before;
+        throw InvalidInput(name + ": " + e.what());
+    }
+    segments_ = tree_local_.empty() ? 0 : tree_local_.size() - 1;
+    from_ = 0;
+    drag_.reset();
+    place_tree();
+}
+
 void LSystemSketchMode::erase(const std::pair<int, int>& n)
 {
     lsystem::Sketch next = sketch_;

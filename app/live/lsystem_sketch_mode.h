@@ -83,6 +83,12 @@ public:
     /// A frame of both hands, stage space; read only while the mode is on (gestures always).
     void push_frame(const HandFrame& frame);
 
+    /// Starts from `sketch` (a sketch file's, e.g. the one saved beside an opened session), as
+    /// if it had been drawn: the growth shown is its `iterations` when it has them, the trunk
+    /// is the axis being drawn; on or off stays as it is. \throw InvalidInput, one line
+    /// starting with `name`, when it is not a sketch the mode can hold or grow (nothing changes).
+    void load(lsystem::Sketch sketch, const std::string& name);
+
     bool active() const { return active_; }
     const lsystem::Sketch& sketch() const { return sketch_; }
     /// The sketch as a sketch file holds it: with the growth shown as its iterations when that

@@ -648,6 +648,7 @@ VrSession::VrSession(Document doc, VrOptions options)
     o.export_file_hint = std::string("start with --export FILE.glb");
     o.imports_refused = std::string("the VR app imports no meshes (use lobesketch desktop)");
     o.lsystem_platform = sketch_platform_for(o.recording_header.source);
+    o.lsystem_sketch_file = options.lsystem_sketch_file;
     live_ = std::make_unique<LiveSession>(std::move(doc), std::move(o));
     Bounds floor;
     floor.add(glm::vec3(-0.5f, 0.0f, -0.5f));

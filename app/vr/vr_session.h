@@ -42,6 +42,8 @@ struct VrOptions {
     std::string autosave_path; ///< written after every change of the document (empty: none)
     std::string record_path;   ///< the session's recording (empty: not recorded)
     std::string export_path;   ///< Export writes the tree here (.glb)
+    /// The L-system sketch to start from (LiveSessionOptions::lsystem_sketch_file; empty: none).
+    std::string lsystem_sketch_file;
     /// Events to apply at their times, as if the panel had been pressed (the event track of
     /// a recording played through an OpenXR runtime that cannot carry it, e.g. the replay
     /// runtime). Times are seconds from the first frame of that recording; frame times fed to

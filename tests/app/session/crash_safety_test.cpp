@@ -31,6 +31,8 @@
 #include "core/atomic_file.h"
 #include "core/document.h"
 #include "core/errors.h"
+#include "growth/lsystem/sketch.h"
+#include "input/tools.h"
 #include "input/pipeline.h"
 #include "input/recording.h"
 #include "app/session/session_builder.h"
@@ -349,7 +351,46 @@ struct DesktopDriver {
         s.mouse_button(desktop_keys::kMouseLeft, false);
         step(6);
     }
+    /// A click (a pinch of the simulated hand) at window pixel (x, y).
+    void click(float x, float y)
+    {
+        move(x, y);
+        step();
+        s.mouse_button(desktop_keys::kMouseLeft, true);
+        step(5);
+        s.mouse_button(desktop_keys::kMouseLeft, false);
+        step(3);
+    }
+    void press(int key)
+    {
+        s.key(key, true);
+        step();
+        s.key(key, false);
+        step();
+    }
 };
+
+/// Sketches an L-system tree in the sketch mode (the platform is below the camera's target,
+/// at the window's centre, about 5 mm per pixel): four trunk sections and a branch from trunk
+/// node 2 (as tests/data/desktop_lsystem_sketch.script does in the window); P first turns the
+/// mode on unless it is on.
+void sketch_lsystem_tree(DesktopDriver& d)
+{
+    if (!d.s.lsystem_sketch().active()) d.press(keys::kLSystemSketch);
+    for (const auto& [x, y] : {std::pair{322.0f, 190.0f}, {318.0f, 170.0f}, {324.0f, 150.0f}, {320.0f, 130.0f}}) d.click(x, y);
+    d.move(318, 170);
+    d.step(3); // the simulated fingertip settles on the node
+    d.press(lsystem_sketch_keys::kBranch);
+    d.click(345, 160);
+    d.click(365, 150);
+    d.press(lsystem_sketch_keys::kTrunk);
+}
+
+/// The sketch file the session's L-system sketch mode holds (what Save writes beside it).
+std::string sketch_file_text(const DesktopSession& s)
+{
+    return lsystem::sketch_json(s.lsystem_sketch().sketch_file()) + "\n";
+}
 
 TEST(CrashSafetyDesktop, EverySnapshotOfARunningSessionRecovers)
 {
@@ -414,6 +455,107 @@ TEST(CrashSafetyDesktop, EverySnapshotOfARunningSessionRecovers)
     ASSERT_EQ(r.code, 0) << r.out;
     EXPECT_NE(r.out.find("nothing to replay"), std::string::npos) << r.out;
     EXPECT_EQ(stroke_difference(load_document(dir + "/final.json").strokes, last.strokes), "");
+}
+
+TEST(CrashSafetyDesktop, TheLSystemSketchIsAutosavedAndRecoveredByteForByte)
+{
+    const std::string dir = temp_dir("crash-desktop-lsystem");
+    DesktopOptions o;
+    o.background_regrowth = false; // every autosave is on disk when its frame ends
+    o.autosave_path = dir + "/session.autosave.json";
+    o.record_path = dir + "/session.lrec";
+    const std::string sketch_autosave = lsystem_sketch_path(o.autosave_path);
+    EXPECT_EQ(fs::path(sketch_autosave).filename(), "session.autosave.lsystem-sketch.json");
+    const std::string snap = dir + "/snap";
+    std::string live_sketch; ///< the mode's sketch file at the "crash"
+    {
+        DesktopSession session(Document{}, o);
+        DesktopDriver d(session);
+        sketch_lsystem_tree(d);
+        ASSERT_EQ(session.lsystem_sketch().sketch().trunk_sections(), 4);
+        ASSERT_EQ(session.lsystem_sketch().sketch().branches.size(), 1u);
+        EXPECT_TRUE(session.document().strokes.empty());
+        // Only the sketch changed: the session's first autosave is made with it, so that
+        // recover finds both.
+        ASSERT_TRUE(fs::exists(o.autosave_path));
+        live_sketch = sketch_file_text(session);
+        EXPECT_EQ(read_file_limited(sketch_autosave, 1 << 20), live_sketch);
+        // The files as a kill at this moment leaves them.
+        fs::create_directories(snap);
+        for (const std::string& f : {o.autosave_path, sketch_autosave, o.record_path})
+            fs::copy_file(f, snap + "/" + fs::path(f).filename().string());
+
+        // The growth and the divergence are in the sketch file too; a scrapped sketch leaves
+        // no sketch autosave behind.
+        d.press(lsystem_sketch_keys::kIterationForward);
+        d.press(lsystem_sketch_keys::kDivergenceUp);
+        EXPECT_EQ(read_file_limited(sketch_autosave, 1 << 20), sketch_file_text(session));
+        EXPECT_NE(sketch_file_text(session), live_sketch);
+        EXPECT_NE(sketch_file_text(session).find("\"iterations\":5"), std::string::npos) << sketch_file_text(session);
+        d.press(lsystem_sketch_keys::kScrap);
+        EXPECT_FALSE(fs::exists(sketch_autosave));
+        sketch_lsystem_tree(d); // drawn again
+        session.finish(d.frame / 60.0 + 0.01);
+    }
+    // The end of the session: the sketch autosave holds the sketch its recording replays to.
+    EXPECT_EQ(read_file_limited(sketch_autosave, 1 << 20),
+              lsystem::sketch_json(replay_lsystem_sketch(read_recording(o.record_path)).sketch_file()) + "\n");
+
+    const test::CliRun r = run_cli("recover " + snap + "/session.autosave.json --recording " + snap + "/session.lrec");
+    ASSERT_EQ(r.code, 0) << r.out;
+    EXPECT_NE(r.out.find("session.autosave.recovered.lsystem-sketch.json"), std::string::npos) << r.out;
+    EXPECT_TRUE(fs::exists(snap + "/session.autosave.recovered.json"));
+    EXPECT_EQ(read_file_limited(snap + "/session.autosave.recovered.lsystem-sketch.json", 1 << 20), live_sketch)
+        << "recover puts the sketch back beside the recovered session, byte for byte";
+    // An existing sketch beside the output is not replaced without --force.
+    fs::remove(snap + "/session.autosave.recovered.json");
+    test::CliRun again = run_cli("-q recover " + snap + "/session.autosave.json");
+    EXPECT_EQ(again.code, 1) << again.out;
+    EXPECT_EQ(count_error_lines(again.out), 1) << again.out;
+    EXPECT_NE(again.out.find("lsystem-sketch.json: exists"), std::string::npos) << again.out;
+    EXPECT_FALSE(fs::exists(snap + "/session.autosave.recovered.json"));
+    again = run_cli("-q recover " + snap + "/session.autosave.json --force");
+    EXPECT_EQ(again.code, 0) << again.out;
+}
+
+TEST(CrashSafetyRecover, ADamagedSketchAutosaveIsOneLineAndTheSessionStillRecovers)
+{
+    const std::string dir = temp_dir("recover-lsystem-damaged");
+    DesktopOptions o;
+    o.background_regrowth = false;
+    o.autosave_path = dir + "/a.json";
+    o.record_path = dir + "/a.lrec";
+    {
+        DesktopSession session(Document{}, o);
+        DesktopDriver d(session);
+        d.circle(320, 180, 60, 40);
+        sketch_lsystem_tree(d);
+        session.finish(d.frame / 60.0 + 0.01);
+    }
+    const std::string sketch_autosave = lsystem_sketch_path(o.autosave_path);
+    const std::string text = read_file_limited(sketch_autosave, 1 << 20);
+    const std::vector<std::string> damages = {
+        text.substr(0, text.size() / 2),            // cut in half
+        R"({"trunk": [[0, 0, 0]]})",                // one trunk node: no section
+        R"({"trunk": [[0, 0, 0], [0, 0, 0]]})",     // a zero-length section
+        std::string(3000, '\x5a'),                  // not JSON
+    };
+    for (std::size_t i = 0; i < damages.size(); ++i) {
+        SCOPED_TRACE("damage " + std::to_string(i));
+        std::ofstream(sketch_autosave, std::ios::binary | std::ios::trunc) << damages[i];
+        const std::string out = dir + "/r" + std::to_string(i) + ".json";
+        const test::CliRun r = run_cli("-q recover " + o.autosave_path + " --out " + out);
+        ASSERT_EQ(r.code, 0) << r.out;
+        int warnings = 0;
+        std::istringstream in(r.out);
+        for (std::string line; std::getline(in, line);) warnings += line.rfind("lobesketch: warning: ", 0) == 0;
+        EXPECT_EQ(warnings, 1) << r.out;
+        EXPECT_NE(r.out.find("a.lsystem-sketch.json"), std::string::npos) << r.out;
+        EXPECT_NE(r.out.find("without its L-system sketch"), std::string::npos) << r.out;
+        EXPECT_EQ(load_document(out).strokes.size(), 1u);
+        EXPECT_FALSE(fs::exists(lsystem_sketch_path(out)));
+        EXPECT_EQ(read_file_limited(sketch_autosave, 1 << 20), damages[i]) << "left as it is";
+    }
 }
 
 // ---------------------------------------------------------------------------------------------
