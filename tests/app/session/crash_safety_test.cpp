@@ -377,7 +377,8 @@ struct DesktopDriver {
 void sketch_lsystem_tree(DesktopDriver& d)
 {
     if (!d.s.lsystem_sketch().active()) d.press(keys::kLSystemSketch);
-    for (const auto& [x, y] : {std::pair{322.0f, 190.0f}, {318.0f, 170.0f}, {324.0f, 150.0f}, {320.0f, 130.0f}}) d.click(x, y);
+    const float trunk[][2] = {{322, 190}, {318, 170}, {324, 150}, {320, 130}};
+    for (const auto& p : trunk) d.click(p[0], p[1]);
     d.move(318, 170);
     d.step(3); // the simulated fingertip settles on the node
     d.press(lsystem_sketch_keys::kBranch);
@@ -465,7 +466,7 @@ TEST(CrashSafetyDesktop, TheLSystemSketchIsAutosavedAndRecoveredByteForByte)
     o.autosave_path = dir + "/session.autosave.json";
     o.record_path = dir + "/session.lrec";
     const std::string sketch_autosave = lsystem_sketch_path(o.autosave_path);
-    EXPECT_EQ(fs::path(sketch_autosave).filename(), "session.autosave.lsystem-sketch.json");
+    EXPECT_EQ(fs::path(sketch_autosave).filename().string(), "session.autosave.lsystem-sketch.json");
     const std::string snap = dir + "/snap";
     std::string live_sketch; ///< the mode's sketch file at the "crash"
     {
