@@ -142,25 +142,6 @@ public:
     /// The bark's uv range (KHR_texture_transform of the bark material when compressed).
     glm::dvec2 bark_uv_lo{0.0}, bark_uv_extent{1.0};
 
-    /// Triangle indices, 16-bit when they fit, meshopt-compressed.
-    int add_indices_q(const std::vector<std::array<std::uint32_t, 3>>& triangles, std::size_t vertex_count)
-    {
-        const std::size_t count = triangles.size() * 3;
-        if (vertex_count <= 65535) {
-            std::vector<std::uint16_t> idx;
-            idx.reserve(count);
-            for (const auto& t : triangles)
-                for (std::uint32_t i : t) idx.push_back(static_cast<std::uint16_t>(i));
-            return push(accessor(add_compressed_view(idx.data(), idx.size() * 2, kElementArrayBuffer, 2, vertex_count),
-                                 TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, count, TINYGLTF_TYPE_SCALAR));
-        }
-        std::vector<std::uint32_t> idx;
-        idx.reserve(count);
-        for (const auto& t : triangles) idx.insert(idx.end(), t.begin(), t.end());
-        return push(accessor(add_compressed_view(idx.data(), idx.size() * 4, kElementArrayBuffer, 4, vertex_count),
-                             TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, count, TINYGLTF_TYPE_SCALAR));
-    }
-
     int add_view(const void* data, std::size_t bytes, int target)
     {
         std::vector<unsigned char>& bin = model_.buffers[0].data;
@@ -215,23 +196,29 @@ public:
     }
 
     /// Triangle indices as UNSIGNED_SHORT when every index fits below the 16-bit restart
-    /// value (65535, which glTF forbids as an index), else UNSIGNED_INT.
-    int add_indices(const std::vector<std::array<std::uint32_t, 3>>& triangles, std::size_t vertex_count)
+    /// value (65535, which glTF forbids as an index), else UNSIGNED_INT; `compressed`: in a
+    /// view of add_compressed_view (meshopt-encoded unless quantized only).
+    int add_indices(const std::vector<std::array<std::uint32_t, 3>>& triangles, std::size_t vertex_count,
+                    bool compressed = false)
     {
         const std::size_t count = triangles.size() * 3;
+        const auto view = [&](const void* data, std::size_t element) {
+            return compressed ? add_compressed_view(data, count * element, kElementArrayBuffer, element, vertex_count)
+                              : add_view(data, count * element, kElementArrayBuffer);
+        };
         if (vertex_count <= 65535) {
             std::vector<std::uint16_t> idx;
             idx.reserve(count);
             for (const auto& t : triangles)
                 for (std::uint32_t i : t) idx.push_back(static_cast<std::uint16_t>(i));
-            return push(accessor(add_view(idx.data(), idx.size() * sizeof(std::uint16_t), kElementArrayBuffer),
-                                 TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, count, TINYGLTF_TYPE_SCALAR));
+            return push(accessor(view(idx.data(), sizeof(std::uint16_t)), TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, count,
+                                 TINYGLTF_TYPE_SCALAR));
         }
         std::vector<std::uint32_t> idx;
         idx.reserve(count);
         for (const auto& t : triangles) idx.insert(idx.end(), t.begin(), t.end());
-        return push(accessor(add_view(idx.data(), idx.size() * sizeof(std::uint32_t), kElementArrayBuffer),
-                             TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, count, TINYGLTF_TYPE_SCALAR));
+        return push(accessor(view(idx.data(), sizeof(std::uint32_t)), TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, count,
+                             TINYGLTF_TYPE_SCALAR));
     }
 
     int add_material(tinygltf::Material m)
@@ -498,7 +485,7 @@ void add_tree_parts(const PreparedExport& e, GlbBuilder& b, bool compress, tinyg
                                                             bark_uvs ? b.bark_uv_extent : glm::dvec2(1.0));
                 if (!chunk.tangents.empty())
                     prim.attributes["TANGENT"] = b.add_units_q(&chunk.tangents[0].x, chunk.tangents.size(), 4);
-                prim.indices = b.add_indices_q(g.triangles, g.vertex_count());
+                prim.indices = b.add_indices(g.triangles, g.vertex_count(), true);
             } else {
                 prim.attributes["POSITION"] = b.add_vec3(g.positions, true);
                 prim.attributes["NORMAL"] = b.add_vec3(g.normals, false);

@@ -82,6 +82,18 @@ void LiveSession::load_lsystem_sketch()
     }
 }
 
+void LiveSession::note_lsystem_messages()
+{
+    for (; lsystem_messages_seen_ < lsystem_sketch_.messages().size(); ++lsystem_messages_seen_)
+        note(lsystem_sketch_.messages()[lsystem_messages_seen_]);
+}
+
+std::string LiveSession::lsystem_sketch_text() const
+{
+    if (lsystem_sketch_.sketch().trunk.size() < 2) return {};
+    return lsystem::sketch_json(lsystem_sketch_.sketch_file()) + "\n";
+}
+
 void LiveSession::note(std::string line)
 {
     last_message_ = line;
@@ -95,8 +107,7 @@ void LiveSession::push_event(const InputEvent& e)
     if (recording_) recording_->append(e);
     pipeline_.push_event(e);
     lsystem_sketch_.push_event(e);
-    for (; lsystem_messages_seen_ < lsystem_sketch_.messages().size(); ++lsystem_messages_seen_)
-        note(lsystem_sketch_.messages()[lsystem_messages_seen_]);
+    note_lsystem_messages();
 }
 
 RenderScene& LiveSession::begin_frame_items()
@@ -118,8 +129,7 @@ void LiveSession::push_frame(const HandFrame& frame)
 {
     pipeline_.push_frame(frame);
     lsystem_sketch_.push_frame(frame);
-    for (; lsystem_messages_seen_ < lsystem_sketch_.messages().size(); ++lsystem_messages_seen_)
-        note(lsystem_sketch_.messages()[lsystem_messages_seen_]);
+    note_lsystem_messages();
     if (recording_) {
         recording_->append(frame);
         ++frames_recorded_;
@@ -191,8 +201,7 @@ void LiveSession::autosave_lsystem_sketch(bool with_document)
     if (!with_document && generation == lsystem_autosaved_generation_) return;
     lsystem_autosaved_generation_ = generation;
     // What save() would write beside the session; none (the file removed) for a scrapped one.
-    std::string text;
-    if (lsystem_sketch_.sketch().trunk.size() >= 2) text = lsystem::sketch_json(lsystem_sketch_.sketch_file()) + "\n";
+    std::string text = lsystem_sketch_text();
     if (lsystem_autosaved_ && *lsystem_autosaved_ == text) return;
     if (!document_autosaved_) {
         // Nothing drawn yet: an older session's autosaves stay until this session makes its own.
@@ -393,9 +402,9 @@ bool LiveSession::save()
         save_document(options_.session_path,
                       at_recording_position(document(), recording_ != nullptr, frames_recorded_, finished_));
         note("saved " + options_.session_path);
-        if (lsystem_sketch_.sketch().trunk.size() >= 2) {
+        if (const std::string text = lsystem_sketch_text(); !text.empty()) {
             const std::string path = lsystem_sketch_path(options_.session_path);
-            write_file_atomic(path, lsystem::sketch_json(lsystem_sketch_.sketch_file()) + "\n");
+            write_file_atomic(path, text);
             note("saved the L-system sketch to " + path);
         }
         return true;

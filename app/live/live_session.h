@@ -168,6 +168,11 @@ private:
     /// `with_document` just submitted; else (every update) a sketch changed before this
     /// session's first autosave makes that autosave, with the document.
     void autosave_lsystem_sketch(bool with_document);
+    /// The sketch file's text as save() writes it beside the session; "" when there is no
+    /// sketch (fewer than two trunk nodes).
+    std::string lsystem_sketch_text() const;
+    /// Notes the sketch mode's messages not noted yet.
+    void note_lsystem_messages();
     void request_regrowth();
     void submit_preview(Document doc);
     void take_regrowth(std::optional<RegrowResult> result);

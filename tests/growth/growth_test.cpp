@@ -43,20 +43,9 @@ GrowthLobe growth_lobe(std::int64_t id, TriangleMesh mesh)
 // Length of grown branch segments whose midpoint lies outside every lobe, over all grown length.
 double outside_fraction(const TreeGraph& tree, const std::vector<GrowthLobe>& lobes)
 {
-    std::vector<MeshRaycaster> rays;
-    for (const GrowthLobe& l : lobes) rays.emplace_back(l.mesh);
-    double out = 0.0, total = 0.0;
-    for (const TreeNode& n : tree.nodes) {
-        if (n.kind != TreeNodeKind::Grown) continue;
-        const glm::vec3 a = tree.nodes[static_cast<std::size_t>(n.parent)].position;
-        const double len = glm::distance(a, n.position);
-        const glm::vec3 mid = 0.5f * (a + n.position);
-        bool in = false;
-        for (const MeshRaycaster& r : rays) in = in || r.inside(mid);
-        total += len;
-        if (!in) out += len;
-    }
-    return total > 0.0 ? out / total : 0.0;
+    std::vector<TriangleMesh> meshes;
+    for (const GrowthLobe& l : lobes) meshes.push_back(l.mesh);
+    return test::outside_share(tree, meshes);
 }
 
 TEST(Growth, GrowthVectorIsTheFormulaToOneMicro)

@@ -20,22 +20,9 @@ namespace {
 
 test::CliRun run(const std::string& args) { return test::run_cli(args); }
 
-void write(const std::string& path, const std::string& text) { std::ofstream(path, std::ios::binary) << text; }
-
-std::string read(const std::string& path)
-{
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
-std::size_t lines_of(const std::string& text)
-{
-    std::size_t n = 0;
-    for (char c : text) n += c == '\n';
-    return n + (!text.empty() && text.back() != '\n');
-}
+using test::lines_of;
+std::string read(const std::string& path) { return test::read_file(path); }
+void write(const std::string& path, const std::string& text) { test::write_file(path, text); }
 
 std::string maple() { return test::source_path("tests/data/sketches/maple.json"); }
 
